@@ -1,0 +1,84 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/eval/trajectory_metrics.h"
+#include "pixyslam/slam/types.h"
+
+namespace pixyslam::sim {
+
+// A paper-like test world: a robot drives laps of a rounded rectangle among
+// coloured poles placed outside it, so that loop closure happens every lap.
+// Noise as in the seed paper: odometry samples carry v, w errors, camera frames
+// range and bearing errors; the camera sees poles inside its horizontal field of
+// view and range limits (no occlusion). Units SI, frame as slam::Pose2.
+struct WorldOptions {
+  std::uint64_t seed = 7;
+  double duration_s = 150.0;
+  // Path: straight sides of length_m x width_m joined by quarter circles.
+  double length_m = 4.0;
+  double width_m = 2.5;
+  double corner_radius_m = 0.5;
+  double speed_mps = 0.2;
+  // Poles: this many per side, `pole_offset_m` outside the path, and as many
+  // inside it when inner_poles is set.
+  int poles_per_long_side = 3;
+  int poles_per_short_side = 2;
+  double pole_offset_m = 0.6;
+  bool inner_poles = true;
+  int first_landmark_id = 1;
+  // Sensors.
+  double odometry_rate_hz = 10.0;
+  double camera_rate_hz = 5.0;
+  double v_sigma_mps = 0.03;           // paper: 3 cm forward
+  double w_sigma_radps = 0.0349;       // paper: 2 deg turn
+  double range_sigma_m = 0.07;         // paper: 70 mm
+  double bearing_sigma_rad = 0.027;    // paper: 0.027 rad
+  double field_of_view_rad = 1.309;    // Pixy: 75 deg horizontal
+  double min_range_m = 0.2;
+  double max_range_m = 3.0;
+};
+
+// Reads a `world:` mapping; unknown keys and bad values throw config::ConfigError.
+WorldOptions read_world_options(config::YamlReader& world);
+
+struct Pole {
+  int id = 0;
+  double x_m = 0.0;
+  double y_m = 0.0;
+};
+
+struct WorldRun {
+  slam::Pose2 initial_pose = slam::Pose2::Zero();
+  std::vector<Pole> poles;
+  std::vector<slam::OdometrySample> odometry;   // noisy, at odometry_rate_hz
+  std::vector<slam::ObservationFrame> frames;   // noisy, at camera_rate_hz, frames with >= 1 pole
+  std::vector<eval::TimedPose> truth;           // true pose at every odometry sample
+  std::size_t pole_sightings = 0;
+};
+
+// The true (v, w) command of the path at time t (piecewise constant).
+struct PathCommand {
+  double v_mps = 0.0;
+  double w_radps = 0.0;
+};
+
+class LoopPath {
+ public:
+  explicit LoopPath(const WorldOptions& o);
+  PathCommand command_at(double t_s) const;
+  double lap_time_s() const { return lap_time_s_; }
+
+ private:
+  std::vector<std::pair<double, PathCommand>> segments_;  // (end time in lap, command)
+  double lap_time_s_ = 0.0;
+};
+
+std::vector<Pole> place_poles(const WorldOptions& o);
+
+// Simulates the whole run deterministically from o.seed.
+WorldRun simulate(const WorldOptions& o);
+
+}  // namespace pixyslam::sim

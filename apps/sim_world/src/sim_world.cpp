@@ -1,0 +1,133 @@
+#include "pixyslam/sim/sim_world.h"
+
+#include <cmath>
+#include <random>
+
+#include "pixyslam/slam/motion_model.h"
+#include "pixyslam/slam/observation_model.h"
+
+namespace pixyslam::sim {
+
+WorldOptions read_world_options(config::YamlReader& w) {
+  WorldOptions o;
+  o.seed = static_cast<std::uint64_t>(w.integer("seed", 0, INT64_MAX, static_cast<std::int64_t>(o.seed)));
+  o.duration_s = w.number("duration_s", 1.0, 1e6, o.duration_s);
+  o.length_m = w.number("length_m", 0.0, 1000.0, o.length_m);
+  o.width_m = w.number("width_m", 0.0, 1000.0, o.width_m);
+  o.corner_radius_m = w.number("corner_radius_m", 0.05, 100.0, o.corner_radius_m);
+  o.speed_mps = w.number("speed_mps", 0.01, 5.0, o.speed_mps);
+  o.poles_per_long_side = static_cast<int>(w.integer("poles_per_long_side", 0, 100, o.poles_per_long_side));
+  o.poles_per_short_side = static_cast<int>(w.integer("poles_per_short_side", 0, 100, o.poles_per_short_side));
+  o.pole_offset_m = w.number("pole_offset_m", 0.05, 100.0, o.pole_offset_m);
+  o.inner_poles = w.boolean("inner_poles", o.inner_poles);
+  o.first_landmark_id = static_cast<int>(w.integer("first_landmark_id", 0, 1000000, o.first_landmark_id));
+  o.odometry_rate_hz = w.number("odometry_rate_hz", 0.1, 1000.0, o.odometry_rate_hz);
+  o.camera_rate_hz = w.number("camera_rate_hz", 0.1, 100.0, o.camera_rate_hz);
+  o.v_sigma_mps = w.number("v_sigma_mps", 0.0, 10.0, o.v_sigma_mps);
+  o.w_sigma_radps = w.number("w_sigma_radps", 0.0, 10.0, o.w_sigma_radps);
+  o.range_sigma_m = w.number("range_sigma_m", 0.0, 10.0, o.range_sigma_m);
+  o.bearing_sigma_rad = w.number("bearing_sigma_rad", 0.0, 1.0, o.bearing_sigma_rad);
+  o.field_of_view_rad = w.number("field_of_view_rad", 0.01, 2.0 * M_PI, o.field_of_view_rad);
+  o.min_range_m = w.number("min_range_m", 0.0, 100.0, o.min_range_m);
+  o.max_range_m = w.number("max_range_m", 0.01, 1000.0, o.max_range_m);
+  if (o.max_range_m <= o.min_range_m) w.fail("max_range_m", "must be greater than min_range_m");
+  w.finish();
+  return o;
+}
+
+LoopPath::LoopPath(const WorldOptions& o) {
+  const double v = o.speed_mps;
+  const double turn_time = (M_PI / 2.0) * o.corner_radius_m / v;
+  const PathCommand straight{v, 0.0};
+  const PathCommand turn{v, v / o.corner_radius_m};
+  double t = 0.0;
+  for (double side : {o.length_m, o.width_m, o.length_m, o.width_m}) {
+    t += side / v;
+    segments_.push_back({t, straight});
+    t += turn_time;
+    segments_.push_back({t, turn});
+  }
+  lap_time_s_ = t;
+}
+
+PathCommand LoopPath::command_at(double t_s) const {
+  const double in_lap = std::fmod(std::max(t_s, 0.0), lap_time_s_);
+  for (const auto& [end, cmd] : segments_) {
+    if (in_lap < end) return cmd;
+  }
+  return segments_.back().second;
+}
+
+std::vector<Pole> place_poles(const WorldOptions& o) {
+  // The path starts at (0, 0) heading +x; its rectangle spans x in [0, L] and
+  // y in [0, W + 2R] with the corners rounded by R.
+  const double l = o.length_m;
+  const double h = o.width_m + 2.0 * o.corner_radius_m;
+  const double off = o.pole_offset_m;
+  std::vector<Pole> poles;
+  int id = o.first_landmark_id;
+  auto along = [&](int count, double x0, double y0, double x1, double y1) {
+    for (int i = 0; i < count; ++i) {
+      const double f = (i + 0.5) / count;
+      poles.push_back({id++, x0 + f * (x1 - x0), y0 + f * (y1 - y0)});
+    }
+  };
+  // Outer ring (offset outside the path), then the inner ring if enabled.
+  for (const double d : {off, o.inner_poles ? -off : 0.0}) {
+    if (d == 0.0) continue;
+    along(o.poles_per_long_side, 0.0, -d, l, -d);                                              // bottom
+    along(o.poles_per_short_side, l + o.corner_radius_m + d, o.corner_radius_m,
+          l + o.corner_radius_m + d, h - o.corner_radius_m);                                   // right
+    along(o.poles_per_long_side, l, h + d, 0.0, h + d);                                         // top
+    along(o.poles_per_short_side, -o.corner_radius_m - d, h - o.corner_radius_m,
+          -o.corner_radius_m - d, o.corner_radius_m);                                           // left
+  }
+  return poles;
+}
+
+WorldRun simulate(const WorldOptions& o) {
+  WorldRun run;
+  run.poles = place_poles(o);
+  run.initial_pose = slam::Pose2(0.0, 0.0, 0.0);
+  const LoopPath path(o);
+  std::mt19937_64 rng(o.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+
+  const double odo_dt = 1.0 / o.odometry_rate_hz;
+  const double cam_dt = 1.0 / o.camera_rate_hz;
+  const double sim_dt = std::min(0.01, 0.5 * std::min(odo_dt, cam_dt));
+  slam::Pose2 pose = run.initial_pose;
+  double next_odo = 0.0;
+  double next_cam = cam_dt;
+  const auto steps = static_cast<long>(std::llround(o.duration_s / sim_dt));
+  for (long step = 0; step <= steps; ++step) {
+    const double t = static_cast<double>(step) * sim_dt;
+    if (t + 1e-9 >= next_odo) {
+      const PathCommand c = path.command_at(t);
+      run.odometry.push_back({t, c.v_mps + o.v_sigma_mps * normal(rng), c.w_radps + o.w_sigma_radps * normal(rng)});
+      run.truth.push_back({t, pose.x(), pose.y(), pose.z()});
+      next_odo += odo_dt;
+    }
+    if (t + 1e-9 >= next_cam) {
+      slam::ObservationFrame frame{t, {}};
+      for (const Pole& p : run.poles) {
+        const slam::PredictedObservation z = slam::predict_observation(pose, Eigen::Vector2d(p.x_m, p.y_m));
+        if (z.z.x() < o.min_range_m || z.z.x() > o.max_range_m) continue;
+        if (std::abs(z.z.y()) > 0.5 * o.field_of_view_rad) continue;
+        slam::RangeBearing d;
+        d.landmark_id = p.id;
+        d.range_m = z.z.x() + o.range_sigma_m * normal(rng);
+        d.bearing_rad = slam::wrap_angle(z.z.y() + o.bearing_sigma_rad * normal(rng));
+        frame.detections.push_back(d);
+      }
+      run.pole_sightings += frame.detections.size();
+      if (!frame.detections.empty()) run.frames.push_back(std::move(frame));
+      next_cam += cam_dt;
+    }
+    const PathCommand c = path.command_at(t);
+    pose = slam::move(pose, c.v_mps, c.w_radps, sim_dt);
+  }
+  return run;
+}
+
+}  // namespace pixyslam::sim

@@ -1,0 +1,72 @@
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "pixyslam/eval/trajectory_metrics.h"
+
+namespace pixyslam::mrclam {
+
+// Reader for the UTIAS Multi-Robot Cooperative Localization and Mapping
+// (MRCLAM) data sets: one folder per data set with whitespace-separated text
+// files, times in unix seconds, positions in metres, angles in radians
+// counter-clockwise, all ground truth in the motion-capture world frame.
+// Subjects 1..5 are the robots, higher subject numbers are landmarks.
+
+// Odometry command at time t_s: forward velocity (m/s) and yaw rate (rad/s).
+struct OdometryRow {
+  double t_s;
+  double v_mps;
+  double w_radps;
+};
+
+// One landmark seen by the camera: subject number (barcode already mapped),
+// range (m) and bearing (rad, counter-clockwise from the robot's heading).
+struct Detection {
+  int subject;
+  double range_m;
+  double bearing_rad;
+};
+
+// All landmark detections sharing one timestamp (one camera image).
+struct MeasurementFrame {
+  double t_s;
+  std::vector<Detection> detections;
+};
+
+// Bookkeeping of the measurement file: measurement_rows data rows in total, of
+// which robot_rows saw another robot (subject 1..5), unknown_barcode_rows had a
+// barcode absent from Barcodes.dat (spurious), and landmark_rows were kept as
+// detections (any mapped subject above 5, even one missing from the landmark
+// file). measurement_rows = robot_rows + unknown_barcode_rows + landmark_rows.
+struct ReadCounts {
+  std::size_t measurement_rows = 0, robot_rows = 0, unknown_barcode_rows = 0, landmark_rows = 0;
+};
+
+// Everything one robot contributes, sorted by time (stable sorts, so rows with
+// equal times keep their file order). Frames hold landmark detections only;
+// frames that saw no landmark are omitted. groundtruth is empty if
+// RobotN_Groundtruth.dat is absent. landmarks come from
+// Landmark_Groundtruth_fixed_11_17.dat when that file exists (Dataset1's
+// original file has landmarks 11 and 17 swapped), else from
+// Landmark_Groundtruth.dat; landmark_file holds the file name used.
+struct RobotData {
+  int robot = 0;
+  std::vector<OdometryRow> odometry;
+  std::vector<MeasurementFrame> frames;
+  std::vector<eval::TimedPose> groundtruth;
+  std::vector<eval::LandmarkPoint> landmarks;
+  std::string landmark_file;
+  ReadCounts counts;
+};
+
+// Loads robot `robot` (1..5) from the data set folder `dataset_dir`. Files may
+// use LF or CRLF line ends; lines starting with '#' and blank lines are skipped.
+// Throws std::runtime_error for: robot out of 1..5, a missing folder or required
+// file (naming the path), a line with the wrong number of columns, a non-number
+// or a non-finite number ("path:line: ... in line '<text>'"), a barcode mapped
+// to two subjects, or a landmark listed twice. Prints nothing.
+RobotData load_robot(const std::string& dataset_dir, int robot);
+
+}  // namespace pixyslam::mrclam

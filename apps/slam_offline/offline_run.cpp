@@ -1,0 +1,110 @@
+#include "offline_run.h"
+
+#include <chrono>
+#include <cstdio>
+
+#include "pixyslam/eval/rigid_alignment.h"
+
+namespace pixyslam::offline {
+
+RunResult run_filter(const slam::FilterOptions& options, const RunInput& input) {
+  RunResult result;
+  slam::FastSlam2 filter(options, input.initial_pose);
+  slam::PoseGaussian dead_reckoning{input.initial_pose, Eigen::Matrix3d::Zero()};
+  slam::OdometrySample control{input.start_time_s, 0.0, 0.0};
+  double dr_time = input.start_time_s;
+
+  auto record = [&](double t) {
+    const slam::PoseEstimate e = filter.pose_estimate();
+    result.trajectory.push_back({t, e.mean.x(), e.mean.y(), e.mean.z()});
+    result.dead_reckoning.push_back(
+        {t, dead_reckoning.mean.x(), dead_reckoning.mean.y(), dead_reckoning.mean.z()});
+  };
+  auto advance_dead_reckoning = [&](double t) {
+    if (t > dr_time) dead_reckoning.mean = slam::move(dead_reckoning.mean, control.v_mps, control.w_radps, t - dr_time);
+    dr_time = std::max(dr_time, t);
+  };
+
+  const auto start = std::chrono::steady_clock::now();
+  filter.add_odometry(control);  // sets the filter's clock to the start time
+  std::size_t i = 0;
+  std::size_t k = 0;
+  while (i < input.odometry.size() || k < input.frames.size()) {
+    const bool take_odometry =
+        k == input.frames.size() ||
+        (i < input.odometry.size() && input.odometry[i].t_s <= input.frames[k].t_s);
+    if (take_odometry) {
+      const slam::OdometrySample& s = input.odometry[i++];
+      if (s.t_s < input.start_time_s) {
+        control = {input.start_time_s, s.v_mps, s.w_radps};
+        filter.add_odometry(control);
+        continue;
+      }
+      advance_dead_reckoning(s.t_s);
+      control = s;
+      filter.add_odometry(s);
+      record(s.t_s);
+    } else {
+      const slam::ObservationFrame& f = input.frames[k++];
+      if (f.t_s < input.start_time_s) continue;
+      advance_dead_reckoning(f.t_s);
+      filter.add_observations(f);
+      record(f.t_s);
+    }
+  }
+  result.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (const slam::LandmarkEstimate& lm : filter.landmarks_of_best()) {
+    result.landmarks.push_back({lm.id, lm.mean.x(), lm.mean.y(), lm.cov(0, 0), lm.cov(0, 1), lm.cov(1, 1)});
+  }
+  result.counters = filter.counters();
+  result.final_effective_sample_size = filter.pose_estimate().effective_sample_size;
+  return result;
+}
+
+Report evaluate(const RunInput& input, const RunResult& result) {
+  Report r;
+  if (!input.truth.empty() && !result.trajectory.empty()) {
+    r.has_truth = true;
+    r.filter = eval::compare_trajectory(result.trajectory, input.truth);
+    r.dead_reckoning = eval::compare_trajectory(result.dead_reckoning, input.truth);
+  }
+  if (!input.landmarks.empty() && !result.landmarks.empty()) {
+    r.has_landmarks = true;
+    std::vector<eval::LandmarkPoint> est;
+    for (const eval::LandmarkRow& row : result.landmarks) est.push_back({row.id, row.x_m, row.y_m});
+    r.landmarks = eval::compare_landmarks(est, input.landmarks);
+  }
+  return r;
+}
+
+void print_report(const std::string& title, const Report& r, const RunResult& res) {
+  constexpr double kDeg = 180.0 / M_PI;
+  std::printf("== %s\n", title.c_str());
+  if (r.has_truth) {
+    std::printf("pose ATE RMSE          %.3f m   (dead reckoning %.3f m)\n", r.filter.ate_rmse_m,
+                r.dead_reckoning.ate_rmse_m);
+    std::printf("heading RMSE           %.2f deg (dead reckoning %.2f deg)\n", r.filter.heading_rmse_rad * kDeg,
+                r.dead_reckoning.heading_rmse_rad * kDeg);
+    std::printf("pose ATE after SE(2) alignment %.3f m, max position error %.3f m, %zu truth samples\n",
+                r.filter.ate_rmse_aligned_m, r.filter.max_position_error_m, r.filter.samples);
+  } else {
+    std::printf("no robot ground truth: pose error not evaluated\n");
+  }
+  if (r.has_landmarks) {
+    std::printf("landmark RMSE          %.3f m raw, %.3f m aligned (%zu matched, %zu missing, %zu extra)\n",
+                r.landmarks.rmse_m, r.landmarks.rmse_aligned_m, r.landmarks.matched, r.landmarks.missing,
+                r.landmarks.extra);
+  }
+  const slam::FilterCounters& c = res.counters;
+  std::printf("observations           %llu used, %llu new landmark, %llu gated, %llu invalid\n",
+              static_cast<unsigned long long>(c.observations_used),
+              static_cast<unsigned long long>(c.observations_new_landmark),
+              static_cast<unsigned long long>(c.observations_gated),
+              static_cast<unsigned long long>(c.observations_invalid));
+  std::printf("filter                 %llu odometry samples, %llu frames, %llu resamples, final N_eff %.1f\n",
+              static_cast<unsigned long long>(c.odometry_samples), static_cast<unsigned long long>(c.frames),
+              static_cast<unsigned long long>(c.resamples), res.final_effective_sample_size);
+  std::printf("wall time              %.2f s\n", res.wall_time_s);
+}
+
+}  // namespace pixyslam::offline

@@ -1,0 +1,47 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "pixyslam/eval/csv_io.h"
+#include "pixyslam/eval/trajectory_metrics.h"
+#include "pixyslam/slam/fastslam2.h"
+
+namespace pixyslam::offline {
+
+// Input of one offline run: odometry and frames in any order (merged by time,
+// odometry first on equal stamps), the start pose and time, and evaluation truth.
+struct RunInput {
+  slam::Pose2 initial_pose = slam::Pose2::Zero();
+  double start_time_s = 0.0;
+  std::vector<slam::OdometrySample> odometry;
+  std::vector<slam::ObservationFrame> frames;
+  std::vector<eval::TimedPose> truth;           // may be empty
+  std::vector<eval::LandmarkPoint> landmarks;   // may be empty
+};
+
+struct RunResult {
+  std::vector<eval::TimedPose> trajectory;        // after every filter step
+  std::vector<eval::TimedPose> dead_reckoning;    // odometry alone, same steps
+  std::vector<eval::LandmarkRow> landmarks;       // best particle
+  slam::FilterCounters counters;
+  double wall_time_s = 0.0;
+  double final_effective_sample_size = 0.0;
+};
+
+// Feeds the filter in time order, skipping samples before start_time_s.
+RunResult run_filter(const slam::FilterOptions& options, const RunInput& input);
+
+// Prints the evaluation (ATE, heading, landmarks, counts) and returns the pose
+// ATE RMSE (or -1 when there is no truth).
+struct Report {
+  bool has_truth = false;
+  eval::TrajectoryErrors filter;
+  eval::TrajectoryErrors dead_reckoning;
+  bool has_landmarks = false;
+  eval::LandmarkErrors landmarks;
+};
+Report evaluate(const RunInput& input, const RunResult& result);
+void print_report(const std::string& title, const Report& report, const RunResult& result);
+
+}  // namespace pixyslam::offline

@@ -1,0 +1,69 @@
+#pragma once
+
+#include <cstdint>
+#include <initializer_list>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+#include <yaml-cpp/yaml.h>
+
+namespace pixyslam::config {
+
+// A configuration problem: the message names the file, the full key path, the
+// bad value and what was expected, e.g.
+//   "config/slam.yaml: key 'filter.particles': value 0 is out of range [1, 1000000]".
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Typed, validated access to one YAML mapping. Every key read is remembered;
+// finish() rejects keys that were never read, so a typo is an error, not a
+// silently ignored setting. Children share the file name and extend the key path.
+// Thread-compatible.
+class YamlReader {
+ public:
+  // Parses a file; a syntax error names the file, line and column.
+  static YamlReader from_file(const std::string& path);
+  // Parses text (tests, embedded defaults); `origin` stands in for a file name.
+  static YamlReader from_string(const std::string& text, const std::string& origin);
+
+  YamlReader(YAML::Node node, std::string origin, std::string key_path);
+
+  bool has(const std::string& key) const;
+  // Required sub-mapping; an absent key is an error.
+  YamlReader child(const std::string& key);
+
+  double number(const std::string& key, double min, double max);
+  double number(const std::string& key, double min, double max, double fallback);
+  std::int64_t integer(const std::string& key, std::int64_t min, std::int64_t max);
+  std::int64_t integer(const std::string& key, std::int64_t min, std::int64_t max,
+                       std::int64_t fallback);
+  bool boolean(const std::string& key);
+  bool boolean(const std::string& key, bool fallback);
+  std::string text(const std::string& key);
+  std::string text(const std::string& key, const std::string& fallback);
+  // A string that must be one of `allowed`.
+  std::string choice(const std::string& key, std::initializer_list<const char*> allowed);
+  std::string choice(const std::string& key, std::initializer_list<const char*> allowed,
+                     const std::string& fallback);
+
+  // Throws ConfigError naming the first key of this mapping that was never read.
+  void finish() const;
+
+  const std::string& origin() const { return origin_; }
+  const std::string& path() const { return path_; }
+  std::string key_path(const std::string& key) const;
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+
+ private:
+  YAML::Node scalar(const std::string& key);
+
+  YAML::Node node_;
+  std::string origin_;
+  std::string path_;
+  std::set<std::string> used_;
+};
+
+}  // namespace pixyslam::config

@@ -1,0 +1,50 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "pixyslam/slam/motion_model.h"
+
+namespace pixyslam::slam {
+
+enum class ResampleMode {
+  kEffectiveSampleSize,  // when N_eff < resample_neff_fraction * N
+  kEveryFrame,           // after every observation frame (the seed paper)
+};
+
+// Everything that configures FastSlam2. Units in the names; validate() checks
+// ranges and throws std::invalid_argument naming the field.
+struct FilterOptions {
+  int particles = 100;
+  std::uint64_t seed = 1;
+
+  MotionNoise motion;
+  // Control held longer than this (no new odometry) is treated as stopped.
+  double control_timeout_s = 5.0;
+
+  // Default observation noise, used when a detection carries no sigmas.
+  double range_sigma_m = 0.07;
+  double bearing_sigma_rad = 0.027;
+  // Detections outside [min_range_m, max_range_m] are rejected as invalid.
+  double min_range_m = 0.05;
+  double max_range_m = 50.0;
+
+  // Mahalanobis gate on observations of mapped landmarks, per particle.
+  bool gate_enabled = true;
+  double gate_probability = 0.999;  // chi-square (2 dof) quantile of the gate
+  // After this many consecutive rejections of one landmark, the next observation
+  // is accepted anyway so that a drifted particle can recover.
+  int gate_readmit_after = 3;
+
+  ResampleMode resample_mode = ResampleMode::kEffectiveSampleSize;
+  double resample_neff_fraction = 0.667;
+};
+
+void validate(const FilterOptions& options);
+
+// Squared Mahalanobis distance of the gate: chi-square quantile with 2 dof.
+double gate_mahalanobis2(const FilterOptions& options);
+
+std::string to_string(ResampleMode mode);
+
+}  // namespace pixyslam::slam

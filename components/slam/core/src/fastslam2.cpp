@@ -1,0 +1,285 @@
+#include "pixyslam/slam/fastslam2.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "pixyslam/slam/observation_model.h"
+#include "pixyslam/slam/resampling.h"
+
+namespace pixyslam::slam {
+namespace {
+
+// Draws x ~ N(g.mean, g.cov); g.cov may be singular (positive semi-definite).
+Pose2 sample_pose(const PoseGaussian& g, std::mt19937_64& rng) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const Eigen::Vector3d e(normal(rng), normal(rng), normal(rng));
+  Eigen::LDLT<Eigen::Matrix3d> ldlt(g.cov);
+  Eigen::Vector3d d = ldlt.vectorD();
+  for (int i = 0; i < 3; ++i) d(i) = d(i) > 0.0 ? std::sqrt(d(i)) : 0.0;
+  // cov = P^T L D L^T P, so x = P^T L sqrt(D) e.
+  const Eigen::Vector3d y = ldlt.matrixL() * (d.asDiagonal() * e);
+  Pose2 x = g.mean + (ldlt.transpositionsP().transpose() * y);
+  x.z() = wrap_angle(x.z());
+  return x;
+}
+
+}  // namespace
+
+FastSlam2::FastSlam2(const FilterOptions& options, const Pose2& initial_pose)
+    : options_(options), gate_d2_(0.0), rng_(options.seed) {
+  validate(options_);
+  gate_d2_ = gate_mahalanobis2(options_);
+  Particle p{PoseGaussian{initial_pose, Eigen::Matrix3d::Zero()}, 0.0, LandmarkMap(&pool_)};
+  p.pose.mean.z() = wrap_angle(p.pose.mean.z());
+  particles_.assign(static_cast<std::size_t>(options_.particles), p);
+}
+
+void FastSlam2::advance_to(double t_s) {
+  if (!has_time_) {
+    has_time_ = true;
+    time_s_ = t_s;
+    return;
+  }
+  if (t_s <= time_s_) return;
+  // The held control expires control_timeout_s after it was received.
+  const double control_end = control_time_s_ + options_.control_timeout_s;
+  const double moving_until = std::min(t_s, control_end);
+  if (moving_until > time_s_ && (control_.v_mps != 0.0 || control_.w_radps != 0.0)) {
+    const double dt = moving_until - time_s_;
+    for (Particle& p : particles_) propagate(p.pose, control_.v_mps, control_.w_radps, dt, options_.motion);
+  }
+  if (t_s > control_end && time_s_ <= control_end && (control_.v_mps != 0.0 || control_.w_radps != 0.0)) {
+    ++counters_.control_timeouts;
+  }
+  time_s_ = t_s;
+}
+
+void FastSlam2::add_odometry(const OdometrySample& sample) {
+  ++counters_.odometry_samples;
+  if (has_time_ && sample.t_s < time_s_) ++counters_.odometry_out_of_order;
+  advance_to(sample.t_s);
+  control_ = sample;
+  control_time_s_ = std::max(sample.t_s, time_s_);
+}
+
+std::uint32_t FastSlam2::slot_for(int landmark_id) {
+  auto [it, inserted] = slot_of_id_.emplace(landmark_id, static_cast<std::uint32_t>(id_of_slot_.size()));
+  if (inserted) id_of_slot_.push_back(landmark_id);
+  return it->second;
+}
+
+void FastSlam2::add_observations(const ObservationFrame& frame) {
+  ++counters_.frames;
+  if (has_time_ && frame.t_s < time_s_) ++counters_.frames_out_of_order;
+  advance_to(frame.t_s);
+
+  const std::size_t n = frame.detections.size();
+  z_.resize(n);
+  r_.resize(n);
+  slots_.resize(n);
+  gated_votes_.assign(n, 0);
+  std::vector<RangeBearing> valid;
+  valid.reserve(n);
+  for (const RangeBearing& d : frame.detections) {
+    const bool ok = std::isfinite(d.range_m) && std::isfinite(d.bearing_rad) &&
+                    d.range_m >= options_.min_range_m && d.range_m <= options_.max_range_m &&
+                    std::abs(d.bearing_rad) <= M_PI && std::isfinite(d.range_sigma_m) &&
+                    std::isfinite(d.bearing_sigma_rad);
+    if (!ok) {
+      ++counters_.observations_invalid;
+      continue;
+    }
+    const std::size_t k = valid.size();
+    valid.push_back(d);
+    z_[k] = Eigen::Vector2d(d.range_m, d.bearing_rad);
+    const double sr = d.range_sigma_m > 0.0 ? d.range_sigma_m : options_.range_sigma_m;
+    const double sb = d.bearing_sigma_rad > 0.0 ? d.bearing_sigma_rad : options_.bearing_sigma_rad;
+    r_[k] = Eigen::Vector2d(sr * sr, sb * sb).asDiagonal();
+    slots_[k] = slot_for(d.landmark_id);
+  }
+  if (valid.empty()) return;
+
+  // Which detections are new is the same for every particle only with known
+  // association; decide per particle anyway.
+  std::vector<bool> any_new(valid.size(), false);
+  for (Particle& p : particles_) {
+    update_particle(p, valid);
+    for (std::size_t k = 0; k < valid.size(); ++k) {
+      if (decision_[k] == Decision::kGated) ++gated_votes_[k];
+      if (decision_[k] == Decision::kNew) any_new[k] = true;
+    }
+  }
+  for (std::size_t k = 0; k < valid.size(); ++k) {
+    if (2 * gated_votes_[k] > options_.particles) {
+      ++counters_.observations_gated;
+    } else if (any_new[k]) {
+      ++counters_.observations_new_landmark;
+    } else {
+      ++counters_.observations_used;
+    }
+  }
+  resample_if_needed();
+}
+
+void FastSlam2::update_particle(Particle& p, const std::vector<RangeBearing>& detections) {
+  const std::size_t n = detections.size();
+  decision_.assign(n, Decision::kNew);
+  PoseGaussian proposal = p.pose;
+  double log_w = 0.0;
+
+  // Proposal: fold each observation of a mapped landmark into the pose Gaussian;
+  // the product of the sequential predictive densities is the FastSLAM 2.0 weight.
+  for (std::size_t k = 0; k < n; ++k) {
+    const Landmark* lm = p.map.find(slots_[k]);
+    if (!lm) continue;
+    const ObservationFit fit = fit_observation(proposal, lm->mean, lm->cov, z_[k], r_[k]);
+    const bool readmit = lm->consecutive_rejections >= static_cast<std::uint32_t>(options_.gate_readmit_after);
+    if (options_.gate_enabled && fit.mahalanobis2 > gate_d2_ && !readmit) {
+      decision_[k] = Decision::kGated;
+      // An outlier costs the likelihood at the gate boundary, so particles that
+      // reject it are not favoured over those that explain it.
+      log_w += fit.log_likelihood + 0.5 * (fit.mahalanobis2 - gate_d2_);
+      continue;
+    }
+    decision_[k] = Decision::kUsed;
+    log_w += fit.log_likelihood;
+    fold_into_proposal(proposal, fit);
+  }
+
+  const Pose2 x = sample_pose(proposal, rng_);
+  p.pose.mean = x;
+  p.pose.cov.setZero();
+  p.log_weight += log_w;
+
+  for (std::size_t k = 0; k < n; ++k) {
+    switch (decision_[k]) {
+      case Decision::kGated:
+        ++p.map.modify(slots_[k]).consecutive_rejections;
+        break;
+      case Decision::kUsed: {
+        Landmark& lm = p.map.modify(slots_[k]);
+        update_landmark(x, z_[k], r_[k], lm.mean, lm.cov);
+        ++lm.times_observed;
+        lm.consecutive_rejections = 0;
+        break;
+      }
+      case Decision::kNew: {
+        const bool seen_this_frame = p.map.find(slots_[k]) != nullptr;
+        Landmark& lm = p.map.modify(slots_[k]);
+        if (seen_this_frame) {
+          update_landmark(x, z_[k], r_[k], lm.mean, lm.cov);
+        } else {
+          initialise_landmark(x, z_[k], r_[k], lm.mean, lm.cov);
+          lm.id = detections[k].landmark_id;
+        }
+        ++lm.times_observed;
+        break;
+      }
+      case Decision::kInvalid:
+        break;
+    }
+  }
+}
+
+void FastSlam2::resample_if_needed() {
+  std::vector<double> log_w(particles_.size());
+  for (std::size_t i = 0; i < particles_.size(); ++i) log_w[i] = particles_[i].log_weight;
+  const std::vector<double> w = normalised_weights(log_w);
+  const double n_eff = effective_sample_size(w);
+  const bool resample = options_.resample_mode == ResampleMode::kEveryFrame ||
+                        n_eff < options_.resample_neff_fraction * static_cast<double>(particles_.size());
+  if (!resample) {
+    // Keep log weights bounded: shift so the best is 0.
+    const double max_log = *std::max_element(log_w.begin(), log_w.end());
+    for (Particle& p : particles_) p.log_weight -= max_log;
+    return;
+  }
+  ++counters_.resamples;
+  const std::vector<std::size_t> picks = systematic_resample(w, rng_);
+  scratch_.clear();
+  scratch_.reserve(particles_.size());
+  for (std::size_t i : picks) {
+    scratch_.push_back(particles_[i]);
+    scratch_.back().log_weight = 0.0;
+  }
+  particles_.swap(scratch_);
+  scratch_.clear();  // drops the old maps' references
+}
+
+std::size_t FastSlam2::best_index() const {
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < particles_.size(); ++i) {
+    if (particles_[i].log_weight > particles_[best].log_weight) best = i;
+  }
+  return best;
+}
+
+PoseEstimate FastSlam2::pose_estimate() const {
+  PoseEstimate e;
+  e.t_s = time_s_;
+  e.particles = static_cast<int>(particles_.size());
+  std::vector<double> log_w(particles_.size());
+  for (std::size_t i = 0; i < particles_.size(); ++i) log_w[i] = particles_[i].log_weight;
+  const std::vector<double> w = normalised_weights(log_w);
+  e.effective_sample_size = effective_sample_size(w);
+
+  double sx = 0, sy = 0, sc = 0, ss = 0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    const Pose2& m = particles_[i].pose.mean;
+    sx += w[i] * m.x();
+    sy += w[i] * m.y();
+    sc += w[i] * std::cos(m.z());
+    ss += w[i] * std::sin(m.z());
+  }
+  e.mean = Pose2(sx, sy, std::atan2(ss, sc));
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    const Pose2& m = particles_[i].pose.mean;
+    const Eigen::Vector3d d(m.x() - e.mean.x(), m.y() - e.mean.y(), wrap_angle(m.z() - e.mean.z()));
+    e.cov += w[i] * (d * d.transpose() + particles_[i].pose.cov);
+  }
+  e.best = particles_[best_index()].pose.mean;
+  return e;
+}
+
+std::vector<LandmarkEstimate> FastSlam2::landmarks_of_best() const {
+  std::vector<LandmarkEstimate> out;
+  particles_[best_index()].map.for_each([&](std::uint32_t, const Landmark& lm) {
+    out.push_back({lm.id, lm.mean, lm.cov, lm.times_observed});
+  });
+  return out;
+}
+
+std::vector<LandmarkEstimate> FastSlam2::landmarks_mixture() const {
+  std::vector<double> log_w(particles_.size());
+  for (std::size_t i = 0; i < particles_.size(); ++i) log_w[i] = particles_[i].log_weight;
+  const std::vector<double> w = normalised_weights(log_w);
+  struct Sum {
+    double weight = 0.0;
+    Eigen::Vector2d m = Eigen::Vector2d::Zero();
+    Eigen::Matrix2d second = Eigen::Matrix2d::Zero();  // E[cov + m m^T]
+    std::uint32_t times = 0;
+  };
+  std::vector<Sum> sums(id_of_slot_.size());
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    particles_[i].map.for_each([&](std::uint32_t slot, const Landmark& lm) {
+      Sum& s = sums[slot];
+      s.weight += w[i];
+      s.m += w[i] * lm.mean;
+      s.second += w[i] * (lm.cov + lm.mean * lm.mean.transpose());
+      s.times = std::max(s.times, lm.times_observed);
+    });
+  }
+  std::vector<LandmarkEstimate> out;
+  for (std::size_t slot = 0; slot < sums.size(); ++slot) {
+    const Sum& s = sums[slot];
+    if (s.weight <= 0.0) continue;
+    const Eigen::Vector2d mean = s.m / s.weight;
+    out.push_back({id_of_slot_[slot], mean, s.second / s.weight - mean * mean.transpose(), s.times});
+  }
+  return out;
+}
+
+}  // namespace pixyslam::slam

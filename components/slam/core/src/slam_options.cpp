@@ -1,0 +1,55 @@
+#include "pixyslam/slam/slam_options.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace pixyslam::slam {
+namespace {
+
+void require(bool ok, const char* field, double value, const char* rule) {
+  if (ok) return;
+  std::ostringstream os;
+  os << "filter option '" << field << "' = " << value << ": " << rule;
+  throw std::invalid_argument(os.str());
+}
+
+void require_non_negative(double v, const char* field) {
+  require(std::isfinite(v) && v >= 0.0, field, v, "must be a finite number >= 0");
+}
+
+void require_positive(double v, const char* field) {
+  require(std::isfinite(v) && v > 0.0, field, v, "must be a finite number > 0");
+}
+
+}  // namespace
+
+void validate(const FilterOptions& o) {
+  require(o.particles >= 1 && o.particles <= 1000000, "particles", o.particles, "must be in [1, 1000000]");
+  require_non_negative(o.motion.v_sigma_m_per_sqrt_s, "motion.v_sigma_m_per_sqrt_s");
+  require_non_negative(o.motion.w_sigma_rad_per_sqrt_s, "motion.w_sigma_rad_per_sqrt_s");
+  require_non_negative(o.motion.distance_sigma_per_sqrt_m, "motion.distance_sigma_per_sqrt_m");
+  require_non_negative(o.motion.heading_sigma_rad_per_sqrt_m, "motion.heading_sigma_rad_per_sqrt_m");
+  require_positive(o.control_timeout_s, "control_timeout_s");
+  require_positive(o.range_sigma_m, "range_sigma_m");
+  require_positive(o.bearing_sigma_rad, "bearing_sigma_rad");
+  require_non_negative(o.min_range_m, "min_range_m");
+  require(std::isfinite(o.max_range_m) && o.max_range_m > o.min_range_m, "max_range_m", o.max_range_m,
+          "must be finite and greater than min_range_m");
+  require(o.gate_probability > 0.0 && o.gate_probability < 1.0, "gate_probability", o.gate_probability,
+          "must be in (0, 1)");
+  require(o.gate_readmit_after >= 1, "gate_readmit_after", o.gate_readmit_after, "must be >= 1");
+  require(o.resample_neff_fraction > 0.0 && o.resample_neff_fraction <= 1.0, "resample_neff_fraction",
+          o.resample_neff_fraction, "must be in (0, 1]");
+}
+
+double gate_mahalanobis2(const FilterOptions& o) {
+  // Chi-square with 2 degrees of freedom: P(d2 <= x) = 1 - exp(-x / 2).
+  return -2.0 * std::log(1.0 - o.gate_probability);
+}
+
+std::string to_string(ResampleMode mode) {
+  return mode == ResampleMode::kEveryFrame ? "every_frame" : "effective_sample_size";
+}
+
+}  // namespace pixyslam::slam
