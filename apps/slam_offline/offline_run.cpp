@@ -1,8 +1,11 @@
 #include "offline_run.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
+#include "mrclam_dataset.h"
+#include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/eval/rigid_alignment.h"
 
 namespace pixyslam::offline {
@@ -105,6 +108,48 @@ void print_report(const std::string& title, const Report& r, const RunResult& re
               static_cast<unsigned long long>(c.odometry_samples), static_cast<unsigned long long>(c.frames),
               static_cast<unsigned long long>(c.resamples), res.final_effective_sample_size);
   std::printf("wall time              %.2f s\n", res.wall_time_s);
+}
+
+}  // namespace pixyslam::offline
+
+namespace pixyslam::offline {
+
+MrclamSensorModel read_mrclam_sensor_model(config::YamlReader& y) {
+  MrclamSensorModel m;
+  m.range_scale = y.number("range_scale", 0.5, 2.0, m.range_scale);
+  m.range_cos_bearing_exponent = y.number("range_cos_bearing_exponent", 0.0, 3.0, m.range_cos_bearing_exponent);
+  m.odometry_delay_s = y.number("odometry_delay_s", -2.0, 2.0, m.odometry_delay_s);
+  y.finish();
+  return m;
+}
+
+RunInput mrclam_input(const mrclam::RobotData& d, const MrclamSensorModel& model) {
+  RunInput in;
+  in.truth = d.groundtruth;
+  in.landmarks = d.landmarks;
+  if (!d.groundtruth.empty()) {
+    const eval::TimedPose& g = d.groundtruth.front();
+    in.initial_pose = slam::Pose2(g.x_m, g.y_m, g.theta_rad);
+    in.start_time_s = g.t_s;
+  } else {
+    in.start_time_s = d.odometry.empty() ? 0.0 : d.odometry.front().t_s;
+  }
+  for (const mrclam::OdometryRow& o : d.odometry) {
+    in.odometry.push_back({o.t_s + model.odometry_delay_s, o.v_mps, o.w_radps});
+  }
+  for (const mrclam::MeasurementFrame& f : d.frames) {
+    slam::ObservationFrame frame{f.t_s, {}};
+    for (const mrclam::Detection& det : f.detections) {
+      slam::RangeBearing z;
+      z.landmark_id = det.subject;
+      z.range_m = det.range_m / (model.range_scale *
+                                 std::pow(std::cos(det.bearing_rad), model.range_cos_bearing_exponent));
+      z.bearing_rad = det.bearing_rad;
+      frame.detections.push_back(z);
+    }
+    in.frames.push_back(std::move(frame));
+  }
+  return in;
 }
 
 }  // namespace pixyslam::offline

@@ -45,3 +45,28 @@ Report evaluate(const RunInput& input, const RunResult& result);
 void print_report(const std::string& title, const Report& report, const RunResult& result);
 
 }  // namespace pixyslam::offline
+
+namespace pixyslam::mrclam {
+struct RobotData;
+}
+namespace pixyslam::config {
+class YamlReader;
+}
+namespace pixyslam::offline {
+
+// How the MRCLAM robots' sensors differ from the ideal models (config `mrclam:`).
+// Measured on Dataset6 against Vicon, all five robots pooled (docs/mrclam.md):
+// - the camera's range behaves like depth along the optical axis with lens
+//   distortion: range_true = range / (range_scale * cos(bearing)^cos_exponent);
+// - the robots start to move about 0.15 s after a velocity command is logged.
+struct MrclamSensorModel {
+  double range_scale = 1.0;
+  double range_cos_bearing_exponent = 0.0;
+  double odometry_delay_s = 0.0;
+};
+MrclamSensorModel read_mrclam_sensor_model(config::YamlReader& mrclam);
+
+// MRCLAM robot data as filter input: started at the first ground-truth pose when
+// there is one, else at the origin at the first odometry time.
+RunInput mrclam_input(const mrclam::RobotData& data, const MrclamSensorModel& model = {});
+}  // namespace pixyslam::offline

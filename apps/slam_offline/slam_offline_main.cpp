@@ -69,32 +69,6 @@ offline::RunInput sim_input(const sim::WorldRun& run) {
   return in;
 }
 
-offline::RunInput mrclam_input(const mrclam::RobotData& d) {
-  offline::RunInput in;
-  in.truth = d.groundtruth;
-  in.landmarks = d.landmarks;
-  if (!d.groundtruth.empty()) {
-    const eval::TimedPose& g = d.groundtruth.front();
-    in.initial_pose = slam::Pose2(g.x_m, g.y_m, g.theta_rad);
-    in.start_time_s = g.t_s;
-  } else {
-    in.start_time_s = d.odometry.empty() ? 0.0 : d.odometry.front().t_s;
-  }
-  for (const mrclam::OdometryRow& o : d.odometry) in.odometry.push_back({o.t_s, o.v_mps, o.w_radps});
-  for (const mrclam::MeasurementFrame& f : d.frames) {
-    slam::ObservationFrame frame{f.t_s, {}};
-    for (const mrclam::Detection& det : f.detections) {
-      slam::RangeBearing z;
-      z.landmark_id = det.subject;
-      z.range_m = det.range_m;
-      z.bearing_rad = det.bearing_rad;
-      frame.detections.push_back(z);
-    }
-    in.frames.push_back(std::move(frame));
-  }
-  return in;
-}
-
 int run(const Args& args) {
   const std::string config_path = args.get("config");
   config::YamlReader root = config::YamlReader::from_file(config_path);
@@ -113,11 +87,16 @@ int run(const Args& args) {
     title = "simulated world, " + std::to_string(run.poles.size()) + " poles, " +
             std::to_string(run.frames.size()) + " camera frames";
   } else {
+    offline::MrclamSensorModel model;
+    if (root.has("mrclam")) {
+      config::YamlReader mrclam_yaml = root.child("mrclam");
+      model = offline::read_mrclam_sensor_model(mrclam_yaml);
+    }
     root.finish();
     const std::string dataset = args.get("dataset");
     const long robot = parse_long(args.get("robot"), "--robot");
     const mrclam::RobotData data = mrclam::load_robot(dataset, static_cast<int>(robot));
-    input = mrclam_input(data);
+    input = offline::mrclam_input(data, model);
     std::printf("MRCLAM %s robot %ld: %zu odometry rows, %zu frames, landmarks from %s\n", dataset.c_str(), robot,
                 data.odometry.size(), data.frames.size(), data.landmark_file.c_str());
     std::printf("dropped rows           %zu robot (subjects 1-5), %zu unknown barcode\n", data.counts.robot_rows,

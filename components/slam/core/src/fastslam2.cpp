@@ -95,7 +95,8 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
     const std::size_t k = valid.size();
     valid.push_back(d);
     z_[k] = Eigen::Vector2d(d.range_m, d.bearing_rad);
-    const double sr = d.range_sigma_m > 0.0 ? d.range_sigma_m : options_.range_sigma_m;
+    const double sr = d.range_sigma_m > 0.0 ? d.range_sigma_m
+                                            : options_.range_sigma_m + options_.range_sigma_per_m * d.range_m;
     const double sb = d.bearing_sigma_rad > 0.0 ? d.bearing_sigma_rad : options_.bearing_sigma_rad;
     r_[k] = Eigen::Vector2d(sr * sr, sb * sb).asDiagonal();
     slots_[k] = slot_for(d.landmark_id);
@@ -132,8 +133,11 @@ void FastSlam2::update_particle(Particle& p, const std::vector<RangeBearing>& de
 
   // Proposal: fold each observation of a mapped landmark into the pose Gaussian;
   // the product of the sequential predictive densities is the FastSLAM 2.0 weight.
+  // The landmarks are unshared right away: every outcome below writes to them.
+  landmarks_.assign(n, nullptr);
   for (std::size_t k = 0; k < n; ++k) {
-    const Landmark* lm = p.map.find(slots_[k]);
+    Landmark* lm = p.map.modify_if_present(slots_[k]);
+    landmarks_[k] = lm;
     if (!lm) continue;
     const ObservationFit fit = fit_observation(proposal, lm->mean, lm->cov, z_[k], r_[k]);
     const bool readmit = lm->consecutive_rejections >= static_cast<std::uint32_t>(options_.gate_readmit_after);
@@ -157,10 +161,10 @@ void FastSlam2::update_particle(Particle& p, const std::vector<RangeBearing>& de
   for (std::size_t k = 0; k < n; ++k) {
     switch (decision_[k]) {
       case Decision::kGated:
-        ++p.map.modify(slots_[k]).consecutive_rejections;
+        ++landmarks_[k]->consecutive_rejections;
         break;
       case Decision::kUsed: {
-        Landmark& lm = p.map.modify(slots_[k]);
+        Landmark& lm = *landmarks_[k];
         update_landmark(x, z_[k], r_[k], lm.mean, lm.cov);
         ++lm.times_observed;
         lm.consecutive_rejections = 0;
@@ -207,6 +211,19 @@ void FastSlam2::resample_if_needed() {
   }
   particles_.swap(scratch_);
   scratch_.clear();  // drops the old maps' references
+}
+
+void FastSlam2::set_prior_map(const std::vector<LandmarkEstimate>& landmarks) {
+  LandmarkMap map(&pool_);
+  for (const LandmarkEstimate& e : landmarks) {
+    Landmark& lm = map.modify(slot_for(e.id));
+    lm.id = e.id;
+    lm.mean = e.mean;
+    lm.cov = e.cov;
+    lm.times_observed = e.times_observed;
+    lm.consecutive_rejections = 0;
+  }
+  for (Particle& p : particles_) p.map = map;
 }
 
 std::size_t FastSlam2::best_index() const {

@@ -141,21 +141,39 @@ Landmark& LandmarkMap::modify(std::uint32_t slot) {
       n->is_leaf = (level == 0);
       if (n->is_leaf) ++size_;
       *link = n;
-    } else if (n->refs > 1) {
-      Node* copy = pool_->allocate();
-      *copy = *n;
-      copy->refs = 1;
-      if (!n->is_leaf) {
-        ref(copy->child[0]);
-        ref(copy->child[1]);
-      }
-      --n->refs;
-      *link = copy;
-      n = copy;
+    } else {
+      n = own(link);
     }
     if (level == 0) return n->landmark;
     link = &n->child[(slot >> (level - 1)) & 1u];
   }
+}
+
+Landmark* LandmarkMap::modify_if_present(std::uint32_t slot) {
+  if (!root_ || (slot >> depth_) != 0) return nullptr;
+  // Check first without copying, so an absent slot costs no allocation.
+  if (!find(slot)) return nullptr;
+  Node** link = &root_;
+  for (int level = depth_;; --level) {
+    Node* n = own(link);
+    if (level == 0) return &n->landmark;
+    link = &n->child[(slot >> (level - 1)) & 1u];
+  }
+}
+
+LandmarkMap::Node* LandmarkMap::own(Node** link) {
+  Node* n = *link;
+  if (n->refs == 1) return n;
+  Node* copy = pool_->allocate();
+  *copy = *n;
+  copy->refs = 1;
+  if (!n->is_leaf) {
+    ref(copy->child[0]);
+    ref(copy->child[1]);
+  }
+  --n->refs;
+  *link = copy;
+  return copy;
 }
 
 void LandmarkMap::for_each(const std::function<void(std::uint32_t, const Landmark&)>& visit) const {

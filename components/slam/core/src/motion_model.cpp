@@ -31,7 +31,8 @@ void propagate(PoseGaussian& g, double v_mps, double w_radps, double dt_s, const
   const double var_d = noise.v_sigma_m_per_sqrt_s * noise.v_sigma_m_per_sqrt_s * dt_s +
                        noise.distance_sigma_per_sqrt_m * noise.distance_sigma_per_sqrt_m * dist;
   const double var_a = noise.w_sigma_rad_per_sqrt_s * noise.w_sigma_rad_per_sqrt_s * dt_s +
-                       noise.heading_sigma_rad_per_sqrt_m * noise.heading_sigma_rad_per_sqrt_m * dist;
+                       noise.heading_sigma_rad_per_sqrt_m * noise.heading_sigma_rad_per_sqrt_m * dist +
+                       noise.rotation_sigma_per_sqrt_rad * noise.rotation_sigma_per_sqrt_rad * std::abs(a);
   const Eigen::Vector2d q(var_d, var_a);
 
   g.cov = f * g.cov * f.transpose() + v * q.asDiagonal() * v.transpose();

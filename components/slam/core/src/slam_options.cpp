@@ -30,8 +30,10 @@ void validate(const FilterOptions& o) {
   require_non_negative(o.motion.w_sigma_rad_per_sqrt_s, "motion.w_sigma_rad_per_sqrt_s");
   require_non_negative(o.motion.distance_sigma_per_sqrt_m, "motion.distance_sigma_per_sqrt_m");
   require_non_negative(o.motion.heading_sigma_rad_per_sqrt_m, "motion.heading_sigma_rad_per_sqrt_m");
+  require_non_negative(o.motion.rotation_sigma_per_sqrt_rad, "motion.rotation_sigma_per_sqrt_rad");
   require_positive(o.control_timeout_s, "control_timeout_s");
   require_positive(o.range_sigma_m, "range_sigma_m");
+  require_non_negative(o.range_sigma_per_m, "range_sigma_per_m");
   require_positive(o.bearing_sigma_rad, "bearing_sigma_rad");
   require_non_negative(o.min_range_m, "min_range_m");
   require(std::isfinite(o.max_range_m) && o.max_range_m > o.min_range_m, "max_range_m", o.max_range_m,

@@ -17,12 +17,15 @@ FilterOptions read_filter_options(config::YamlReader& f) {
         m.number("distance_sigma_per_sqrt_m", 0.0, 10.0, o.motion.distance_sigma_per_sqrt_m);
     o.motion.heading_sigma_rad_per_sqrt_m =
         m.number("heading_sigma_rad_per_sqrt_m", 0.0, 10.0, o.motion.heading_sigma_rad_per_sqrt_m);
+    o.motion.rotation_sigma_per_sqrt_rad =
+        m.number("rotation_sigma_per_sqrt_rad", 0.0, 10.0, o.motion.rotation_sigma_per_sqrt_rad);
     m.finish();
   }
   o.control_timeout_s = f.number("control_timeout_s", 1e-3, 3600.0, o.control_timeout_s);
   if (f.has("observation")) {
     config::YamlReader z = f.child("observation");
     o.range_sigma_m = z.number("range_sigma_m", 1e-6, 100.0, o.range_sigma_m);
+    o.range_sigma_per_m = z.number("range_sigma_per_m", 0.0, 10.0, o.range_sigma_per_m);
     o.bearing_sigma_rad = z.number("bearing_sigma_rad", 1e-6, 3.0, o.bearing_sigma_rad);
     o.min_range_m = z.number("min_range_m", 0.0, 1000.0, o.min_range_m);
     o.max_range_m = z.number("max_range_m", 0.0, 1000.0, o.max_range_m);

@@ -77,6 +77,10 @@ class FastSlam2 {
   // Moves to frame.t_s, then runs the FastSLAM 2.0 update for the frame.
   void add_observations(const ObservationFrame& frame);
 
+  // Gives every particle the same known landmarks (one shared tree, no copies):
+  // localisation in a prior map, or a restart from a saved map. Replaces the maps.
+  void set_prior_map(const std::vector<LandmarkEstimate>& landmarks);
+
   PoseEstimate pose_estimate() const;
   // Landmarks of the highest-weight particle.
   std::vector<LandmarkEstimate> landmarks_of_best() const;
@@ -119,6 +123,7 @@ class FastSlam2 {
   std::vector<Eigen::Matrix2d> r_;
   std::vector<std::uint32_t> slots_;
   std::vector<Decision> decision_;
+  std::vector<Landmark*> landmarks_;
   std::vector<int> gated_votes_;
   FilterCounters counters_;
 };

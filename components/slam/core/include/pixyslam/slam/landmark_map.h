@@ -40,6 +40,10 @@ class LandmarkMap {
   const Landmark* find(std::uint32_t slot) const;
   // Writable landmark in `slot` (created default if absent), unshared first.
   Landmark& modify(std::uint32_t slot);
+  // Writable landmark in `slot` if present, else nullptr; one walk down the tree.
+  // Pointers returned stay valid until this map is copied into, assigned or
+  // destroyed (later modify calls on other slots do not move them).
+  Landmark* modify_if_present(std::uint32_t slot);
   std::size_t size() const { return size_; }
   int depth() const { return depth_; }
   // Visits landmarks in slot order.
@@ -52,6 +56,8 @@ class LandmarkMap {
  private:
   friend class LandmarkMapPool;
   void release();
+  // Unshares `*link` (copies it if another map holds it) and returns it.
+  Node* own(Node** link);
 
   LandmarkMapPool* pool_ = nullptr;
   Node* root_ = nullptr;

@@ -16,6 +16,9 @@ struct MotionNoise {
   double w_sigma_rad_per_sqrt_s = 0.03;
   double distance_sigma_per_sqrt_m = 0.0;
   double heading_sigma_rad_per_sqrt_m = 0.0;
+  // Rotation variance proportional to the commanded rotation (sigma^2 * |a|):
+  // wheels slip and motors lag when the robot turns.
+  double rotation_sigma_per_sqrt_rad = 0.0;
 };
 
 // Gaussian over a pose: mean and 3x3 covariance.

@@ -22,8 +22,11 @@ struct FilterOptions {
   // Control held longer than this (no new odometry) is treated as stopped.
   double control_timeout_s = 5.0;
 
-  // Default observation noise, used when a detection carries no sigmas.
+  // Default observation noise, used when a detection carries no sigmas:
+  // range sd = range_sigma_m + range_sigma_per_m * range (size-based ranging
+  // degrades with distance).
   double range_sigma_m = 0.07;
+  double range_sigma_per_m = 0.0;
   double bearing_sigma_rad = 0.027;
   // Detections outside [min_range_m, max_range_m] are rejected as invalid.
   double min_range_m = 0.05;

@@ -39,6 +39,7 @@ struct ObservationFrame {
 
 // Wraps an angle to (-pi, pi].
 inline double wrap_angle(double a) {
+  if (a > -M_PI && a <= M_PI) return a;  // the common case, without a libm call
   a = std::remainder(a, 2.0 * M_PI);
   return a <= -M_PI ? a + 2.0 * M_PI : a;
 }

@@ -1,0 +1,214 @@
+// Tests of read_filter_options: values round-trip from YAML, and every kind of
+// configuration mistake is a config::ConfigError naming the origin and key path.
+
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/slam/slam_options.h"
+#include "pixyslam/slam/slam_options_yaml.h"
+
+namespace pixyslam::slam {
+namespace {
+
+using config::ConfigError;
+using config::YamlReader;
+
+constexpr const char* kOrigin = "test_filter.yaml";
+
+// Parses a document holding a `filter:` mapping and reads it like the apps do.
+FilterOptions read(const std::string& text) {
+  YamlReader root = YamlReader::from_string(text, kOrigin);
+  YamlReader filter = root.child("filter");
+  FilterOptions o = read_filter_options(filter);
+  root.finish();
+  return o;
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    read(text);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected ConfigError for:\n" << text;
+  return "";
+}
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+TEST(SlamOptionsYaml, FullConfigRoundTripsEveryValue) {
+  // Given a config where every key differs from the FilterOptions default,
+  const FilterOptions o = read(
+      "filter:\n"
+      "  particles: 321\n"
+      "  seed: 987654321\n"
+      "  motion:\n"
+      "    v_sigma_m_per_sqrt_s: 0.0125\n"
+      "    w_sigma_rad_per_sqrt_s: 0.0225\n"
+      "    distance_sigma_per_sqrt_m: 0.05\n"
+      "    heading_sigma_rad_per_sqrt_m: 0.06\n"
+      "  control_timeout_s: 2.5\n"
+      "  observation:\n"
+      "    range_sigma_m: 0.11\n"
+      "    bearing_sigma_rad: 0.031\n"
+      "    min_range_m: 0.3\n"
+      "    max_range_m: 12.5\n"
+      "  gate:\n"
+      "    enabled: false\n"
+      "    probability: 0.99\n"
+      "    readmit_after: 7\n"
+      "  resample:\n"
+      "    mode: every_frame\n"
+      "    neff_fraction: 0.4\n");
+  // then each value arrives in its field.
+  const FilterOptions d;
+  EXPECT_EQ(o.particles, 321);
+  EXPECT_EQ(o.seed, 987654321u);
+  EXPECT_DOUBLE_EQ(o.motion.v_sigma_m_per_sqrt_s, 0.0125);
+  EXPECT_DOUBLE_EQ(o.motion.w_sigma_rad_per_sqrt_s, 0.0225);
+  EXPECT_DOUBLE_EQ(o.motion.distance_sigma_per_sqrt_m, 0.05);
+  EXPECT_DOUBLE_EQ(o.motion.heading_sigma_rad_per_sqrt_m, 0.06);
+  EXPECT_DOUBLE_EQ(o.control_timeout_s, 2.5);
+  EXPECT_DOUBLE_EQ(o.range_sigma_m, 0.11);
+  EXPECT_DOUBLE_EQ(o.bearing_sigma_rad, 0.031);
+  EXPECT_DOUBLE_EQ(o.min_range_m, 0.3);
+  EXPECT_DOUBLE_EQ(o.max_range_m, 12.5);
+  EXPECT_FALSE(o.gate_enabled);
+  EXPECT_NE(o.gate_enabled, d.gate_enabled);
+  EXPECT_DOUBLE_EQ(o.gate_probability, 0.99);
+  EXPECT_EQ(o.gate_readmit_after, 7);
+  EXPECT_EQ(o.resample_mode, ResampleMode::kEveryFrame);
+  EXPECT_NE(o.resample_mode, d.resample_mode);
+  EXPECT_DOUBLE_EQ(o.resample_neff_fraction, 0.4);
+  EXPECT_NO_THROW(validate(o));
+}
+
+TEST(SlamOptionsYaml, MissingKeysKeepDefaults) {
+  const FilterOptions o = read("filter:\n  particles: 17\n  resample:\n    mode: effective_sample_size\n");
+  const FilterOptions d;
+  EXPECT_EQ(o.particles, 17);
+  EXPECT_EQ(o.seed, d.seed);
+  EXPECT_DOUBLE_EQ(o.motion.v_sigma_m_per_sqrt_s, d.motion.v_sigma_m_per_sqrt_s);
+  EXPECT_DOUBLE_EQ(o.range_sigma_m, d.range_sigma_m);
+  EXPECT_EQ(o.gate_enabled, d.gate_enabled);
+  EXPECT_DOUBLE_EQ(o.gate_probability, d.gate_probability);
+  EXPECT_EQ(o.resample_mode, ResampleMode::kEffectiveSampleSize);
+  EXPECT_DOUBLE_EQ(o.resample_neff_fraction, d.resample_neff_fraction);
+}
+
+TEST(SlamOptionsYaml, ReadsTheShippedSimConfig) {
+  // The repository's own sim config must load (its `world:` part is not ours).
+  // The source tree is found from this file's path (absolute with CMake/Ninja).
+  const std::filesystem::path config =
+      std::filesystem::path(__FILE__).parent_path().parent_path() / "config" / "slam_sim.yaml";
+  if (!std::filesystem::exists(config)) GTEST_SKIP() << "source tree not found from __FILE__: " << config;
+  YamlReader root = YamlReader::from_file(config.string());
+  YamlReader filter = root.child("filter");
+  const FilterOptions o = read_filter_options(filter);
+  EXPECT_EQ(o.particles, 100);
+  EXPECT_DOUBLE_EQ(o.motion.v_sigma_m_per_sqrt_s, 0.0095);
+}
+
+TEST(SlamOptionsYaml, UnknownNestedKeyNamesOriginAndFullPath) {
+  const std::string m = error_of("filter:\n  motion:\n    v_sigma: 0.01\n");
+  EXPECT_TRUE(contains(m, kOrigin)) << m;
+  EXPECT_TRUE(contains(m, "filter.motion.v_sigma")) << m;
+  EXPECT_TRUE(contains(m, "unknown")) << m;
+}
+
+TEST(SlamOptionsYaml, UnknownTopLevelFilterKeyIsAnError) {
+  const std::string m = error_of("filter:\n  particle: 10\n");
+  EXPECT_TRUE(contains(m, kOrigin)) << m;
+  EXPECT_TRUE(contains(m, "filter.particle")) << m;
+}
+
+TEST(SlamOptionsYaml, WrongTypeNamesTheKey) {
+  const std::string m = error_of("filter:\n  particles: abc\n");
+  EXPECT_TRUE(contains(m, kOrigin)) << m;
+  EXPECT_TRUE(contains(m, "filter.particles")) << m;
+  EXPECT_TRUE(contains(m, "abc")) << m;
+
+  const std::string m2 = error_of("filter:\n  gate:\n    enabled: maybe\n");
+  EXPECT_TRUE(contains(m2, "filter.gate.enabled")) << m2;
+
+  const std::string m3 = error_of("filter:\n  observation:\n    range_sigma_m: far\n");
+  EXPECT_TRUE(contains(m3, "filter.observation.range_sigma_m")) << m3;
+}
+
+TEST(SlamOptionsYaml, OutOfRangeNamesKeyAndRange) {
+  const std::string m = error_of("filter:\n  particles: 0\n");
+  EXPECT_TRUE(contains(m, kOrigin)) << m;
+  EXPECT_TRUE(contains(m, "filter.particles")) << m;
+  EXPECT_TRUE(contains(m, "[1, 1000000]")) << m;
+
+  const std::string m2 = error_of("filter:\n  motion:\n    v_sigma_m_per_sqrt_s: -0.1\n");
+  EXPECT_TRUE(contains(m2, "filter.motion.v_sigma_m_per_sqrt_s")) << m2;
+  EXPECT_TRUE(contains(m2, "out of range")) << m2;
+
+  const std::string m3 = error_of("filter:\n  gate:\n    probability: 1\n");
+  EXPECT_TRUE(contains(m3, "filter.gate.probability")) << m3;
+}
+
+TEST(SlamOptionsYaml, CrossFieldViolationIsAConfigErrorNamingTheField) {
+  // Each value is within its own range, but max_range_m <= min_range_m.
+  const std::string m = error_of("filter:\n  observation:\n    min_range_m: 5\n    max_range_m: 2\n");
+  EXPECT_TRUE(contains(m, kOrigin)) << m;
+  EXPECT_TRUE(contains(m, "max_range_m")) << m;
+}
+
+TEST(SlamOptionsYaml, BadResampleModeListsAllowedValues) {
+  const std::string m = error_of("filter:\n  resample:\n    mode: foo\n");
+  EXPECT_TRUE(contains(m, "filter.resample.mode")) << m;
+  EXPECT_TRUE(contains(m, "foo")) << m;
+  EXPECT_TRUE(contains(m, "effective_sample_size")) << m;
+  EXPECT_TRUE(contains(m, "every_frame")) << m;
+}
+
+TEST(SlamOptionsYaml, SyntaxErrorGivesLineNumber) {
+  // Line 3 opens a flow sequence that is never closed.
+  try {
+    read("filter:\n  particles: 10\n  seed: [1, 2\n");
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_TRUE(contains(m, kOrigin)) << m;
+    EXPECT_TRUE(contains(m, "line")) << m;
+  }
+  // Line 4 is indented deeper than its sibling on line 5: the error is on line 5.
+  try {
+    read("filter:\n  particles: 10\n  motion:\n     v_sigma_m_per_sqrt_s: 0.1\n    w_sigma_rad_per_sqrt_s: 0.1\n");
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_TRUE(contains(m, kOrigin)) << m;
+    EXPECT_TRUE(contains(m, "line 5")) << m;
+  }
+}
+
+TEST(SlamOptionsYaml, MissingFileNamesThePath) {
+  try {
+    read_filter_options_file("/nonexistent/pixyslam_missing_filter.yaml");
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_TRUE(contains(e.what(), "pixyslam_missing_filter.yaml")) << e.what();
+  }
+}
+
+TEST(SlamOptions, GateMahalanobisIsTheChiSquare2Quantile) {
+  FilterOptions o;
+  o.gate_probability = 0.95;
+  EXPECT_NEAR(gate_mahalanobis2(o), 5.991464547107979, 1e-9);
+  o.gate_probability = 0.999;
+  EXPECT_NEAR(gate_mahalanobis2(o), 13.815510557964274, 1e-9);
+}
+
+TEST(SlamOptions, ResampleModeNames) {
+  EXPECT_EQ(to_string(ResampleMode::kEveryFrame), "every_frame");
+  EXPECT_EQ(to_string(ResampleMode::kEffectiveSampleSize), "effective_sample_size");
+}
+
+}  // namespace
+}  // namespace pixyslam::slam
