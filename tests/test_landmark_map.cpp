@@ -340,6 +340,59 @@ TEST(LandmarkMap, RandomizedAgainstStdMapModel) {
   EXPECT_EQ(pool.nodes_live(), 0u);
 }
 
+TEST(LandmarkMap, ModifyIfPresentUnsharesOnlyPresentSlots) {
+  LandmarkMapPool pool;
+  LandmarkMap original(&pool);
+  for (std::uint32_t s = 0; s < 100; s += 2) put(original, s, s);
+  LandmarkMap copy(original);
+  const int depth = copy.depth();
+
+  // An absent slot (inside or beyond the capacity) gives nullptr, allocates nothing.
+  const std::size_t before = pool.nodes_allocated_total();
+  EXPECT_EQ(copy.modify_if_present(1), nullptr);
+  EXPECT_EQ(copy.modify_if_present(99), nullptr);
+  EXPECT_EQ(copy.modify_if_present(5000), nullptr);
+  EXPECT_EQ(pool.nodes_allocated_total(), before);
+  EXPECT_EQ(copy.size(), 50u);
+  EXPECT_EQ(copy.find(1), nullptr);
+
+  // A present slot is unshared along its path only; writing through the
+  // pointer does not reach the original.
+  Landmark* lm = copy.modify_if_present(42);
+  ASSERT_NE(lm, nullptr);
+  EXPECT_LE(pool.nodes_allocated_total() - before, static_cast<std::size_t>(depth + 1));
+  lm->mean.x() = -42.0;
+  EXPECT_EQ(value_of(copy, 42), -42.0);
+  EXPECT_EQ(value_of(original, 42), 42.0);
+  EXPECT_EQ(copy.size(), 50u);
+  for (std::uint32_t s = 0; s < 100; s += 2) {
+    if (s != 42) {
+      EXPECT_TRUE(copy.shares_node_with(original, s)) << s;
+    }
+  }
+
+  // The pointer stays valid while other slots of the same map are modified,
+  // even when the tree grows.
+  put(copy, 44, -44.0);
+  put(copy, 43, -43.0);
+  put(copy, 3000, -3000.0);
+  lm->mean.y() = 7.0;
+  ASSERT_NE(copy.find(42), nullptr);
+  EXPECT_EQ(copy.find(42)->mean.y(), 7.0);
+  EXPECT_EQ(copy.find(42), lm);
+  EXPECT_EQ(original.find(42)->mean.y(), 0.0);
+  EXPECT_EQ(original.find(3000), nullptr);
+
+  // Already owned: a second call allocates nothing and returns the same landmark.
+  const std::size_t owned = pool.nodes_allocated_total();
+  EXPECT_EQ(copy.modify_if_present(42), lm);
+  EXPECT_EQ(pool.nodes_allocated_total(), owned);
+
+  LandmarkMap empty(&pool);
+  EXPECT_EQ(empty.modify_if_present(0), nullptr);
+  EXPECT_EQ(empty.size(), 0u);
+}
+
 TEST(LandmarkMap, MovedFromMapIsEmptyAndReusable) {
   LandmarkMapPool pool;
   LandmarkMap a(&pool);

@@ -156,11 +156,12 @@ TEST(MotionModel, PropagatedCovarianceMatchesMonteCarloFromAPoint) {
 }
 
 TEST(MotionModel, PropagatedCovarianceMatchesMonteCarloWithPriorAndDistanceNoise) {
-  // Given a correlated prior and all four noise terms, the linearised
+  // Given a correlated prior and all the noise terms, the linearised
   // F cov F^T + V Q V^T matches the sampled covariance within a few percent
   // (noise kept small enough that linearisation error is well below that).
   std::mt19937 prng(42);
-  const MotionNoise noise{0.06, 0.05, 0.05, 0.04};
+  MotionNoise noise{0.06, 0.05, 0.05, 0.04};
+  noise.rotation_sigma_per_sqrt_rad = 0.03;
   const double v = 0.8, w = -0.6, dt = 1.5;
   PoseGaussian g;
   g.mean = Pose2(1.0, 2.0, -2.5);
@@ -171,7 +172,7 @@ TEST(MotionModel, PropagatedCovarianceMatchesMonteCarloWithPriorAndDistanceNoise
   propagate(g, v, w, dt, noise);
   const double dist = std::abs(v * dt);
   const double var_d = 0.06 * 0.06 * dt + 0.05 * 0.05 * dist;
-  const double var_a = 0.05 * 0.05 * dt + 0.04 * 0.04 * dist;
+  const double var_a = 0.05 * 0.05 * dt + 0.04 * 0.04 * dist + 0.03 * 0.03 * std::abs(w * dt);
   const Eigen::Matrix3d mc = monte_carlo_cov(g0, v, w, dt, var_d, var_a, 200000, prng);
   expect_cov_close(g.cov, mc, 0.03);
 }
@@ -193,6 +194,18 @@ TEST(MotionModel, CovarianceStaysSymmetricPositiveSemiDefinite) {
   EXPECT_GT(g.cov(2, 2), 0.0);
 }
 
+TEST(MotionModel, RotationNoiseScalesWithTheTurnedAngle) {
+  // Pure rotation by a = w dt from a known pose: heading variance is
+  // w_sigma^2 dt + rotation_sigma^2 |a|, for left and right turns alike.
+  MotionNoise noise{0.0, 0.1, 0.0, 0.0};
+  noise.rotation_sigma_per_sqrt_rad = 0.2;
+  for (const double w : {0.8, -0.8}) {
+    PoseGaussian g;
+    propagate(g, 0.0, w, 2.0, noise);
+    EXPECT_NEAR(g.cov(2, 2), 0.01 * 2.0 + 0.04 * 1.6, 1e-15) << "w " << w;
+  }
+}
+
 TEST(MotionModel, NonPositiveDtDoesNothing) {
   const MotionNoise noise{0.1, 0.1, 0.1, 0.1};
   PoseGaussian g;
@@ -209,8 +222,9 @@ TEST(MotionModel, NonPositiveDtDoesNothing) {
 
 TEST(MotionModel, StandingStillAddsOnlyTimeNoise) {
   // v = w = 0 for dt: position variance grows by v_sigma^2 dt along the heading,
-  // heading variance by w_sigma^2 dt; the distance terms add nothing.
-  const MotionNoise noise{0.1, 0.2, 5.0, 5.0};
+  // heading variance by w_sigma^2 dt; the distance and rotation terms add nothing.
+  MotionNoise noise{0.1, 0.2, 5.0, 5.0};
+  noise.rotation_sigma_per_sqrt_rad = 5.0;
   PoseGaussian g;
   g.mean = Pose2(0.0, 0.0, 0.0);
   propagate(g, 0.0, 0.0, 2.0, noise);

@@ -50,9 +50,11 @@ TEST(SlamOptionsYaml, FullConfigRoundTripsEveryValue) {
       "    w_sigma_rad_per_sqrt_s: 0.0225\n"
       "    distance_sigma_per_sqrt_m: 0.05\n"
       "    heading_sigma_rad_per_sqrt_m: 0.06\n"
+      "    rotation_sigma_per_sqrt_rad: 0.07\n"
       "  control_timeout_s: 2.5\n"
       "  observation:\n"
       "    range_sigma_m: 0.11\n"
+      "    range_sigma_per_m: 0.02\n"
       "    bearing_sigma_rad: 0.031\n"
       "    min_range_m: 0.3\n"
       "    max_range_m: 12.5\n"
@@ -71,8 +73,10 @@ TEST(SlamOptionsYaml, FullConfigRoundTripsEveryValue) {
   EXPECT_DOUBLE_EQ(o.motion.w_sigma_rad_per_sqrt_s, 0.0225);
   EXPECT_DOUBLE_EQ(o.motion.distance_sigma_per_sqrt_m, 0.05);
   EXPECT_DOUBLE_EQ(o.motion.heading_sigma_rad_per_sqrt_m, 0.06);
+  EXPECT_DOUBLE_EQ(o.motion.rotation_sigma_per_sqrt_rad, 0.07);
   EXPECT_DOUBLE_EQ(o.control_timeout_s, 2.5);
   EXPECT_DOUBLE_EQ(o.range_sigma_m, 0.11);
+  EXPECT_DOUBLE_EQ(o.range_sigma_per_m, 0.02);
   EXPECT_DOUBLE_EQ(o.bearing_sigma_rad, 0.031);
   EXPECT_DOUBLE_EQ(o.min_range_m, 0.3);
   EXPECT_DOUBLE_EQ(o.max_range_m, 12.5);

@@ -54,11 +54,7 @@ int run(int argc, char** argv) {
   config::YamlReader root = config::YamlReader::from_file(config_path);
   config::YamlReader filter_yaml = root.child("filter");
   slam::FilterOptions options = slam::read_filter_options(filter_yaml);
-  offline::MrclamSensorModel model;
-  if (root.has("mrclam")) {
-    config::YamlReader mrclam_yaml = root.child("mrclam");
-    model = offline::read_mrclam_sensor_model(mrclam_yaml);
-  }
+  const offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
   root.finish();
 
   std::printf("%-6s %-5s %9s %9s %10s %10s %11s %11s %8s %8s\n", "robot", "seed", "ATE_m", "DR_ATE_m",

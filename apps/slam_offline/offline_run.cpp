@@ -114,8 +114,10 @@ void print_report(const std::string& title, const Report& r, const RunResult& re
 
 namespace pixyslam::offline {
 
-MrclamSensorModel read_mrclam_sensor_model(config::YamlReader& y) {
+MrclamSensorModel read_mrclam_sensor_model(config::YamlReader& root) {
   MrclamSensorModel m;
+  if (!root.has("mrclam")) return m;
+  config::YamlReader y = root.child("mrclam");
   m.range_scale = y.number("range_scale", 0.5, 2.0, m.range_scale);
   m.range_cos_bearing_exponent = y.number("range_cos_bearing_exponent", 0.0, 3.0, m.range_cos_bearing_exponent);
   m.odometry_delay_s = y.number("odometry_delay_s", -2.0, 2.0, m.odometry_delay_s);

@@ -64,7 +64,8 @@ struct MrclamSensorModel {
   double range_cos_bearing_exponent = 0.0;
   double odometry_delay_s = 0.0;
 };
-MrclamSensorModel read_mrclam_sensor_model(config::YamlReader& mrclam);
+// Reads the optional `mrclam:` mapping of a config file's root (defaults: ideal sensors).
+MrclamSensorModel read_mrclam_sensor_model(config::YamlReader& root);
 
 // MRCLAM robot data as filter input: started at the first ground-truth pose when
 // there is one, else at the origin at the first odometry time.

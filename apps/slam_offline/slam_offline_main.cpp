@@ -87,11 +87,7 @@ int run(const Args& args) {
     title = "simulated world, " + std::to_string(run.poles.size()) + " poles, " +
             std::to_string(run.frames.size()) + " camera frames";
   } else {
-    offline::MrclamSensorModel model;
-    if (root.has("mrclam")) {
-      config::YamlReader mrclam_yaml = root.child("mrclam");
-      model = offline::read_mrclam_sensor_model(mrclam_yaml);
-    }
+    const offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
     root.finish();
     const std::string dataset = args.get("dataset");
     const long robot = parse_long(args.get("robot"), "--robot");
