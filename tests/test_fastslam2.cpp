@@ -149,18 +149,21 @@ TEST(FastSlam2, SameSeedAndInputGiveBitIdenticalResults) {
 //  * NEES only over t in [2 s, 40 s]: half a lap, before the first loop closure.
 //    FastSLAM is known to become overconfident over long runs (path degeneracy,
 //    Bailey et al. 2006); with this filter the full 150 s run reaches average
-//    NEES ~100 even when correct, so a long-run bound would not be meaningful.
+//    NEES 50..400 (200 particles) even when correct, so a long-run bound would
+//    not be meaningful.
 //  * 1000 particles.
 //  * For a consistent filter each step's NEES ~ chi-square(3), mean 3. Errors are
 //    strongly autocorrelated in time, so a run's average behaves like a handful
 //    of independent chi-square samples, not hundreds: per-run averages of the
 //    correct filter ranged 1.5 .. 8.4 over 30 seeds (mean 3.4). Bounds: every
 //    run's average in [0.5, 9] (9 ~ 97% quantile of chi-square(3)) and the mean
-//    over the runs in [1, 6].
+//    over the runs in [1, 6]. The six runs below give 5.7 1.9 2.5 3.6 1.7 2.3.
 //  * What fails: without the proposal (poses sampled from the motion model, a
 //    FastSLAM 1.0 proposal with these noises) the mean is ~12 (up to ~46 per run);
 //    a wrong sign of d(bearing)/d(theta), a wrong landmark Jacobian or S without
 //    the pose term give non-positive-definite covariances or NEES in the 100s+.
+//    (A sign error in d(bearing)/d(x, y) alone stays consistent-looking here; it
+//    is caught by the Jacobian unit tests and by the ATE test below.)
 TEST(FastSlam2, PoseNeesIsConsistentInTheFirstHalfLap) {
   const int kRuns = 6;
   std::vector<double> run_nees;
@@ -339,6 +342,35 @@ TEST(FastSlam2, InvalidObservationsAreCountedAndIgnored) {
   expect_finite(f.pose_estimate());
 }
 
+TEST(FastSlam2, ObservationAtZeroPredictedRangeKeepsTheEstimateFinite) {
+  // BUG (observation_model.cpp fit_observation / fastslam2.cpp update_particle):
+  // when a particle's pose mean coincides with a mapped landmark's mean, the
+  // predicted range is 0 and predict_observation divides 0/0, so fit.s and
+  // fit.mahalanobis2 are NaN. The gate test `fit.mahalanobis2 > gate_d2_` is
+  // false for NaN, so the observation is "used": the NaN is folded into the pose,
+  // the landmark and the weight of every particle, and pose_estimate() returns
+  // NaN mean and covariance. Here: landmark mapped at (2, 0) from the origin, the
+  // robot drives 1 m/s for 2 s (odometry mean exactly (2, 0, 0)), then a valid
+  // detection (range 1 m) of that landmark arrives. Expected: the observation is
+  // rejected (gated or invalid) or otherwise handled, the estimate stays finite.
+  // Actual: mean = cov = NaN, observations_used = 1.
+  GTEST_SKIP() << "known bug: a fit with predicted range 0 is NaN and passes the gate";
+  FilterOptions o;
+  o.particles = 10;
+  FastSlam2 f(o, Pose2::Zero());
+  f.add_odometry({0.0, 0.0, 0.0});
+  f.add_observations({0.0, {{1, 2.0, 0.0}}});
+  f.add_odometry({0.0, 1.0, 0.0});
+  f.add_odometry({2.0, 0.0, 0.0});
+  f.add_observations({2.1, {{1, 1.0, 0.0}}});
+  expect_finite(f.pose_estimate());
+  for (const LandmarkEstimate& lm : f.landmarks_of_best()) {
+    EXPECT_TRUE(lm.mean.allFinite());
+    EXPECT_TRUE(lm.cov.allFinite());
+  }
+  for (const Particle& p : f.particles()) EXPECT_FALSE(std::isnan(p.log_weight));
+}
+
 TEST(FastSlam2, OutOfOrderSamplesAreCountedAndAppliedAtFilterTime) {
   FilterOptions o;
   o.particles = 20;
@@ -492,6 +524,31 @@ TEST(FastSlam2, ResamplingEveryFrameResetsWeights) {
     for (const Particle& p : f.particles()) EXPECT_EQ(p.log_weight, 0.0);
     EXPECT_NEAR(f.pose_estimate().effective_sample_size, 200.0, 1e-9);
   }
+}
+
+// ------------------------------------------------------- observation noise
+
+TEST(FastSlam2, ObservationNoiseFromOptionsOrDetection) {
+  // From a known pose, a first sighting straight ahead initialises the landmark
+  // with the range variance along x and (r sigma_b)^2 along y.
+  FilterOptions o;
+  o.particles = 10;
+  o.range_sigma_m = 0.05;
+  o.range_sigma_per_m = 0.02;
+  o.bearing_sigma_rad = 0.01;
+  FastSlam2 f(o, Pose2::Zero());
+  f.add_odometry({0.0, 0.0, 0.0});
+  // Landmark 1 without sigmas: sd = 0.05 + 0.02 * 5 = 0.15; landmark 2 with its own.
+  f.add_observations({0.1, {{1, 5.0, 0.0}, {2, 4.0, 0.0, 0.3, 0.02}}});
+  const std::vector<LandmarkEstimate> lms = f.landmarks_of_best();
+  ASSERT_EQ(lms.size(), 2u);
+  EXPECT_EQ(lms[0].id, 1);
+  EXPECT_NEAR(lms[0].mean.x(), 5.0, 1e-12);
+  EXPECT_NEAR(lms[0].cov(0, 0), 0.15 * 0.15, 1e-12);
+  EXPECT_NEAR(lms[0].cov(1, 1), (5.0 * 0.01) * (5.0 * 0.01), 1e-12);
+  EXPECT_EQ(lms[1].id, 2);
+  EXPECT_NEAR(lms[1].cov(0, 0), 0.3 * 0.3, 1e-12);
+  EXPECT_NEAR(lms[1].cov(1, 1), (4.0 * 0.02) * (4.0 * 0.02), 1e-12);
 }
 
 // --------------------------------------------------------------- prior map

@@ -393,6 +393,31 @@ TEST(LandmarkMap, ModifyIfPresentUnsharesOnlyPresentSlots) {
   EXPECT_EQ(empty.size(), 0u);
 }
 
+TEST(LandmarkMap, SlotBeyondTheDepthLimitThrowsOnANonEmptyMap) {
+  LandmarkMapPool pool;
+  LandmarkMap m(&pool);
+  put(m, 0, 1.0);
+  EXPECT_THROW(m.modify(1u << 31), std::out_of_range);
+  EXPECT_EQ(m.find(1u << 31), nullptr);
+  EXPECT_EQ(value_of(m, 0), 1.0);  // the map is still intact
+  put(m, (1u << 31) - 1, 2.0);      // the largest slot that fits
+  EXPECT_EQ(value_of(m, (1u << 31) - 1), 2.0);
+}
+
+TEST(LandmarkMap, SlotBeyondTheDepthLimitThrowsOnAnEmptyMap) {
+  // BUG (landmark_map.cpp, LandmarkMap::modify): on an EMPTY map the initial
+  // depth loop `while ((slot >> depth_) != 0) ++depth_;` shifts a 32-bit slot by
+  // 32 or more for slot >= 2^31 (undefined behaviour; on x86 it never ends), so
+  // modify(1u << 31) hangs instead of throwing std::out_of_range as it does on a
+  // non-empty map (kMaxDepth check in the grow loop). Skipped until fixed, as the
+  // call would hang the test run.
+  GTEST_SKIP() << "known bug: LandmarkMap::modify(slot >= 2^31) on an empty map hangs (UB shift)";
+  LandmarkMapPool pool;
+  LandmarkMap m(&pool);
+  EXPECT_THROW(m.modify(1u << 31), std::out_of_range);
+  EXPECT_EQ(m.size(), 0u);
+}
+
 TEST(LandmarkMap, MovedFromMapIsEmptyAndReusable) {
   LandmarkMapPool pool;
   LandmarkMap a(&pool);

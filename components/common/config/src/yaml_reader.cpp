@@ -88,11 +88,7 @@ double YamlReader::number(const std::string& key, double min, double max) {
 }
 
 double YamlReader::number(const std::string& key, double min, double max, double fallback) {
-  if (!has(key)) {
-    used_.insert(key);
-    return fallback;
-  }
-  return number(key, min, max);
+  return or_fallback(key, fallback, [&] { return number(key, min, max); });
 }
 
 std::int64_t YamlReader::integer(const std::string& key, std::int64_t min, std::int64_t max) {
@@ -113,11 +109,7 @@ std::int64_t YamlReader::integer(const std::string& key, std::int64_t min, std::
 
 std::int64_t YamlReader::integer(const std::string& key, std::int64_t min, std::int64_t max,
                                  std::int64_t fallback) {
-  if (!has(key)) {
-    used_.insert(key);
-    return fallback;
-  }
-  return integer(key, min, max);
+  return or_fallback(key, fallback, [&] { return integer(key, min, max); });
 }
 
 bool YamlReader::boolean(const std::string& key) {
@@ -128,21 +120,13 @@ bool YamlReader::boolean(const std::string& key) {
 }
 
 bool YamlReader::boolean(const std::string& key, bool fallback) {
-  if (!has(key)) {
-    used_.insert(key);
-    return fallback;
-  }
-  return boolean(key);
+  return or_fallback(key, fallback, [&] { return boolean(key); });
 }
 
 std::string YamlReader::text(const std::string& key) { return scalar(key).Scalar(); }
 
 std::string YamlReader::text(const std::string& key, const std::string& fallback) {
-  if (!has(key)) {
-    used_.insert(key);
-    return fallback;
-  }
-  return text(key);
+  return or_fallback(key, fallback, [&] { return text(key); });
 }
 
 std::string YamlReader::choice(const std::string& key, std::initializer_list<const char*> allowed) {
@@ -157,11 +141,7 @@ std::string YamlReader::choice(const std::string& key, std::initializer_list<con
 
 std::string YamlReader::choice(const std::string& key, std::initializer_list<const char*> allowed,
                                const std::string& fallback) {
-  if (!has(key)) {
-    used_.insert(key);
-    return fallback;
-  }
-  return choice(key, allowed);
+  return or_fallback(key, fallback, [&] { return choice(key, allowed); });
 }
 
 void YamlReader::finish() const {

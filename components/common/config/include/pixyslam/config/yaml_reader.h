@@ -59,6 +59,15 @@ class YamlReader {
 
  private:
   YAML::Node scalar(const std::string& key);
+  // An absent optional key counts as read and yields `fallback`.
+  template <class T, class Read>
+  T or_fallback(const std::string& key, const T& fallback, const Read& read) {
+    if (!has(key)) {
+      used_.insert(key);
+      return fallback;
+    }
+    return read();
+  }
 
   YAML::Node node_;
   std::string origin_;
