@@ -1,6 +1,5 @@
 #include "pixyslam/slam/landmark_map.h"
 
-#include <cassert>
 #include <stdexcept>
 
 namespace pixyslam::slam {
@@ -8,45 +7,27 @@ namespace pixyslam::slam {
 struct LandmarkMap::Node {
   std::uint32_t refs = 1;
   bool is_leaf = false;
-  Node* child[2] = {nullptr, nullptr};
-  Landmark landmark;
 };
-
-namespace {
-constexpr std::size_t kBlockNodes = 4096;
-constexpr int kMaxDepth = 31;
-}  // namespace
-
-LandmarkMapPool::~LandmarkMapPool() {
-  for (LandmarkMap::Node* block : blocks_) delete[] block;
-}
-
-LandmarkMap::Node* LandmarkMapPool::allocate() {
-  ++allocated_total_;
-  ++live_;
-  LandmarkMap::Node* n;
-  if (!free_list_.empty()) {
-    n = free_list_.back();
-    free_list_.pop_back();
-  } else {
-    if (blocks_.empty() || block_used_ == kBlockNodes) {
-      blocks_.push_back(new LandmarkMap::Node[kBlockNodes]);
-      block_used_ = 0;
-    }
-    n = &blocks_.back()[block_used_++];
-  }
-  *n = LandmarkMap::Node{};
-  return n;
-}
-
-void LandmarkMapPool::free(LandmarkMap::Node* node) {
-  --live_;
-  free_list_.push_back(node);
-}
 
 namespace {
 
 using Node = LandmarkMap::Node;
+
+struct Inner : Node {
+  Node* child[2] = {nullptr, nullptr};
+};
+
+struct Leaf : Node {
+  Landmark landmark;
+};
+
+Inner* inner(Node* n) { return static_cast<Inner*>(n); }
+const Inner* inner(const Node* n) { return static_cast<const Inner*>(n); }
+Leaf* leaf(Node* n) { return static_cast<Leaf*>(n); }
+const Leaf* leaf(const Node* n) { return static_cast<const Leaf*>(n); }
+
+constexpr std::size_t kBlockNodes = 4096;
+constexpr int kMaxDepth = 31;
 
 void ref(Node* n) {
   if (n) ++n->refs;
@@ -57,13 +38,46 @@ void ref(Node* n) {
 void unref(LandmarkMapPool* pool, Node* n, void (*free_node)(LandmarkMapPool*, Node*)) {
   if (!n || --n->refs > 0) return;
   if (!n->is_leaf) {
-    unref(pool, n->child[0], free_node);
-    unref(pool, n->child[1], free_node);
+    unref(pool, inner(n)->child[0], free_node);
+    unref(pool, inner(n)->child[1], free_node);
   }
   free_node(pool, n);
 }
 
+template <class T>
+Node* take(std::vector<Node*>& free_list, std::vector<std::shared_ptr<void>>& blocks, std::size_t& used) {
+  T* n;
+  if (!free_list.empty()) {
+    n = static_cast<T*>(free_list.back());
+    free_list.pop_back();
+  } else {
+    if (blocks.empty() || used == kBlockNodes) {
+      blocks.emplace_back(new T[kBlockNodes], std::default_delete<T[]>());
+      used = 0;
+    }
+    n = static_cast<T*>(blocks.back().get()) + used++;
+  }
+  *n = T{};
+  return n;
+}
+
 }  // namespace
+
+LandmarkMapPool::~LandmarkMapPool() = default;
+
+LandmarkMap::Node* LandmarkMapPool::allocate(bool is_leaf) {
+  ++allocated_total_;
+  ++live_;
+  Node* n = is_leaf ? take<Leaf>(leaf_.free_list, leaf_.blocks, leaf_.block_used)
+                    : take<Inner>(inner_.free_list, inner_.blocks, inner_.block_used);
+  n->is_leaf = is_leaf;
+  return n;
+}
+
+void LandmarkMapPool::free(LandmarkMap::Node* node) {
+  --live_;
+  (node->is_leaf ? leaf_ : inner_).free_list.push_back(node);
+}
 
 LandmarkMap::LandmarkMap(LandmarkMapPool* pool) : pool_(pool) {}
 
@@ -114,21 +128,24 @@ void LandmarkMap::release() {
 const Landmark* LandmarkMap::find(std::uint32_t slot) const {
   if (!root_ || (depth_ < 32 && (slot >> depth_) != 0)) return nullptr;
   const Node* n = root_;
-  for (int level = depth_ - 1; level >= 0 && n; --level) n = n->child[(slot >> level) & 1u];
-  return (n && n->is_leaf) ? &n->landmark : nullptr;
+  for (int level = depth_ - 1; level >= 0 && n; --level) n = inner(n)->child[(slot >> level) & 1u];
+  return (n && n->is_leaf) ? &leaf(n)->landmark : nullptr;
 }
 
 Landmark& LandmarkMap::modify(std::uint32_t slot) {
   if (!pool_) throw std::logic_error("LandmarkMap::modify on a map without a pool");
   if (!root_) {
-    depth_ = 0;
-    while ((slot >> depth_) != 0) ++depth_;
+    int depth = 0;
+    while ((slot >> depth) != 0) {
+      if (++depth > kMaxDepth) throw std::out_of_range("LandmarkMap slot too large");
+    }
+    depth_ = depth;
   }
   // Grow: the old tree becomes the left subtree of a new root until slot fits.
   while (root_ && (slot >> depth_) != 0) {
     if (depth_ >= kMaxDepth) throw std::out_of_range("LandmarkMap slot too large");
-    Node* top = pool_->allocate();
-    top->child[0] = root_;
+    Node* top = pool_->allocate(false);
+    inner(top)->child[0] = root_;
     root_ = top;
     ++depth_;
   }
@@ -137,15 +154,14 @@ Landmark& LandmarkMap::modify(std::uint32_t slot) {
   for (int level = depth_;; --level) {
     Node* n = *link;
     if (!n) {
-      n = pool_->allocate();
-      n->is_leaf = (level == 0);
+      n = pool_->allocate(level == 0);
       if (n->is_leaf) ++size_;
       *link = n;
     } else {
       n = own(link);
     }
-    if (level == 0) return n->landmark;
-    link = &n->child[(slot >> (level - 1)) & 1u];
+    if (level == 0) return leaf(n)->landmark;
+    link = &inner(n)->child[(slot >> (level - 1)) & 1u];
   }
 }
 
@@ -156,20 +172,23 @@ Landmark* LandmarkMap::modify_if_present(std::uint32_t slot) {
   Node** link = &root_;
   for (int level = depth_;; --level) {
     Node* n = own(link);
-    if (level == 0) return &n->landmark;
-    link = &n->child[(slot >> (level - 1)) & 1u];
+    if (level == 0) return &leaf(n)->landmark;
+    link = &inner(n)->child[(slot >> (level - 1)) & 1u];
   }
 }
 
 LandmarkMap::Node* LandmarkMap::own(Node** link) {
   Node* n = *link;
   if (n->refs == 1) return n;
-  Node* copy = pool_->allocate();
-  *copy = *n;
-  copy->refs = 1;
-  if (!n->is_leaf) {
-    ref(copy->child[0]);
-    ref(copy->child[1]);
+  Node* copy = pool_->allocate(n->is_leaf);
+  if (n->is_leaf) {
+    leaf(copy)->landmark = leaf(n)->landmark;
+  } else {
+    for (Node* c : inner(n)->child) {
+      ref(c);
+    }
+    inner(copy)->child[0] = inner(n)->child[0];
+    inner(copy)->child[1] = inner(n)->child[1];
   }
   --n->refs;
   *link = copy;
@@ -189,11 +208,11 @@ void LandmarkMap::for_each(const std::function<void(std::uint32_t, const Landmar
     stack.pop_back();
     if (!it.node) continue;
     if (it.level == 0) {
-      visit(it.prefix, it.node->landmark);
+      visit(it.prefix, leaf(it.node)->landmark);
       continue;
     }
-    stack.push_back({it.node->child[1], it.level - 1, (it.prefix << 1) | 1u});
-    stack.push_back({it.node->child[0], it.level - 1, it.prefix << 1});
+    stack.push_back({inner(it.node)->child[1], it.level - 1, (it.prefix << 1) | 1u});
+    stack.push_back({inner(it.node)->child[0], it.level - 1, it.prefix << 1});
   }
 }
 

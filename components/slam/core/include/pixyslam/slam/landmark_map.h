@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
@@ -79,12 +80,18 @@ class LandmarkMapPool {
 
  private:
   friend class LandmarkMap;
-  LandmarkMap::Node* allocate();
+  // Inner nodes (two child pointers) and leaves (one Landmark) come from separate
+  // slabs so the nodes walked on every lookup stay small.
+  LandmarkMap::Node* allocate(bool leaf);
   void free(LandmarkMap::Node* node);
 
-  std::vector<LandmarkMap::Node*> free_list_;
-  std::vector<LandmarkMap::Node*> blocks_;
-  std::size_t block_used_ = 0;
+  struct Slab {
+    std::vector<LandmarkMap::Node*> free_list;
+    std::vector<std::shared_ptr<void>> blocks;  // owns the memory, typed deleter
+    std::size_t block_used = 0;
+  };
+  Slab inner_;
+  Slab leaf_;
   std::size_t allocated_total_ = 0;
   std::size_t live_ = 0;
 };
