@@ -343,18 +343,10 @@ TEST(FastSlam2, InvalidObservationsAreCountedAndIgnored) {
 }
 
 TEST(FastSlam2, ObservationAtZeroPredictedRangeKeepsTheEstimateFinite) {
-  // BUG (observation_model.cpp fit_observation / fastslam2.cpp update_particle):
-  // when a particle's pose mean coincides with a mapped landmark's mean, the
-  // predicted range is 0 and predict_observation divides 0/0, so fit.s and
-  // fit.mahalanobis2 are NaN. The gate test `fit.mahalanobis2 > gate_d2_` is
-  // false for NaN, so the observation is "used": the NaN is folded into the pose,
-  // the landmark and the weight of every particle, and pose_estimate() returns
-  // NaN mean and covariance. Here: landmark mapped at (2, 0) from the origin, the
-  // robot drives 1 m/s for 2 s (odometry mean exactly (2, 0, 0)), then a valid
-  // detection (range 1 m) of that landmark arrives. Expected: the observation is
-  // rejected (gated or invalid) or otherwise handled, the estimate stays finite.
-  // Actual: mean = cov = NaN, observations_used = 1.
-  GTEST_SKIP() << "known bug: a fit with predicted range 0 is NaN and passes the gate";
+  // Regression: a particle whose pose mean coincides with a mapped landmark has
+  // predicted range 0 (0/0 in the Jacobians); that NaN once passed the gate and
+  // spread into the pose, the map and the weights. Landmark mapped at (2, 0), the
+  // robot drives exactly onto it, then a valid detection of it arrives.
   FilterOptions o;
   o.particles = 10;
   FastSlam2 f(o, Pose2::Zero());

@@ -12,6 +12,8 @@
 namespace pixyslam::slam {
 namespace {
 
+constexpr double kMinLandmarkDistanceSq = 1e-6;  // (1 mm)^2
+
 // Draws x ~ N(g.mean, g.cov); g.cov may be singular (positive semi-definite).
 Pose2 sample_pose(const PoseGaussian& g, std::mt19937_64& rng) {
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -139,7 +141,16 @@ void FastSlam2::update_particle(Particle& p, const std::vector<RangeBearing>& de
     Landmark* lm = p.map.modify_if_present(slots_[k]);
     landmarks_[k] = lm;
     if (!lm) continue;
+    if ((lm->mean - proposal.mean.head<2>()).squaredNorm() < kMinLandmarkDistanceSq) {
+      // The particle sits on the landmark: range-bearing is undefined there.
+      decision_[k] = Decision::kInvalid;
+      continue;
+    }
     const ObservationFit fit = fit_observation(proposal, lm->mean, lm->cov, z_[k], r_[k]);
+    if (!std::isfinite(fit.mahalanobis2) || !std::isfinite(fit.log_likelihood)) {
+      decision_[k] = Decision::kInvalid;
+      continue;
+    }
     const bool readmit = lm->consecutive_rejections >= static_cast<std::uint32_t>(options_.gate_readmit_after);
     if (options_.gate_enabled && fit.mahalanobis2 > gate_d2_ && !readmit) {
       decision_[k] = Decision::kGated;
