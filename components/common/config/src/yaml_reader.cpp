@@ -55,6 +55,12 @@ void YamlReader::fail(const std::string& key, const std::string& what) const {
 
 bool YamlReader::has(const std::string& key) const { return static_cast<bool>(node_[key]); }
 
+std::vector<std::string> YamlReader::keys() const {
+  std::vector<std::string> out;
+  for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+  return out;
+}
+
 YamlReader YamlReader::child(const std::string& key) {
   used_.insert(key);
   YAML::Node n = node_[key];

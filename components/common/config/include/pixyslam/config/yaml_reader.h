@@ -5,6 +5,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -32,6 +33,8 @@ class YamlReader {
   YamlReader(YAML::Node node, std::string origin, std::string key_path);
 
   bool has(const std::string& key) const;
+  // The keys of this mapping, in file order (for mappings keyed by data, e.g. ids).
+  std::vector<std::string> keys() const;
   // Required sub-mapping; an absent key is an error.
   YamlReader child(const std::string& key);
 

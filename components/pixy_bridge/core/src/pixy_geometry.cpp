@@ -1,0 +1,163 @@
+#include "pixyslam/pixy/pixy_geometry.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace pixyslam::pixy {
+namespace {
+
+constexpr int kMaxTags = 5;
+
+void require(bool ok, const char* what) {
+  if (!ok) throw std::invalid_argument(std::string("CameraModel: ") + what);
+}
+
+}  // namespace
+
+void validate(const CameraModel& c) {
+  require(std::isfinite(c.focal_length_mm) && c.focal_length_mm > 0.0, "focal_length_mm must be > 0");
+  require(std::isfinite(c.sensor_width_mm) && c.sensor_width_mm > 0.0, "sensor_width_mm must be > 0");
+  require(std::isfinite(c.sensor_height_mm) && c.sensor_height_mm > 0.0, "sensor_height_mm must be > 0");
+  require(c.image_width_px > 0, "image_width_px must be > 0");
+  require(c.image_height_px > 0, "image_height_px must be > 0");
+  require(std::isfinite(c.landmark_height_m) && c.landmark_height_m > 0.0, "landmark_height_m must be > 0");
+  require(std::isfinite(c.min_height_to_width) && c.min_height_to_width > 0.0,
+          "min_height_to_width must be > 0");
+  require(std::isfinite(c.max_height_to_width) && c.max_height_to_width >= c.min_height_to_width,
+          "max_height_to_width must be >= min_height_to_width");
+  require(std::isfinite(c.range_sigma_fraction) && c.range_sigma_fraction > 0.0,
+          "range_sigma_fraction must be > 0");
+  require(std::isfinite(c.bearing_sigma_rad) && c.bearing_sigma_rad > 0.0, "bearing_sigma_rad must be > 0");
+}
+
+double range_m(const CameraModel& c, double block_height_px) {
+  if (block_height_px <= 0.0) return std::numeric_limits<double>::infinity();
+  // Seed paper Eq. 5: r = f * h_r / S_h * I_h / h_s (f and S_h in mm cancel).
+  return c.focal_length_mm * c.landmark_height_m / c.sensor_height_mm * c.image_height_px / block_height_px;
+}
+
+double bearing_rad(const CameraModel& c, double block_x_px) {
+  // Seed paper Eq. 6: phi = atan(w_s * S_w / (f * I_w)), with the offset w_s
+  // taken from the image centre towards the left so that left is positive.
+  const double w_s_px = 0.5 * c.image_width_px - block_x_px;
+  return std::atan(w_s_px * c.sensor_width_mm / (c.focal_length_mm * c.image_width_px));
+}
+
+bool aspect_ok(const CameraModel& c, const PixyBlock& b) {
+  if (b.width == 0 || b.height == 0) return false;
+  // h_s / w_s within [2.0, 2.2] in the paper. A quotient of small integers is
+  // correctly rounded, so a ratio exactly on a bound compares equal to it.
+  const double ratio = static_cast<double>(b.height) / static_cast<double>(b.width);
+  return ratio >= c.min_height_to_width && ratio <= c.max_height_to_width;
+}
+
+std::optional<std::uint16_t> parse_signature(std::string_view text) {
+  if (text.size() >= 2 && text[0] == '0' && text[1] == 'o') {
+    text.remove_prefix(2);
+  } else if (text.size() >= 2 && text[0] == '0') {
+    text.remove_prefix(1);
+  }
+  if (text.empty() || text.size() > kMaxTags) return std::nullopt;
+  std::uint16_t value = 0;
+  for (char ch : text) {
+    if (ch < '1' || ch > '7') return std::nullopt;
+    value = static_cast<std::uint16_t>(value * 8 + (ch - '0'));
+  }
+  return value;
+}
+
+std::string signature_tags(std::uint16_t signature) {
+  std::string tags;
+  for (std::uint16_t s = signature; s != 0; s = static_cast<std::uint16_t>(s / 8)) {
+    const int tag = s % 8;
+    if (tag == 0) return "";
+    tags.insert(tags.begin(), static_cast<char>('0' + tag));
+  }
+  if (tags.size() > kMaxTags) return "";
+  return tags;
+}
+
+bool valid_signature(std::uint16_t signature) { return !signature_tags(signature).empty(); }
+
+void SignatureMap::add(std::uint16_t signature, int landmark_id) {
+  if (!valid_signature(signature)) {
+    throw std::invalid_argument("SignatureMap: " + std::to_string(signature) +
+                                " is not a Pixy signature (1 to 5 tags, each 1..7)");
+  }
+  if (landmark_id < 0) throw std::invalid_argument("SignatureMap: landmark id must be >= 0");
+  if (by_signature_.count(signature)) {
+    throw std::invalid_argument("SignatureMap: signature " + signature_tags(signature) + " is already mapped");
+  }
+  if (by_landmark_.count(landmark_id)) {
+    throw std::invalid_argument("SignatureMap: landmark " + std::to_string(landmark_id) +
+                                " already has signature " + signature_tags(by_landmark_.at(landmark_id)));
+  }
+  by_signature_.emplace(signature, landmark_id);
+  by_landmark_.emplace(landmark_id, signature);
+}
+
+std::optional<int> SignatureMap::landmark_of_signature(std::uint16_t signature) const {
+  const auto it = by_signature_.find(signature);
+  if (it == by_signature_.end()) return std::nullopt;
+  return it->second;
+}
+
+std::optional<int> SignatureMap::landmark_of(const PixyBlock& block) const {
+  // Single tags (1..7) are normal signatures; colour codes have at least two tags.
+  const bool multi_tag = block.signature > 7;
+  if (multi_tag != block.colour_code) return std::nullopt;
+  return landmark_of_signature(block.signature);
+}
+
+std::vector<Detection> to_detections(const PixyFrame& frame, const SignatureMap& signatures,
+                                     const CameraModel& camera, DetectionCounters& counters) {
+  std::vector<Detection> out;
+  out.reserve(frame.blocks.size());
+  for (const PixyBlock& b : frame.blocks) {
+    ++counters.blocks;
+    const std::optional<int> id = signatures.landmark_of(b);
+    if (!id) {
+      ++counters.unknown_signature;
+      continue;
+    }
+    if (b.height == 0) {
+      ++counters.zero_height;
+      continue;
+    }
+    if (b.x > camera.image_width_px || b.y > camera.image_height_px || b.width > camera.image_width_px ||
+        b.height > camera.image_height_px) {
+      ++counters.outside_image;
+      continue;
+    }
+    if (!aspect_ok(camera, b)) {
+      ++counters.bad_aspect;
+      continue;
+    }
+    Detection d;
+    d.landmark_id = *id;
+    d.range_m = range_m(camera, b.height);
+    d.bearing_rad = bearing_rad(camera, b.x);
+    d.range_sigma_m = camera.range_sigma_fraction * d.range_m;
+    d.bearing_sigma_rad = camera.bearing_sigma_rad;
+    d.block = b;
+
+    // One detection per landmark: keep the largest block.
+    bool keep = true;
+    for (Detection& other : out) {
+      if (other.landmark_id != d.landmark_id) continue;
+      const auto area = [](const PixyBlock& x) { return std::uint32_t{x.width} * x.height; };
+      if (area(d.block) > area(other.block)) {
+        other = d;  // replaces the smaller one in its place
+      }
+      keep = false;
+      ++counters.duplicate_landmark;
+      break;
+    }
+    if (keep) out.push_back(d);
+  }
+  counters.detections += out.size();
+  return out;
+}
+
+}  // namespace pixyslam::pixy
