@@ -10,4 +10,4 @@ shift || true
 if [[ ! -d "$dataset" ]]; then echo "eval_mrclam: $dataset not found, skipping"; exit 0; fi
 "$root/scripts/build.sh" >/dev/null
 build_dir=${BUILD_DIR:-$root/build}
-"$build_dir/apps/slam_offline/mrclam_eval" --dataset "$dataset" --config "$root/config/slam_mrclam.yaml" "$@"
+"$build_dir/bin/mrclam_eval" --dataset "$dataset" --config "$root/config/slam_mrclam.yaml" "$@"

@@ -7,6 +7,8 @@ PACKAGES=(
   cmake g++ ninja-build pkg-config
   libeigen3-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev
+  libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools default-jre-headless
+  libzstd-dev
 )
 
 missing=()

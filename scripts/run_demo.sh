@@ -6,4 +6,4 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/install_deps.sh"
 "$root/scripts/build.sh"
 build_dir=${BUILD_DIR:-$root/build}
-"$build_dir/apps/slam_offline/slam_offline" sim --config "$root/config/slam_sim.yaml" --out "$build_dir/demo"
+"$build_dir/bin/slam_offline" sim --config "$root/config/slam_sim.yaml" --out "$build_dir/demo"

@@ -69,6 +69,33 @@ YamlReader YamlReader::child(const std::string& key) {
   return YamlReader(n, origin_, key_path(key));
 }
 
+std::vector<YamlReader> YamlReader::mapping_list(const std::string& key) {
+  used_.insert(key);
+  YAML::Node n = node_[key];
+  if (!n) fail(key, "missing (a list is required)");
+  if (!n.IsSequence()) fail(key, "expected a list, got " + describe(n));
+  std::vector<YamlReader> out;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string item = key + "[" + std::to_string(i) + "]";
+    if (!n[i].IsMap()) fail(item, "expected a mapping, got " + describe(n[i]));
+    out.emplace_back(n[i], origin_, key_path(item));
+  }
+  return out;
+}
+
+std::vector<std::string> YamlReader::text_list(const std::string& key) {
+  used_.insert(key);
+  YAML::Node n = node_[key];
+  if (!n) fail(key, "missing (a list is required)");
+  if (!n.IsSequence()) fail(key, "expected a list, got " + describe(n));
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    if (!n[i].IsScalar()) fail(key + "[" + std::to_string(i) + "]", "expected a single value, got " + describe(n[i]));
+    out.push_back(n[i].Scalar());
+  }
+  return out;
+}
+
 YAML::Node YamlReader::scalar(const std::string& key) {
   used_.insert(key);
   YAML::Node n = node_[key];

@@ -37,6 +37,10 @@ class YamlReader {
   std::vector<std::string> keys() const;
   // Required sub-mapping; an absent key is an error.
   YamlReader child(const std::string& key);
+  // Required list of mappings (key path "key[i]" in errors); may be empty.
+  std::vector<YamlReader> mapping_list(const std::string& key);
+  // Required list of single values, as text.
+  std::vector<std::string> text_list(const std::string& key);
 
   double number(const std::string& key, double min, double max);
   double number(const std::string& key, double min, double max, double fallback);

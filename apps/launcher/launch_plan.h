@@ -1,0 +1,50 @@
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace pixyslam::launcher {
+
+// One process of a run: its argv (argv[0] is looked up in the launcher's own
+// folder first, then PATH), a start delay after the previous one, and whether
+// its clean exit ends the run (e.g. a simulator that drives one lap).
+struct ProcessSpec {
+  std::string name;
+  std::vector<std::string> command;
+  double delay_s = 0.0;
+  bool ends_run = false;
+};
+
+// A run as a launch file describes it (config/launch_*.yaml).
+struct LaunchPlan {
+  double duration_s = 0.0;      // stop after this long; 0 = until Ctrl-C or ends_run
+  double stop_timeout_s = 5.0;  // SIGINT, then SIGKILL after this
+  std::vector<ProcessSpec> processes;
+  std::vector<ProcessSpec> after_run;  // run one after another once all have stopped
+};
+
+// Reads the `launch:` mapping of a file. In every command word, ${name} is
+// replaced by variables[name] (unknown names are errors); the launcher defines
+// config_dir (the launch file's folder), bin_dir and run_dir. Unknown keys,
+// duplicate names and empty commands throw config::ConfigError naming the file and key.
+LaunchPlan read_launch_plan(const std::string& path, const std::map<std::string, std::string>& variables);
+
+// Replaces every ${name}; throws std::invalid_argument naming an unknown variable.
+std::string substitute(const std::string& text, const std::map<std::string, std::string>& variables);
+
+// Splits a byte stream into lines for prefixing: feed() returns the complete
+// lines (without '\n'); finish() the unterminated rest, if any. Lines longer
+// than `max_line` are cut into pieces of that size.
+class LineSplitter {
+ public:
+  explicit LineSplitter(std::size_t max_line = 4096) : max_line_(max_line) {}
+  std::vector<std::string> feed(const char* data, std::size_t size);
+  std::vector<std::string> finish();
+
+ private:
+  std::size_t max_line_;
+  std::string pending_;
+};
+
+}  // namespace pixyslam::launcher

@@ -1,0 +1,195 @@
+#include "process_group.h"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+#include <thread>
+
+namespace pixyslam::launcher {
+
+bool ExitStatus::ok() const { return exited ? code == 0 : stopped_by_us && code == SIGINT; }
+
+std::string ExitStatus::describe() const {
+  if (exited) return "exit code " + std::to_string(code);
+  return std::string("signal ") + std::to_string(code) + " (" + strsignal(code) + ")" +
+         (stopped_by_us ? ", stopped by the launcher" : "");
+}
+
+struct ProcessGroup::Child {
+  ProcessSpec spec;
+  pid_t pid = -1;
+  int output_fd = -1;  // read end of the child's stdout+stderr pipe
+  LineSplitter splitter;
+  bool running = false;
+  ExitStatus status;
+};
+
+ProcessGroup::ProcessGroup(std::string bin_dir, std::FILE* out)
+    : bin_dir_(std::move(bin_dir)), out_(out) {}
+
+ProcessGroup::~ProcessGroup() {
+  for (auto& child : children_) {
+    if (child->running) kill(-child->pid, SIGKILL);
+  }
+  for (auto& child : children_) {
+    if (child->running) waitpid(child->pid, nullptr, 0);
+    if (child->output_fd >= 0) close(child->output_fd);
+  }
+}
+
+std::string ProcessGroup::resolve(const std::string& program) const {
+  auto executable = [](const std::string& path) { return access(path.c_str(), X_OK) == 0; };
+  if (program.find('/') != std::string::npos) {
+    if (executable(program)) return program;
+    throw std::runtime_error("program '" + program + "' not found or not executable");
+  }
+  if (!bin_dir_.empty() && executable(bin_dir_ + "/" + program)) return bin_dir_ + "/" + program;
+  const char* path = std::getenv("PATH");
+  std::string dirs = path ? path : "";
+  std::size_t start = 0;
+  while (start <= dirs.size()) {
+    const std::size_t end = std::min(dirs.find(':', start), dirs.size());
+    const std::string dir = dirs.substr(start, end - start);
+    if (!dir.empty() && executable(dir + "/" + program)) return dir + "/" + program;
+    start = end + 1;
+  }
+  throw std::runtime_error("program '" + program + "' not found in " + bin_dir_ + " or PATH");
+}
+
+void ProcessGroup::start(const ProcessSpec& spec) {
+  auto child = std::make_unique<Child>();
+  child->spec = spec;
+  const std::string program = resolve(spec.command.front());
+  int fds[2];
+  if (pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+  std::vector<char*> argv;
+  for (const std::string& word : spec.command) argv.push_back(const_cast<char*>(word.c_str()));
+  argv.push_back(nullptr);
+
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
+  if (pid == 0) {
+    // Child: own process group (a terminal's Ctrl-C reaches only the launcher,
+    // which stops the children in order), output into the pipe, signals unblocked.
+    setpgid(0, 0);
+    dup2(fds[1], STDOUT_FILENO);
+    dup2(fds[1], STDERR_FILENO);
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    execv(program.c_str(), argv.data());
+    std::fprintf(stderr, "cannot execute %s: %s\n", program.c_str(), std::strerror(errno));
+    _exit(127);
+  }
+  setpgid(pid, pid);  // also here: no race with a stop right after fork
+  close(fds[1]);
+  fcntl(fds[0], F_SETFL, O_NONBLOCK);
+  child->pid = pid;
+  child->output_fd = fds[0];
+  child->running = true;
+  std::fprintf(out_, "[launch] started %s (pid %d): %s\n", spec.name.c_str(), pid, program.c_str());
+  std::fflush(out_);
+  children_.push_back(std::move(child));
+}
+
+void ProcessGroup::drain(Child& child, bool final) {
+  if (child.output_fd < 0) return;
+  char buffer[4096];
+  for (;;) {
+    const ssize_t n = read(child.output_fd, buffer, sizeof(buffer));
+    if (n > 0) {
+      for (const std::string& line : child.splitter.feed(buffer, static_cast<std::size_t>(n))) {
+        std::fprintf(out_, "[%s] %s\n", child.spec.name.c_str(), line.c_str());
+      }
+      continue;
+    }
+    if (n == 0 || (n < 0 && errno != EAGAIN && errno != EINTR) || final) {
+      if (n == 0 || final) {
+        for (const std::string& line : child.splitter.finish()) {
+          std::fprintf(out_, "[%s] %s\n", child.spec.name.c_str(), line.c_str());
+        }
+      }
+      if (n == 0) {
+        close(child.output_fd);
+        child.output_fd = -1;
+      }
+    }
+    break;
+  }
+  std::fflush(out_);
+}
+
+void ProcessGroup::reap() {
+  for (auto& child : children_) {
+    if (!child->running) continue;
+    int status = 0;
+    const pid_t r = waitpid(child->pid, &status, WNOHANG);
+    if (r != child->pid) continue;
+    child->running = false;
+    child->status.exited = WIFEXITED(status);
+    child->status.code = WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status);
+    drain(*child, true);
+  }
+}
+
+std::vector<std::size_t> ProcessGroup::poll(std::chrono::milliseconds timeout) {
+  std::vector<bool> was_running;
+  for (const auto& child : children_) was_running.push_back(child->running);
+  std::vector<pollfd> fds;
+  for (const auto& child : children_) {
+    if (child->output_fd >= 0) fds.push_back({child->output_fd, POLLIN, 0});
+  }
+  if (fds.empty()) {
+    std::this_thread::sleep_for(timeout);
+  } else {
+    ::poll(fds.data(), fds.size(), static_cast<int>(timeout.count()));
+  }
+  for (auto& child : children_) drain(*child, false);
+  reap();
+  std::vector<std::size_t> ended;
+  for (std::size_t i = 0; i < children_.size(); ++i) {
+    if (was_running[i] && !children_[i]->running) ended.push_back(i);
+  }
+  return ended;
+}
+
+void ProcessGroup::stop_all(std::chrono::milliseconds timeout) {
+  for (auto it = children_.rbegin(); it != children_.rend(); ++it) {
+    if ((*it)->running) {
+      (*it)->status.stopped_by_us = true;
+      kill(-(*it)->pid, SIGINT);
+    }
+  }
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (any_running() && std::chrono::steady_clock::now() < end) poll(std::chrono::milliseconds(50));
+  for (auto& child : children_) {
+    if (child->running) {
+      std::fprintf(out_, "[launch] %s did not stop within %.1f s: SIGKILL\n", child->spec.name.c_str(),
+                   static_cast<double>(timeout.count()) / 1000.0);
+      kill(-child->pid, SIGKILL);
+    }
+  }
+  while (any_running()) poll(std::chrono::milliseconds(50));
+}
+
+bool ProcessGroup::running(std::size_t i) const { return children_.at(i)->running; }
+
+bool ProcessGroup::any_running() const {
+  for (const auto& child : children_) {
+    if (child->running) return true;
+  }
+  return false;
+}
+
+const ProcessSpec& ProcessGroup::spec(std::size_t i) const { return children_.at(i)->spec; }
+const ExitStatus& ProcessGroup::status(std::size_t i) const { return children_.at(i)->status; }
+
+}  // namespace pixyslam::launcher

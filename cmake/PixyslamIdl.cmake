@@ -1,0 +1,45 @@
+# pixyslam_add_idl_library(TARGET IDL_DIR DIR IDL_FILES a.idl b.idl ...)
+#
+# Generates C++ types, PubSubTypes and TypeObjects with fastddsgen (-typeobject)
+# into the build tree at build time, and a static library TARGET of them linked
+# to Fast DDS. Also generates <TARGET>_idl_text.cpp: each file's IDL with its
+# includes inlined (an `omgidl` schema for MCAP), looked up by file stem.
+find_program(FASTDDSGEN_EXECUTABLE fastddsgen REQUIRED)
+
+function(pixyslam_add_idl_library target)
+  cmake_parse_arguments(ARG "" "IDL_DIR" "IDL_FILES" ${ARGN})
+  set(out_dir ${CMAKE_CURRENT_BINARY_DIR}/${target}_generated)
+  file(MAKE_DIRECTORY ${out_dir})
+  set(idl_paths "")
+  set(generated "")
+  foreach(idl ${ARG_IDL_FILES})
+    get_filename_component(stem ${idl} NAME_WE)
+    list(APPEND idl_paths ${ARG_IDL_DIR}/${idl})
+    foreach(suffix "" PubSubTypes TypeObject)
+      list(APPEND generated ${out_dir}/${stem}${suffix}.cxx ${out_dir}/${stem}${suffix}.h)
+    endforeach()
+  endforeach()
+  add_custom_command(
+    OUTPUT ${generated}
+    COMMAND ${FASTDDSGEN_EXECUTABLE} -typeobject -replace -d ${out_dir} -I ${ARG_IDL_DIR} ${idl_paths}
+    DEPENDS ${idl_paths}
+    WORKING_DIRECTORY ${out_dir}
+    COMMENT "fastddsgen: ${ARG_IDL_FILES}"
+    VERBATIM)
+
+  set(text_cpp ${out_dir}/${target}_idl_text.cpp)
+  add_custom_command(
+    OUTPUT ${text_cpp}
+    COMMAND ${CMAKE_COMMAND} -DIDL_DIR=${ARG_IDL_DIR} "-DIDL_FILES=${ARG_IDL_FILES}"
+            -DOUTPUT=${text_cpp} -P ${PROJECT_SOURCE_DIR}/cmake/embed_idl_text.cmake
+    DEPENDS ${idl_paths} ${PROJECT_SOURCE_DIR}/cmake/embed_idl_text.cmake
+    COMMENT "Embedding IDL text for ${target}"
+    VERBATIM)
+
+  list(FILTER generated INCLUDE REGEX "\\.cxx$")
+  add_library(${target} STATIC ${generated} ${text_cpp})
+  target_include_directories(${target} PUBLIC ${out_dir})
+  target_link_libraries(${target} PUBLIC fastcdr fastrtps)
+  target_compile_features(${target} PUBLIC cxx_std_17)
+  set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+endfunction()

@@ -1,0 +1,32 @@
+#pragma once
+
+#include <map>
+#include <set>
+#include <string>
+
+namespace pixyslam::app {
+
+// `--key value` flags of a process. Unknown flags, a flag without its value and
+// a repeated flag are errors (std::invalid_argument naming the flag); `--help`
+// and `-h` set help(). Thread-compatible.
+class CommandLine {
+ public:
+  CommandLine(int argc, char** argv, const std::set<std::string>& known_flags);
+
+  bool has(const std::string& flag) const { return values_.count(flag) != 0; }
+  // The value of a required flag (error naming it if absent).
+  const std::string& get(const std::string& flag) const;
+  std::string get(const std::string& flag, const std::string& fallback) const;
+  double number(const std::string& flag, double fallback) const;
+  bool help() const { return help_; }
+
+ private:
+  std::map<std::string, std::string> values_;
+  bool help_ = false;
+};
+
+// Folder of a file path ("." for a bare file name), for resolving paths that a
+// config file gives relative to itself.
+std::string folder_of(const std::string& path);
+
+}  // namespace pixyslam::app

@@ -1,0 +1,59 @@
+#include "pixyslam/app/stop_signal.h"
+
+#include <pthread.h>
+#include <signal.h>
+
+#include <atomic>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+namespace pixyslam::app {
+
+namespace {
+
+std::mutex g_mutex;
+std::condition_variable g_cv;
+std::atomic<bool> g_requested{false};
+std::atomic<int> g_signal{0};
+
+void set_requested(int signal_number) {
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    if (!g_requested) g_signal = signal_number;
+    g_requested = true;
+  }
+  g_cv.notify_all();
+}
+
+}  // namespace
+
+void StopSignal::install() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &set, nullptr);
+    std::thread([set] {
+      for (;;) {
+        int number = 0;
+        if (sigwait(&set, &number) == 0) set_requested(number);
+      }
+    }).detach();
+  });
+}
+
+bool StopSignal::requested() { return g_requested.load(); }
+
+bool StopSignal::wait_for(std::chrono::milliseconds timeout) {
+  std::unique_lock<std::mutex> lock(g_mutex);
+  return g_cv.wait_for(lock, timeout, [] { return g_requested.load(); });
+}
+
+void StopSignal::request() { set_requested(0); }
+
+int StopSignal::signal_number() { return g_signal.load(); }
+
+}  // namespace pixyslam::app

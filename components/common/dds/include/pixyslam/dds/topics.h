@@ -1,0 +1,55 @@
+#pragma once
+
+#include <string_view>
+
+#include "common.h"
+#include "ground_truth.h"
+#include "ground_truthPubSubTypes.h"
+#include "ground_truthTypeObject.h"
+#include "landmark_observation.h"
+#include "landmark_observationPubSubTypes.h"
+#include "landmark_observationTypeObject.h"
+#include "map_state.h"
+#include "map_statePubSubTypes.h"
+#include "map_stateTypeObject.h"
+#include "odometry.h"
+#include "odometryPubSubTypes.h"
+#include "odometryTypeObject.h"
+
+namespace pixyslam::msg {
+// IDL of idl/<stem>.idl with its includes inlined (an `omgidl` schema); "" if unknown.
+std::string_view idl_text(std::string_view stem);
+}  // namespace pixyslam::msg
+
+namespace pixyslam::dds {
+
+// Every topic of the system, in one place. The XML profiles (config/dds/) hold a
+// data_writer and a data_reader profile named exactly like each topic: QoS lives
+// there, not in code.
+inline constexpr std::string_view kOdometryTopic = "pixyslam/odometry";
+inline constexpr std::string_view kLandmarkObservationTopic = "pixyslam/landmark_observation";
+inline constexpr std::string_view kMapStateTopic = "pixyslam/map_state";
+inline constexpr std::string_view kGroundTruthTopic = "pixyslam/ground_truth";
+
+// Message type -> its topic, generated TopicDataType and IDL file.
+template <class Message>
+struct MessageTraits;
+
+#define PIXYSLAM_MESSAGE_TRAITS(Message, topic_name, idl_stem_name, register_fn) \
+  template <>                                                                     \
+  struct MessageTraits<msg::Message> {                                            \
+    using PubSubType = msg::Message##PubSubType;                                  \
+    static constexpr std::string_view topic = topic_name;                         \
+    static constexpr std::string_view idl_stem = idl_stem_name;                   \
+    static void register_type_object() { register_fn(); }                         \
+  };
+
+PIXYSLAM_MESSAGE_TRAITS(Odometry, kOdometryTopic, "odometry", registerodometryTypes)
+PIXYSLAM_MESSAGE_TRAITS(LandmarkObservation, kLandmarkObservationTopic, "landmark_observation",
+                        registerlandmark_observationTypes)
+PIXYSLAM_MESSAGE_TRAITS(MapState, kMapStateTopic, "map_state", registermap_stateTypes)
+PIXYSLAM_MESSAGE_TRAITS(GroundTruth, kGroundTruthTopic, "ground_truth", registerground_truthTypes)
+
+#undef PIXYSLAM_MESSAGE_TRAITS
+
+}  // namespace pixyslam::dds

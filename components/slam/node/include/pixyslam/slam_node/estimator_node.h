@@ -1,0 +1,92 @@
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <utility>
+#include <variant>
+#include <vector>
+
+// Eigen before Fast DDS: fastrtps/types/TypesBase.h declares operator== templates
+// for any enum that make Eigen's enum comparisons ambiguous if seen first.
+#include "pixyslam/slam/fastslam2.h"
+#include "pixyslam/slam/sensor_queue.h"
+#include "pixyslam/slam_node/estimator_options.h"
+#include "landmark_observation.h"
+#include "map_state.h"
+#include "odometry.h"
+#include "pixyslam/dds/endpoints.h"
+
+namespace pixyslam::slam_node {
+
+struct EstimatorCounters {
+  std::uint64_t odometry_received = 0;
+  std::uint64_t observations_received = 0;
+  std::uint64_t odometry_lost = 0;       // seq gaps seen by the readers
+  std::uint64_t observations_lost = 0;
+  std::uint64_t steps = 0;               // filter steps (= MapStates published)
+  std::uint64_t map_states_published = 0;
+  std::uint64_t samples_late = 0;
+  std::uint64_t samples_reordered = 0;
+};
+
+// The SLAM estimator process: subscribes to Odometry and LandmarkObservation,
+// feeds the FastSLAM 2.0 core in timestamp order from ONE filter thread (DDS
+// callbacks only enqueue) and publishes a MapState after every filter step.
+// The filter clock starts at the first sample's stamp. start() runs the filter
+// thread; stop() drains what is queued, publishes the last state and joins.
+// Thread-safe.
+class EstimatorNode {
+ public:
+  explicit EstimatorNode(const EstimatorOptions& options);
+  ~EstimatorNode();
+  EstimatorNode(const EstimatorNode&) = delete;
+  EstimatorNode& operator=(const EstimatorNode&) = delete;
+
+  void start();
+  void stop();
+
+  EstimatorCounters counters() const;
+  // A copy of the latest MapState (for the status line and for tests).
+  msg::MapState latest_map_state() const;
+  // The mean pose after every step (stamps in ns), for --out files.
+  std::vector<std::pair<std::uint64_t, slam::Pose2>> trajectory() const;
+
+ private:
+  using Inbox = std::variant<msg::Odometry, msg::LandmarkObservation>;
+
+  void enqueue(Inbox&& item);
+  void filter_loop();
+  void step(const slam::SensorInput& input);
+  void log_status() const;
+
+  EstimatorOptions options_;
+  std::unique_ptr<dds::Participant> participant_;
+  std::unique_ptr<dds::Writer<msg::MapState>> map_writer_;
+  std::unique_ptr<dds::Reader<msg::Odometry>> odometry_reader_;
+  std::unique_ptr<dds::Reader<msg::LandmarkObservation>> observation_reader_;
+
+  mutable std::mutex inbox_mutex_;
+  std::condition_variable inbox_cv_;
+  std::deque<Inbox> inbox_;
+  bool stopping_ = false;
+  std::thread thread_;
+
+  // Filter-thread state (read by others under state_mutex_).
+  mutable std::mutex state_mutex_;
+  slam::SensorQueue queue_;
+  std::unique_ptr<slam::FastSlam2> filter_;
+  bool has_epoch_ = false;
+  std::uint64_t epoch_ns_ = 0;
+  std::uint64_t last_odometry_seq_ = 0;
+  std::uint64_t last_observation_seq_ = 0;
+  msg::MapState map_state_;
+  std::vector<std::pair<std::uint64_t, slam::Pose2>> trajectory_;
+  EstimatorCounters counters_;
+};
+
+}  // namespace pixyslam::slam_node

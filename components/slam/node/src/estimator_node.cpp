@@ -1,0 +1,186 @@
+#include "pixyslam/slam_node/estimator_node.h"
+
+#include <chrono>
+#include <cstdio>
+
+#include "pixyslam/slam_node/map_state_conversions.h"
+
+namespace pixyslam::slam_node {
+
+EstimatorNode::EstimatorNode(const EstimatorOptions& options)
+    : options_(options), queue_(options.queue) {
+  slam::validate(options_.filter);
+  participant_ = std::make_unique<dds::Participant>(options_.dds, "slam_estimator");
+  map_writer_ = std::make_unique<dds::Writer<msg::MapState>>(*participant_);
+  odometry_reader_ = std::make_unique<dds::Reader<msg::Odometry>>(
+      *participant_, [this](const msg::Odometry& m) { enqueue(m); });
+  observation_reader_ = std::make_unique<dds::Reader<msg::LandmarkObservation>>(
+      *participant_, [this](const msg::LandmarkObservation& m) { enqueue(m); });
+}
+
+EstimatorNode::~EstimatorNode() {
+  stop();
+  // Readers first: no callback may run into a half-destroyed node.
+  odometry_reader_.reset();
+  observation_reader_.reset();
+  map_writer_.reset();
+  participant_.reset();
+}
+
+void EstimatorNode::start() {
+  std::lock_guard<std::mutex> lock(inbox_mutex_);
+  if (thread_.joinable() || stopping_) return;
+  thread_ = std::thread([this] { filter_loop(); });
+}
+
+void EstimatorNode::stop() {
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    stopping_ = true;
+  }
+  inbox_cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void EstimatorNode::enqueue(Inbox&& item) {
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    inbox_.push_back(std::move(item));
+  }
+  inbox_cv_.notify_one();
+}
+
+EstimatorCounters EstimatorNode::counters() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  EstimatorCounters c = counters_;
+  c.odometry_received = odometry_reader_->received();
+  c.observations_received = observation_reader_->received();
+  c.odometry_lost = odometry_reader_->lost();
+  c.observations_lost = observation_reader_->lost();
+  c.samples_late = queue_.counters().late;
+  c.samples_reordered = queue_.counters().reordered;
+  return c;
+}
+
+msg::MapState EstimatorNode::latest_map_state() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  return map_state_;
+}
+
+std::vector<std::pair<std::uint64_t, slam::Pose2>> EstimatorNode::trajectory() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  return trajectory_;
+}
+
+void EstimatorNode::filter_loop() {
+  using Clock = std::chrono::steady_clock;
+  auto next_status = Clock::now() + std::chrono::duration<double>(options_.status_period_s);
+  std::deque<Inbox> batch;
+  for (;;) {
+    bool stopping = false;
+    {
+      std::unique_lock<std::mutex> lock(inbox_mutex_);
+      // Wake for new input, for a held sample's release time, or periodically.
+      double wait_s = 0.1;
+      {
+        std::lock_guard<std::mutex> state_lock(state_mutex_);
+        if (has_epoch_ && queue_.size() > 0) {
+          const double now_s = static_cast<double>(static_cast<std::int64_t>(dds::now_ns() - epoch_ns_)) * 1e-9;
+          wait_s = std::clamp(queue_.next_release_s() - now_s, 0.0, 0.1);
+        }
+      }
+      inbox_cv_.wait_for(lock, std::chrono::duration<double>(wait_s),
+                         [this] { return !inbox_.empty() || stopping_; });
+      batch.swap(inbox_);
+      stopping = stopping_;
+    }
+
+    std::vector<slam::SensorInput> ready;
+    {
+      std::lock_guard<std::mutex> state_lock(state_mutex_);
+      for (const Inbox& item : batch) {
+        const std::uint64_t stamp = std::visit([](const auto& m) { return m.header().stamp_ns(); }, item);
+        if (!has_epoch_) {
+          // Whole seconds keep the epoch readable; times stay small doubles.
+          epoch_ns_ = stamp - stamp % 1000000000ull;
+          has_epoch_ = true;
+        }
+        if (const auto* odometry = std::get_if<msg::Odometry>(&item)) {
+          queue_.push(to_odometry_input(*odometry, epoch_ns_));
+        } else {
+          queue_.push(to_observation_input(std::get<msg::LandmarkObservation>(item), epoch_ns_,
+                                           options_.use_detection_sigmas));
+        }
+      }
+      batch.clear();
+      if (has_epoch_) {
+        if (stopping) {
+          ready = queue_.pop_all();
+        } else {
+          const double now_s = static_cast<double>(static_cast<std::int64_t>(dds::now_ns() - epoch_ns_)) * 1e-9;
+          ready = queue_.pop_ready(now_s);
+        }
+      }
+    }
+    for (const slam::SensorInput& input : ready) step(input);
+
+    if (options_.status_period_s > 0.0 && Clock::now() >= next_status) {
+      log_status();
+      next_status = Clock::now() + std::chrono::duration<double>(options_.status_period_s);
+    }
+    if (stopping) break;
+  }
+  log_status();
+}
+
+void EstimatorNode::step(const slam::SensorInput& input) {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  const auto begin = std::chrono::steady_clock::now();
+  if (!filter_) {
+    filter_ = std::make_unique<slam::FastSlam2>(options_.filter, options_.initial_pose);
+  }
+  if (const auto* odometry = std::get_if<slam::OdometryInput>(&input)) {
+    filter_->add_odometry(odometry->sample);
+    last_odometry_seq_ = odometry->seq;
+  } else {
+    const auto& observation = std::get<slam::ObservationInput>(input);
+    filter_->add_observations(observation.frame);
+    last_observation_seq_ = observation.seq;
+  }
+  StepInfo info;
+  info.epoch_ns = epoch_ns_;
+  info.odometry_seq = last_odometry_seq_;
+  info.observation_seq = last_observation_seq_;
+  info.samples_late = queue_.counters().late;
+  info.update_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  fill_map_state(*filter_, info, options_.published_particle_poses, options_.landmarks == "mixture",
+                 map_state_);
+  const msg::Pose2D& mean = map_state_.mean_pose();
+  trajectory_.emplace_back(map_state_.header().stamp_ns(),
+                           slam::Pose2(mean.x_m(), mean.y_m(), mean.theta_rad()));
+  ++counters_.steps;
+  if (map_writer_->publish(map_state_)) ++counters_.map_states_published;
+}
+
+void EstimatorNode::log_status() const {
+  const EstimatorCounters c = counters();
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  const slam::FilterCounters f = filter_ ? filter_->counters() : slam::FilterCounters{};
+  std::fprintf(stderr,
+               "slam_estimator: odometry %llu (lost %llu), observations %llu (lost %llu), "
+               "steps %llu, late %llu, reordered %llu; detections used %llu, new %llu, gated %llu, "
+               "invalid %llu; resamples %llu; landmarks %zu\n",
+               static_cast<unsigned long long>(c.odometry_received),
+               static_cast<unsigned long long>(c.odometry_lost),
+               static_cast<unsigned long long>(c.observations_received),
+               static_cast<unsigned long long>(c.observations_lost),
+               static_cast<unsigned long long>(c.steps), static_cast<unsigned long long>(c.samples_late),
+               static_cast<unsigned long long>(c.samples_reordered),
+               static_cast<unsigned long long>(f.observations_used),
+               static_cast<unsigned long long>(f.observations_new_landmark),
+               static_cast<unsigned long long>(f.observations_gated),
+               static_cast<unsigned long long>(f.observations_invalid),
+               static_cast<unsigned long long>(f.resamples), map_state_.landmarks().size());
+}
+
+}  // namespace pixyslam::slam_node

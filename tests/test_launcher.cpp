@@ -1,0 +1,139 @@
+// The launcher: launch-file parsing, line splitting, process supervision.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "launch_plan.h"
+#include "pixyslam/config/yaml_reader.h"
+#include "process_group.h"
+
+namespace pixyslam::launcher {
+namespace {
+
+std::string write_temp(const std::string& text) {
+  char path[] = "/tmp/pixyslam_launch_test_XXXXXX";
+  const int fd = mkstemp(path);
+  EXPECT_GE(fd, 0);
+  EXPECT_EQ(write(fd, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  close(fd);
+  return path;
+}
+
+TEST(LaunchPlan, ReadsProcessesAndSubstitutesVariables) {
+  const std::string path = write_temp(
+      "launch:\n  duration_s: 12\n  processes:\n"
+      "    - name: a\n      command: [prog, --config, '${config_dir}/a.yaml']\n"
+      "    - name: b\n      command: [other]\n      delay_s: 1.5\n      ends_run: true\n"
+      "  after_run:\n    - name: eval\n      command: [eval, '${run_dir}/log']\n");
+  const LaunchPlan plan = read_launch_plan(path, {{"config_dir", "/c"}, {"run_dir", "/r"}});
+  std::remove(path.c_str());
+  ASSERT_EQ(plan.processes.size(), 2u);
+  EXPECT_DOUBLE_EQ(plan.duration_s, 12.0);
+  EXPECT_EQ(plan.processes[0].command[2], "/c/a.yaml");
+  EXPECT_DOUBLE_EQ(plan.processes[1].delay_s, 1.5);
+  EXPECT_TRUE(plan.processes[1].ends_run);
+  ASSERT_EQ(plan.after_run.size(), 1u);
+  EXPECT_EQ(plan.after_run[0].command[1], "/r/log");
+}
+
+TEST(LaunchPlan, ErrorsNameFileAndKey) {
+  const std::string path = write_temp(
+      "launch:\n  processes:\n    - name: a\n      command: [p]\n      colour: red\n");
+  try {
+    read_launch_plan(path, {});
+    FAIL() << "expected an error";
+  } catch (const config::ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path), std::string::npos) << what;
+    EXPECT_NE(what.find("launch.processes[0].colour"), std::string::npos) << what;
+  }
+  std::remove(path.c_str());
+}
+
+TEST(LaunchPlan, UnknownVariableAndDuplicateNameAreErrors) {
+  const std::string unknown = write_temp("launch:\n  processes:\n    - name: a\n      command: ['${nope}']\n");
+  EXPECT_THROW(read_launch_plan(unknown, {}), config::ConfigError);
+  std::remove(unknown.c_str());
+  const std::string twice = write_temp(
+      "launch:\n  processes:\n    - {name: a, command: [p]}\n    - {name: a, command: [q]}\n");
+  EXPECT_THROW(read_launch_plan(twice, {}), config::ConfigError);
+  std::remove(twice.c_str());
+}
+
+TEST(LineSplitter, SplitsAtNewlinesAcrossChunksAndCutsLongLines) {
+  LineSplitter splitter(8);
+  auto lines = splitter.feed("ab\ncd", 5);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0], "ab");
+  lines = splitter.feed("e\n0123456789", 12);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0], "cde");
+  EXPECT_EQ(lines[1], "01234567");
+  lines = splitter.finish();
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0], "89");
+}
+
+std::string read_all(std::FILE* f) {
+  std::rewind(f);
+  std::string out;
+  char buffer[256];
+  std::size_t n;
+  while ((n = std::fread(buffer, 1, sizeof(buffer), f)) > 0) out.append(buffer, n);
+  return out;
+}
+
+TEST(ProcessGroup, ForwardsOutputWithPrefixAndReportsExitCodes) {
+  std::FILE* out = std::tmpfile();
+  {
+    ProcessGroup group("", out);
+    group.start({"ok", {"/bin/sh", "-c", "echo hello; echo world >&2"}, 0.0, false});
+    group.start({"bad", {"/bin/sh", "-c", "exit 3"}, 0.0, false});
+    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (group.any_running() && std::chrono::steady_clock::now() < end) {
+      group.poll(std::chrono::milliseconds(50));
+    }
+    ASSERT_FALSE(group.any_running());
+    EXPECT_TRUE(group.status(0).ok());
+    EXPECT_FALSE(group.status(1).ok());
+    EXPECT_EQ(group.status(1).code, 3);
+  }
+  const std::string text = read_all(out);
+  std::fclose(out);
+  EXPECT_NE(text.find("[ok] hello\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("[ok] world\n"), std::string::npos) << text;
+}
+
+TEST(ProcessGroup, StopAllInterruptsAndEscalatesToKill) {
+  std::FILE* out = std::tmpfile();
+  ProcessGroup group("", out);
+  group.start({"sleeper", {"/bin/sleep", "30"}, 0.0, false});
+  // Ignores SIGINT: must be killed after the timeout.
+  group.start({"stubborn", {"/bin/sh", "-c", "trap '' INT; sleep 30"}, 0.0, false});
+  group.poll(std::chrono::milliseconds(200));
+  const auto begin = std::chrono::steady_clock::now();
+  group.stop_all(std::chrono::milliseconds(500));
+  EXPECT_LT(std::chrono::steady_clock::now() - begin, std::chrono::seconds(5));
+  EXPECT_FALSE(group.any_running());
+  EXPECT_TRUE(group.status(0).ok());    // SIGINT from us
+  EXPECT_FALSE(group.status(1).ok());   // needed SIGKILL
+  std::fclose(out);
+}
+
+TEST(ProcessGroup, MissingProgramIsNamed) {
+  ProcessGroup group("/nonexistent", stdout);
+  try {
+    group.start({"x", {"no_such_program_pixyslam"}, 0.0, false});
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_program_pixyslam"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace pixyslam::launcher
