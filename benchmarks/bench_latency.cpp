@@ -1,0 +1,157 @@
+// End-to-end latency on loopback: Odometry published by this process -> the
+// MapState that includes it, from a separate slam_estimator process.
+//   bench_latency [--config config/slam_estimator.yaml] [--duration S] 
+// Streams the simulated world in real time at the paper's rates (odometry 10 Hz,
+// stamped at the start of its period and sent at its end, as the encoder bridge
+// does; camera frames 10 Hz) and prints p50/p90/p99/max of the latency.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "pixyslam/sim/sim_world.h"
+#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/stop_signal.h"
+#include "pixyslam/dds/endpoints.h"
+#include "process_group.h"
+
+namespace pixyslam::bench {
+namespace {
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const std::size_t i = std::min(values.size() - 1, static_cast<std::size_t>(p * static_cast<double>(values.size())));
+  return values[i];
+}
+
+std::string own_folder() {
+  return std::filesystem::read_symlink("/proc/self/exe").parent_path().string();
+}
+
+}  // namespace
+
+int run(int argc, char** argv) {
+  const std::string source_config = std::string(PIXYSLAM_CONFIG_DIR) + "/slam_estimator.yaml";
+  const app::CommandLine args(argc, argv, {"config", "duration"});
+  const std::string config = args.get("config", source_config);
+  const double duration_s = args.number("duration", 60.0);
+
+  // The estimator as its own process, its output forwarded with a prefix.
+  launcher::ProcessGroup estimator(own_folder(), stdout);
+  std::vector<std::string> command{"slam_estimator", "--config", config};
+  estimator.start({"slam_estimator", command, 0.0, false});
+
+  dds::DdsOptions dds_options;
+  dds_options.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml";
+  dds::Participant participant(dds_options, "bench_latency");
+  dds::Writer<msg::Odometry> odometry_writer(participant);
+  dds::Writer<msg::LandmarkObservation> observation_writer(participant);
+
+  std::mutex mutex;
+  std::map<std::uint64_t, std::uint64_t> published_ns;  // odometry seq -> publish time
+  std::vector<double> latencies_ms;
+  std::vector<double> update_ms;
+  std::uint64_t last_seen = 0;
+  dds::Reader<msg::MapState> map_reader(participant, [&](const msg::MapState& m) {
+    const std::uint64_t now = dds::now_ns();
+    std::lock_guard<std::mutex> lock(mutex);
+    update_ms.push_back(m.update_time_s() * 1e3);
+    const std::uint64_t seq = m.odometry_sequence();
+    if (seq == 0 || seq == last_seen) return;
+    last_seen = seq;
+    auto it = published_ns.find(seq);
+    if (it != published_ns.end()) latencies_ms.push_back(static_cast<double>(now - it->second) * 1e-6);
+  });
+  if (!odometry_writer.wait_for_readers(1, std::chrono::seconds(20)) ||
+      !observation_writer.wait_for_readers(1, std::chrono::seconds(20))) {
+    std::fprintf(stderr, "bench_latency: the estimator did not appear on DDS\n");
+    return 1;
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+
+  sim::WorldOptions world;
+  world.duration_s = duration_s;
+  world.camera_rate_hz = 10.0;
+  world.max_range_m = 4.0;
+  const sim::WorldRun run = sim::simulate(world);
+  const double period = 1.0 / world.odometry_rate_hz;
+
+  // Events in wall-time order: a frame is sent at its stamp, odometry at its period's end.
+  struct Event {
+    double send_s;
+    bool odometry;
+    std::size_t index;
+  };
+  std::vector<Event> events;
+  for (std::size_t i = 0; i < run.odometry.size(); ++i) events.push_back({run.odometry[i].t_s + period, true, i});
+  for (std::size_t i = 0; i < run.frames.size(); ++i) events.push_back({run.frames[i].t_s, false, i});
+  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) { return a.send_s < b.send_s; });
+
+  const auto start = std::chrono::steady_clock::now();
+  const std::uint64_t base_ns = dds::now_ns();
+  auto to_ns = [&](double t_s) { return base_ns + static_cast<std::uint64_t>(t_s * 1e9); };
+  for (const Event& e : events) {
+    if (app::StopSignal::requested()) break;
+    std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                              std::chrono::duration<double>(e.send_s)));
+    if (e.odometry) {
+      const slam::OdometrySample& s = run.odometry[e.index];
+      msg::Odometry m;
+      m.header().stamp_ns(to_ns(s.t_s));
+      m.header().frame_id("base_link");
+      m.v_mps(s.v_mps);
+      m.w_radps(s.w_radps);
+      m.period_s(period);
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        published_ns[odometry_writer.published() + 1] = dds::now_ns();
+      }
+      odometry_writer.publish(m);
+    } else {
+      const slam::ObservationFrame& f = run.frames[e.index];
+      msg::LandmarkObservation m;
+      m.header().stamp_ns(to_ns(f.t_s));
+      m.header().frame_id("camera");
+      for (const slam::RangeBearing& rb : f.detections) {
+        msg::LandmarkDetection d;
+        d.landmark_id(rb.landmark_id);
+        d.range_m(rb.range_m);
+        d.bearing_rad(rb.bearing_rad);
+        d.range_sigma_m(0.07);
+        d.bearing_sigma_rad(0.027);
+        m.detections().push_back(d);
+      }
+      observation_writer.publish(m);
+    }
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  estimator.stop_all(std::chrono::seconds(5));
+
+  std::lock_guard<std::mutex> lock(mutex);
+  std::printf("bench_latency: %zu odometry samples, %zu with a MapState (%.1f s, 100 particles unless configured)\n",
+              run.odometry.size(), latencies_ms.size(), duration_s);
+  std::printf("  Odometry publish -> MapState received [ms]: p50 %.3f  p90 %.3f  p99 %.3f  max %.3f\n",
+              percentile(latencies_ms, 0.5), percentile(latencies_ms, 0.9), percentile(latencies_ms, 0.99),
+              percentile(latencies_ms, 1.0));
+  std::printf("  filter step time in the estimator [ms]:   p50 %.3f  p99 %.3f\n", percentile(update_ms, 0.5),
+              percentile(update_ms, 0.99));
+  return latencies_ms.size() + 5 >= run.odometry.size() ? 0 : 1;
+}
+
+}  // namespace pixyslam::bench
+
+int main(int argc, char** argv) {
+  pixyslam::app::StopSignal::install();
+  try {
+    return pixyslam::bench::run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_latency: %s\n", e.what());
+    return 1;
+  }
+}
