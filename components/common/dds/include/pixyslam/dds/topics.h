@@ -5,16 +5,21 @@
 #include "common.h"
 #include "ground_truth.h"
 #include "ground_truthPubSubTypes.h"
-#include "ground_truthTypeObject.h"
 #include "landmark_observation.h"
 #include "landmark_observationPubSubTypes.h"
-#include "landmark_observationTypeObject.h"
 #include "map_state.h"
 #include "map_statePubSubTypes.h"
-#include "map_stateTypeObject.h"
 #include "odometry.h"
 #include "odometryPubSubTypes.h"
-#include "odometryTypeObject.h"
+
+// The generated TypeObject registration functions (declared here rather than
+// by including the generated *TypeObject.h headers: those put
+// `using namespace eprosima::fastrtps::types;` at global scope, whose
+// operator== templates then clash with Eigen's enum comparisons).
+void registerodometryTypes();
+void registerlandmark_observationTypes();
+void registermap_stateTypes();
+void registerground_truthTypes();
 
 namespace pixyslam::msg {
 // IDL of idl/<stem>.idl with its includes inlined (an `omgidl` schema); "" if unknown.

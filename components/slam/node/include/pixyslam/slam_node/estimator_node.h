@@ -11,15 +11,13 @@
 #include <variant>
 #include <vector>
 
-// Eigen before Fast DDS: fastrtps/types/TypesBase.h declares operator== templates
-// for any enum that make Eigen's enum comparisons ambiguous if seen first.
-#include "pixyslam/slam/fastslam2.h"
-#include "pixyslam/slam/sensor_queue.h"
-#include "pixyslam/slam_node/estimator_options.h"
 #include "landmark_observation.h"
 #include "map_state.h"
 #include "odometry.h"
 #include "pixyslam/dds/endpoints.h"
+#include "pixyslam/slam/fastslam2.h"
+#include "pixyslam/slam/sensor_queue.h"
+#include "pixyslam/slam_node/estimator_options.h"
 
 namespace pixyslam::slam_node {
 
