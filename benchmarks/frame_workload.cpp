@@ -1,5 +1,5 @@
 // Fixed frame workload for instruction counting:
-//   valgrind --tool=callgrind --toggle-collect='pixyslam::bench::FrameWorkload::step()' \
+//   valgrind --tool=callgrind --toggle-collect='pixyslam::bench::FrameWorkload::step()'
 //     build/benchmarks/frame_workload M K FRAMES
 // Instructions per frame = Ir of the collected part / FRAMES.
 #include <cstdio>

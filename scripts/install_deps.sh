@@ -8,7 +8,7 @@ PACKAGES=(
   libeigen3-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools default-jre-headless
-  libzstd-dev
+  libzstd-dev liblz4-dev
 )
 
 missing=()

@@ -1,6 +1,9 @@
 #include "pixyslam/dds/participant.h"
 
+#include "pixyslam/dds/topics.h"
+
 #include <chrono>
+#include <mutex>
 #include <stdexcept>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -29,7 +32,25 @@ DdsOptions read_dds_options(config::YamlReader& reader, const std::string& confi
   return o;
 }
 
+namespace {
+
+// Every type of the system is known to the TypeObject factory before any
+// participant exists: Fast DDS 2.9 crashes in discovery when it meets a remote
+// endpoint of an unregistered type holding a sequence of structs.
+void register_all_type_objects() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    MessageTraits<msg::Odometry>::register_type_object();
+    MessageTraits<msg::LandmarkObservation>::register_type_object();
+    MessageTraits<msg::MapState>::register_type_object();
+    MessageTraits<msg::GroundTruth>::register_type_object();
+  });
+}
+
+}  // namespace
+
 Participant::Participant(const DdsOptions& options, const std::string& name) : options_(options) {
+  register_all_type_objects();
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   if (!options.profiles_file.empty() &&
       factory->load_XML_profiles_file(options.profiles_file) != ReturnCode_t::RETCODE_OK) {

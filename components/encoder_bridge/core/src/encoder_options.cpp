@@ -113,6 +113,10 @@ EncoderOptions read_encoder_options_file(const std::string& path) {
   config::YamlReader root = config::YamlReader::from_file(path);
   config::YamlReader bridge = root.child("encoder_bridge");
   EncoderOptions o = read_encoder_options(bridge);
+  // The process's own mappings, read by the encoder node (encoder_node_options.h).
+  for (const char* process_key : {"node", "dds"}) {
+    if (root.has(process_key)) root.child(process_key);
+  }
   root.finish();
   return o;
 }

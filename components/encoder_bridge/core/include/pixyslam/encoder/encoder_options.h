@@ -38,7 +38,9 @@ void validate(const EncoderOptions& options);
 // is required. Throws config::ConfigError naming the file and the key path.
 EncoderOptions read_encoder_options(config::YamlReader& reader);
 
-// Reads the `encoder_bridge` mapping of a file; any other top-level key is an error.
+// Reads the `encoder_bridge` mapping of a file. The process's `node` and `dds`
+// mappings may be there too (not read here: the encoder node reads the whole
+// file); any other top-level key is an error.
 EncoderOptions read_encoder_options_file(const std::string& path);
 
 // The options as YAML text in the layout read_encoder_options() expects, under

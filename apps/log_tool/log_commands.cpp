@@ -1,0 +1,211 @@
+#include "log_commands.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <iomanip>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include "pixyslam/log_tool/sequence_check.h"
+#include "pixyslam/logger/mcap_reader.h"
+#include "pixyslam/logger_node/cdr_payload.h"
+
+namespace pixyslam::log_tool {
+
+namespace {
+
+const char* yes_no(bool b) { return b ? "yes" : "no"; }
+
+std::string compression_name(const std::string& c) { return c.empty() ? "none" : c; }
+
+// "12.345 s" from nanoseconds.
+std::string seconds(std::uint64_t ns) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(3) << static_cast<double>(ns) * 1e-9 << " s";
+  return os.str();
+}
+
+std::string status_text(const logger::McapReader& reader) {
+  const logger::McapRecovery& r = reader.recovery();
+  if (reader.clean()) return "complete (summary and footer present, no problems)";
+  std::string s = r.footer_present ? "complete but with problems" : "RECOVERED (no footer: the writer did not close it)";
+  return s;
+}
+
+}  // namespace
+
+int run_info(const std::string& path, std::ostream& out) {
+  const logger::McapReader reader(path);
+  const logger::McapRecovery& rec = reader.recovery();
+  const auto& messages = reader.messages();
+
+  out << "file:        " << path << "\n";
+  out << "size:        " << rec.file_size << " bytes\n";
+  out << "status:      " << status_text(reader) << "\n";
+  out << "summary:     " << yes_no(rec.summary_present) << ", footer: " << yes_no(rec.footer_present) << "\n";
+  out << "header:      profile '" << reader.profile() << "', library '" << reader.library() << "'\n";
+
+  std::uint64_t first = std::numeric_limits<std::uint64_t>::max();
+  std::uint64_t last = 0;
+  std::map<std::uint16_t, std::uint64_t> per_channel;
+  for (const logger::McapMessage& m : messages) {
+    first = std::min(first, m.log_time_ns);
+    last = std::max(last, m.log_time_ns);
+    ++per_channel[m.channel_id];
+  }
+  out << "messages:    " << messages.size();
+  if (!messages.empty()) out << " over " << seconds(last - first) << " (log time " << first << " .. " << last << " ns)";
+  out << "\n";
+
+  std::map<std::string, std::uint64_t> by_compression;
+  std::uint64_t compressed = 0;
+  std::uint64_t uncompressed = 0;
+  for (const logger::McapChunkInfo& c : reader.chunks()) {
+    ++by_compression[compression_name(c.compression)];
+    compressed += c.compressed_size;
+    uncompressed += c.uncompressed_size;
+  }
+  out << "chunks:      " << reader.chunks().size();
+  if (!reader.chunks().empty()) {
+    out << " (";
+    bool first_entry = true;
+    for (const auto& [name, count] : by_compression) {
+      out << (first_entry ? "" : ", ") << name << ": " << count;
+      first_entry = false;
+    }
+    out << "), " << compressed << " bytes stored for " << uncompressed << " uncompressed";
+  }
+  out << "\n";
+
+  out << "schemas:     " << reader.schemas().size() << "\n";
+  for (const logger::McapSchema& s : reader.schemas()) {
+    out << "  " << s.id << "  " << s.name << "  (" << s.encoding << ", " << s.data.size() << " bytes)\n";
+  }
+  out << "topics:      " << reader.channels().size() << "\n";
+  for (const logger::McapChannel& c : reader.channels()) {
+    const logger::McapSchema* schema = reader.find_schema(c.schema_id);
+    out << "  " << std::left << std::setw(32) << c.topic << std::right << std::setw(8) << per_channel[c.id]
+        << " messages  " << (schema ? schema->name : std::string("(no schema)")) << "  " << c.message_encoding;
+    for (const auto& [key, value] : c.metadata) out << "  " << key << "=" << value;
+    out << "\n";
+  }
+
+  if (!reader.clean()) {
+    out << "recovery:\n"
+        << "  header present " << yes_no(rec.header_present) << ", data end " << yes_no(rec.data_end_present)
+        << ", summary " << yes_no(rec.summary_present) << ", footer " << yes_no(rec.footer_present) << "\n"
+        << "  chunks complete " << rec.complete_chunks << ", rejected " << rec.rejected_chunks
+        << "; messages recovered " << rec.messages_recovered << "\n"
+        << "  valid bytes " << rec.valid_bytes << " of " << rec.file_size << ", ignored at end "
+        << rec.bytes_ignored_at_end << "\n";
+    out << "diagnostics: " << reader.diagnostics().size() << "\n";
+    for (const logger::McapDiagnostic& d : reader.diagnostics()) {
+      out << "  offset " << d.offset << ": " << d.message << "\n";
+    }
+  }
+  return 0;
+}
+
+namespace {
+
+// What one topic (channel) of a file holds.
+struct TopicCheck {
+  const logger::McapChannel* channel = nullptr;
+  std::string type_name;
+  std::uint64_t messages = 0;
+  std::uint64_t undecodable = 0;
+  std::string first_error;
+  std::uint64_t sequence_mismatches = 0;      // MCAP sequence != header seq (low 32 bits)
+  std::uint64_t publish_time_mismatches = 0;  // MCAP publish_time != header stamp_ns
+  std::map<std::string, std::vector<std::uint64_t>> seqs_by_robot;
+};
+
+}  // namespace
+
+int run_check(const CheckRequest& request, std::ostream& out) {
+  const logger::McapReader reader(request.path);
+  bool ok = true;
+
+  if (reader.clean()) {
+    out << "OK   file: complete, " << reader.messages().size() << " messages\n";
+  } else {
+    const bool pass = request.allow_recovered;
+    ok = ok && pass;
+    out << (pass ? "OK   " : "FAIL ") << "file: " << status_text(reader) << ", " << reader.diagnostics().size()
+        << " diagnostics, " << reader.recovery().bytes_ignored_at_end << " bytes ignored at end"
+        << (pass ? " (allowed)" : " (--allow-recovered to check it anyway)") << "\n";
+  }
+
+  std::map<std::uint16_t, TopicCheck> topics;
+  for (const logger::McapChannel& c : reader.channels()) {
+    TopicCheck& t = topics[c.id];
+    t.channel = &c;
+    const logger::McapSchema* schema = reader.find_schema(c.schema_id);
+    t.type_name = schema ? schema->name : "";
+  }
+  for (const logger::McapMessage& m : reader.messages()) {
+    auto it = topics.find(m.channel_id);
+    if (it == topics.end()) continue;  // the reader reports messages of unknown channels
+    TopicCheck& t = it->second;
+    ++t.messages;
+    logger_node::SampleHeader header;
+    std::string error;
+    if (t.channel->message_encoding != "cdr") {
+      error = "message encoding '" + t.channel->message_encoding + "' is not cdr";
+    } else if (logger_node::decode_header(t.type_name, m.data.data(), m.data.size(), header, error)) {
+      t.seqs_by_robot[header.robot_id].push_back(header.seq);
+      if (m.sequence != static_cast<std::uint32_t>(header.seq)) ++t.sequence_mismatches;
+      if (m.publish_time_ns != header.stamp_ns) ++t.publish_time_mismatches;
+      continue;
+    }
+    if (t.undecodable++ == 0) t.first_error = error;
+  }
+
+  std::set<std::string> seen_topics;
+  for (const auto& [id, t] : topics) {
+    const std::string& topic = t.channel->topic;
+    seen_topics.insert(topic);
+    std::vector<std::string> problems;
+    if (t.undecodable > 0) {
+      problems.push_back(std::to_string(t.undecodable) + " not decodable as '" + t.type_name +
+                         "' (first: " + t.first_error + ")");
+    }
+    if (t.sequence_mismatches > 0) {
+      problems.push_back(std::to_string(t.sequence_mismatches) + " with MCAP sequence != header.seq");
+    }
+    if (t.publish_time_mismatches > 0) {
+      problems.push_back(std::to_string(t.publish_time_mismatches) + " with publish_time != header.stamp_ns");
+    }
+    const auto expected = request.expected.find(topic);
+    if (expected != request.expected.end() && expected->second != t.messages) {
+      problems.push_back("expected " + std::to_string(expected->second) + " messages");
+    }
+    std::vector<std::string> sequences;
+    for (const auto& [robot, seqs] : t.seqs_by_robot) {
+      const SequenceReport report = analyze_sequence(seqs);
+      std::string line = describe(report);
+      if (t.seqs_by_robot.size() > 1) line = robot + ": " + line;
+      if (!report.complete()) problems.push_back("seq not exactly 1..N");
+      sequences.push_back(line);
+    }
+    const bool topic_ok = problems.empty();
+    ok = ok && topic_ok;
+    out << (topic_ok ? "OK   " : "FAIL ") << topic << ": " << t.messages << " messages";
+    for (const std::string& s : sequences) out << ", " << s;
+    if (t.seqs_by_robot.size() == 1) out << " (robot " << t.seqs_by_robot.begin()->first << ")";
+    for (const std::string& p : problems) out << "; " << p;
+    out << "\n";
+  }
+  for (const auto& [topic, count] : request.expected) {
+    if (seen_topics.count(topic)) continue;
+    ok = ok && count == 0;
+    out << (count == 0 ? "OK   " : "FAIL ") << topic << ": no such topic in the file (expected " << count
+        << " messages)\n";
+  }
+  out << (ok ? "check passed" : "check FAILED") << "\n";
+  return ok ? 0 : 1;
+}
+
+}  // namespace pixyslam::log_tool

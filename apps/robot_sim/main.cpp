@@ -1,0 +1,45 @@
+// robot_sim: the simulated robot's hardware. Writes Arduino encoder lines and
+// Pixy UART bytes into two pseudo-terminals and publishes GroundTruth.
+//   robot_sim --config config/robot_sim.yaml [--pixy-config config/pixy_bridge.yaml]
+//             [--encoder-config config/encoder_bridge.yaml] [--duration S]
+//             [--arduino-link PATH] [--pixy-link PATH]
+// The bridge configs default to the files beside --config. Exits 0 when the
+// run's duration is over (or on SIGINT/SIGTERM).
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/stop_signal.h"
+#include "pixyslam/config/yaml_reader.h"
+#include "robot_sim_node.h"
+
+int main(int argc, char** argv) {
+  using namespace pixyslam;
+  app::StopSignal::install();
+  try {
+    const app::CommandLine args(argc, argv, {"config", "pixy-config", "encoder-config", "duration", "arduino-link", "pixy-link"});
+    if (args.help()) {
+      std::puts("usage: robot_sim --config FILE [--pixy-config FILE] [--encoder-config FILE] [--duration S]\n"
+                "                 [--arduino-link PATH] [--pixy-link PATH]");
+      return 0;
+    }
+    const std::string config = args.get("config");
+    const std::string folder = app::folder_of(config);
+    robot_sim::RobotSimProcessConfig c = robot_sim::read_robot_sim_process_config(
+        config, args.get("pixy-config", folder + "/pixy_bridge.yaml"),
+        args.get("encoder-config", folder + "/encoder_bridge.yaml"));
+    c.run.duration_s = args.number("duration", c.run.duration_s);
+    c.run.arduino_link = args.get("arduino-link", c.run.arduino_link);
+    c.run.pixy_link = args.get("pixy-link", c.run.pixy_link);
+    robot_sim::RobotSimNode node(c);
+    node.run();
+    return 0;
+  } catch (const config::ConfigError& e) {
+    std::fprintf(stderr, "robot_sim: config error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "robot_sim: %s\n", e.what());
+    return 1;
+  }
+}

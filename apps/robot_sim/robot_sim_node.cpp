@@ -1,0 +1,154 @@
+#include "robot_sim_node.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+
+#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/stop_signal.h"
+#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/dds/endpoints.h"
+#include "pixyslam/serial/pseudo_terminal.h"
+
+namespace pixyslam::robot_sim {
+
+RobotSimProcessConfig read_robot_sim_process_config(const std::string& sim_yaml,
+                                                    const std::string& pixy_yaml,
+                                                    const std::string& encoder_yaml) {
+  RobotSimProcessConfig c;
+  config::YamlReader root = config::YamlReader::from_file(sim_yaml);
+  c.sim = read_robot_sim_config(root, pixy_yaml, encoder_yaml);
+  config::YamlReader run = root.child("run");
+  RunOptions& r = c.run;
+  r.duration_s = run.number("duration_s", 0.0, 1e6, r.duration_s);
+  r.power_on_delay_s = run.number("power_on_delay_s", 0.0, 60.0, r.power_on_delay_s);
+  r.arduino_link = run.text("arduino_link", r.arduino_link);
+  r.pixy_link = run.text("pixy_link", r.pixy_link);
+  if (r.arduino_link.empty() || r.arduino_link == r.pixy_link) {
+    run.fail("arduino_link", "must be a path different from pixy_link");
+  }
+  r.ground_truth_rate_hz = run.number("ground_truth_rate_hz", 0.1, 1000.0, r.ground_truth_rate_hz);
+  r.tick_s = run.number("tick_s", 0.0005, 0.1, r.tick_s);
+  r.speed_factor = run.number("speed_factor", 0.1, 10.0, r.speed_factor);
+  run.finish();
+  if (root.has("dds")) {
+    config::YamlReader dds = root.child("dds");
+    c.dds = dds::read_dds_options(dds, app::folder_of(sim_yaml));
+  }
+  root.finish();
+  return c;
+}
+
+struct RobotSimNode::Impl {
+  explicit Impl(const RobotSimProcessConfig& c)
+      : config(c),
+        emulator(make_hardware_emulator(c.sim)),
+        participant(c.dds, "robot_sim"),
+        truth_writer(participant) {
+    for (const std::string& link : {c.run.arduino_link, c.run.pixy_link}) {
+      const auto folder = std::filesystem::path(link).parent_path();
+      if (!folder.empty()) std::filesystem::create_directories(folder);
+    }
+    arduino = std::make_unique<serial::PseudoTerminal>(c.run.arduino_link);
+    pixy = std::make_unique<serial::PseudoTerminal>(c.run.pixy_link);
+    for (const sim::Pole& pole : emulator.poles()) {
+      if (!emulator.signature_of(pole.id)) continue;  // invisible: not part of the map
+      msg::TrueLandmark l;
+      l.landmark_id(pole.id);
+      l.x_m(pole.x_m);
+      l.y_m(pole.y_m);
+      landmarks.push_back(l);
+    }
+  }
+
+  void publish_truth(const eval::TimedPose& pose) {
+    msg::GroundTruth m;
+    m.header().stamp_ns(power_on_ns + static_cast<std::uint64_t>(std::llround(pose.t_s * 1e9)));
+    m.header().frame_id("map");
+    m.pose().x_m(pose.x_m);
+    m.pose().y_m(pose.y_m);
+    m.pose().theta_rad(pose.theta_rad);
+    const sim::PathCommand command = emulator.path().command_at(pose.t_s);
+    m.v_mps(command.v_mps);
+    m.w_radps(command.w_radps);
+    m.landmarks(landmarks);
+    truth_writer.publish(m);
+  }
+
+  RobotSimProcessConfig config;
+  HardwareEmulator emulator;
+  dds::Participant participant;
+  dds::Writer<msg::GroundTruth> truth_writer;
+  std::unique_ptr<serial::PseudoTerminal> arduino;
+  std::unique_ptr<serial::PseudoTerminal> pixy;
+  std::vector<msg::TrueLandmark> landmarks;
+  std::uint64_t power_on_ns = 0;
+};
+
+RobotSimNode::RobotSimNode(const RobotSimProcessConfig& config) : impl_(std::make_unique<Impl>(config)) {}
+
+RobotSimNode::~RobotSimNode() = default;
+
+double RobotSimNode::run() {
+  Impl& s = *impl_;
+  const RunOptions& run = s.config.run;
+  std::fprintf(stderr, "robot_sim: Arduino on %s (%s), Pixy on %s (%s); %zu visible poles; power on in %.1f s\n",
+               s.arduino->device_path().c_str(), s.arduino->slave_path().c_str(),
+               s.pixy->device_path().c_str(), s.pixy->slave_path().c_str(), s.landmarks.size(),
+               run.power_on_delay_s);
+  if (app::StopSignal::wait_for(std::chrono::milliseconds(static_cast<long>(run.power_on_delay_s * 1000)))) {
+    return 0.0;
+  }
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  s.power_on_ns = dds::now_ns();
+  const double truth_period = 1.0 / run.ground_truth_rate_hz;
+  double next_truth_s = 0.0;
+  double t = 0.0;
+  double next_status_s = 10.0;
+  const auto tick = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(run.tick_s));
+  auto wake = start;
+  while (!app::StopSignal::requested()) {
+    t = std::chrono::duration<double>(Clock::now() - start).count() * run.speed_factor;
+    if (run.duration_s > 0.0 && t > run.duration_s) t = run.duration_s;
+    const HardwareOutput out = s.emulator.advance_to(t);
+    if (!out.arduino_bytes.empty()) s.arduino->write_all(out.arduino_bytes);
+    if (!out.pixy_bytes.empty()) s.pixy->write_all(out.pixy_bytes);
+    for (const eval::TimedPose& pose : out.truth) {
+      if (pose.t_s + 1e-9 < next_truth_s) continue;
+      s.publish_truth(pose);
+      next_truth_s += truth_period;
+    }
+    if (t >= next_status_s) {
+      const HardwareCounters& c = s.emulator.counters();
+      std::fprintf(stderr, "robot_sim: t %.0f s, %llu Arduino lines, %llu Pixy frames sent, %llu blocks\n", t,
+                   static_cast<unsigned long long>(c.arduino_lines),
+                   static_cast<unsigned long long>(c.pixy_frames_sent),
+                   static_cast<unsigned long long>(c.blocks_sent));
+      next_status_s += 10.0;
+    }
+    if (run.duration_s > 0.0 && t >= run.duration_s) break;
+    wake += tick;
+    std::this_thread::sleep_until(wake);
+  }
+  // Give readers a moment to take the last ground truth.
+  s.truth_writer.wait_for_acknowledgments(std::chrono::milliseconds(500));
+  const HardwareCounters& c = s.emulator.counters();
+  std::fprintf(stderr,
+               "robot_sim: done at t %.1f s: %llu Arduino lines, %llu Pixy frames (%llu sent), %llu blocks "
+               "(%llu clipped); poles behind %llu, out of range %llu, outside image %llu, too small %llu; "
+               "%llu ground truth messages; pty bytes dropped %llu / %llu\n",
+               t, static_cast<unsigned long long>(c.arduino_lines), static_cast<unsigned long long>(c.pixy_frames),
+               static_cast<unsigned long long>(c.pixy_frames_sent), static_cast<unsigned long long>(c.blocks_sent),
+               static_cast<unsigned long long>(c.blocks_clipped), static_cast<unsigned long long>(c.behind_camera),
+               static_cast<unsigned long long>(c.out_of_range), static_cast<unsigned long long>(c.outside_image),
+               static_cast<unsigned long long>(c.too_small),
+               static_cast<unsigned long long>(s.truth_writer.published()),
+               static_cast<unsigned long long>(s.arduino->counters().dropped_bytes),
+               static_cast<unsigned long long>(s.pixy->counters().dropped_bytes));
+  return t;
+}
+
+}  // namespace pixyslam::robot_sim

@@ -1,0 +1,52 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "pixyslam/dds/participant.h"
+#include "pixyslam/robot_sim/robot_sim_config.h"
+
+namespace pixyslam::robot_sim {
+
+// How the simulator process runs (`run:` of config/robot_sim.yaml).
+struct RunOptions {
+  double duration_s = 90.0;          // hardware time simulated; 0 = until stopped
+  double power_on_delay_s = 2.0;     // pseudo-terminals up, hardware silent (bridges open them)
+  std::string arduino_link = "/tmp/pixyslam/arduino";  // symlinks to the pty slaves
+  std::string pixy_link = "/tmp/pixyslam/pixy";
+  double ground_truth_rate_hz = 10.0;
+  double tick_s = 0.002;             // wall-clock step of the emulation loop
+  double speed_factor = 1.0;         // hardware seconds per wall second
+};
+
+struct RobotSimProcessConfig {
+  RobotSimConfig sim;
+  RunOptions run;
+  dds::DdsOptions dds;
+};
+
+// Reads `world:`, `hardware:`, `run:` and `dds:` of the simulator's file and the
+// camera / wheel settings of the bridges' files. Throws config::ConfigError.
+RobotSimProcessConfig read_robot_sim_process_config(const std::string& sim_yaml,
+                                                    const std::string& pixy_yaml,
+                                                    const std::string& encoder_yaml);
+
+// The simulator process: runs the HardwareEmulator in real time, writes the
+// Arduino's lines and the Pixy's UART bytes into two pseudo-terminals (the
+// bridges open their symlinks as serial devices) and publishes GroundTruth
+// (true pose, true landmarks) stamped on the host clock. run() returns when
+// the duration is over or a stop is requested (StopSignal).
+class RobotSimNode {
+ public:
+  explicit RobotSimNode(const RobotSimProcessConfig& config);
+  ~RobotSimNode();
+  // Returns the hardware time reached.
+  double run();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace pixyslam::robot_sim

@@ -1,0 +1,101 @@
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "pixyslam/bridge/byte_source.h"
+
+namespace pixyslam::bridge {
+
+// A log line sink (one line, no trailing newline). Called from any thread.
+using LogFunction = std::function<void(const std::string& line)>;
+// The host clock in ns that stamps received bytes (dds::now_ns in the bridges;
+// tests drive their own).
+using ClockFunction = std::function<std::uint64_t()>;
+
+// Writes "<process>: <line>\n" to stderr (one fprintf per line, so lines of
+// several threads do not interleave).
+LogFunction stderr_log(const std::string& process);
+
+struct DeviceReaderOptions {
+  std::chrono::milliseconds reopen_period{1000};  // between open attempts after a failure or hang-up
+  std::chrono::milliseconds poll_period{50};      // read timeout: on_poll runs at least this often
+  std::chrono::seconds repeat_error_log{60};      // a persisting open failure is logged again after this
+  std::size_t buffer_bytes = 1024;                // most bytes handed over per on_bytes call
+};
+
+// Running totals of a DeviceReader.
+struct DeviceCounters {
+  std::uint64_t opens = 0;          // successful opens (the first and every reopen)
+  std::uint64_t open_failures = 0;  // failed open attempts
+  std::uint64_t hangups = 0;        // the device went away while open
+  std::uint64_t read_errors = 0;    // reads that threw (the device is closed and reopened)
+  std::uint64_t handler_errors = 0;  // exceptions thrown by a handler (logged, then ignored)
+  std::uint64_t reads = 0;          // reads that returned data
+  std::uint64_t bytes = 0;          // bytes read
+};
+
+// Owns the thread that reads a bridge's device: keeps the ByteSource open,
+// hands every chunk read to on_bytes with the host time it was read at, and
+// calls on_poll at least every poll_period (also while the device is missing),
+// so the node can flush by time and log its status. When the device cannot be
+// opened, hangs up or fails a read, the reader logs it (naming the device) and
+// tries to open it again every reopen_period, forever: it never gives up and
+// never throws out of its thread. A handler that throws is logged and counted.
+// Handlers run on the reader thread only, one at a time. start() and stop()
+// are not thread-safe against each other; counters() is thread-safe.
+class DeviceReader {
+ public:
+  struct Handlers {
+    std::function<void()> on_open;  // after every successful open
+    std::function<void(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns)> on_bytes;
+    std::function<void(std::uint64_t now_ns)> on_poll;
+  };
+
+  DeviceReader(std::unique_ptr<ByteSource> source, const DeviceReaderOptions& options, LogFunction log,
+               ClockFunction clock);
+  ~DeviceReader();
+  DeviceReader(const DeviceReader&) = delete;
+  DeviceReader& operator=(const DeviceReader&) = delete;
+
+  // Starts the thread (no-op if it runs).
+  void start(Handlers handlers);
+  // Stops and joins the thread (within about one poll_period) and closes the device.
+  void stop();
+
+  DeviceCounters counters() const;
+  const std::string& device_name() const { return device_name_; }
+
+ private:
+  void loop();
+  // Waits `period` (or until stop), calling on_poll every poll_period.
+  void wait(std::chrono::milliseconds period);
+  bool stopping() const { return stop_.load(); }
+  template <class Call>
+  void run_handler(const char* name, const Call& call);
+
+  std::unique_ptr<ByteSource> source_;
+  const std::string device_name_;
+  DeviceReaderOptions options_;
+  LogFunction log_;
+  ClockFunction clock_;
+  Handlers handlers_;
+
+  std::atomic<bool> stop_{false};
+  std::mutex wait_mutex_;
+  std::condition_variable wait_cv_;
+  std::thread thread_;
+
+  mutable std::mutex counters_mutex_;
+  DeviceCounters counters_;
+};
+
+}  // namespace pixyslam::bridge

@@ -1,0 +1,51 @@
+#include "pixyslam/bridge/bridge_options.h"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+
+namespace pixyslam::bridge {
+
+BridgeProcessOptions read_bridge_process_options(config::YamlReader& node) {
+  BridgeProcessOptions o;
+  o.reopen_period_s = node.number("reopen_period_s", 0.01, 3600.0, o.reopen_period_s);
+  o.status_period_s = node.number("status_period_s", 0.0, 86400.0, o.status_period_s);
+  return o;
+}
+
+DeviceReaderOptions device_reader_options(const BridgeProcessOptions& o) {
+  DeviceReaderOptions d;
+  d.reopen_period = std::chrono::milliseconds(std::llround(o.reopen_period_s * 1000.0));
+  return d;
+}
+
+std::string yaml_number(double value) {
+  std::array<char, 32> buf{};
+  const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), value);
+  return std::string(buf.data(), r.ptr);
+}
+
+std::string yaml_quoted(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string to_yaml_lines(const BridgeProcessOptions& o) {
+  return "  reopen_period_s: " + yaml_number(o.reopen_period_s) + "\n" +
+         "  status_period_s: " + yaml_number(o.status_period_s) + "\n";
+}
+
+std::string to_yaml(const dds::DdsOptions& o) {
+  return "dds:\n"
+         "  domain_id: " + std::to_string(o.domain_id) + "\n" +
+         "  profiles_file: " + yaml_quoted(o.profiles_file) + "\n" +
+         "  participant_profile: " + yaml_quoted(o.participant_profile) + "\n" +
+         "  robot_id: " + yaml_quoted(o.robot_id) + "\n" +
+         "  type_information: " + (o.type_information ? "true" : "false") + "\n";
+}
+
+}  // namespace pixyslam::bridge

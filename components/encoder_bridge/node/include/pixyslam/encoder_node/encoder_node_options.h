@@ -1,0 +1,30 @@
+#pragma once
+
+#include <string>
+
+#include "pixyslam/bridge/bridge_options.h"
+#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/dds/participant.h"
+#include "pixyslam/encoder/encoder_options.h"
+
+namespace pixyslam::encoder_node {
+
+// Everything the encoder_bridge process is configured with
+// (config/encoder_bridge.yaml).
+struct EncoderNodeOptions {
+  encoder::EncoderOptions encoder;       // `encoder_bridge:` (serial link, wheels, rate)
+  bridge::BridgeProcessOptions process;  // `node:` reopen_period_s, status_period_s
+  double clock_window_s = 1.0;           // `node.clock_window_s`: Arduino clock mapping window (ArduinoClock)
+  dds::DdsOptions dds;                   // `dds:`
+};
+
+// Reads `encoder_bridge:` (required), `node:` and `dds:` (optional) from the top
+// level of a file and calls root.finish(). `config_dir` resolves a relative
+// dds.profiles_file. Throws config::ConfigError naming the file and key path.
+EncoderNodeOptions read_encoder_node_options(config::YamlReader& root, const std::string& config_dir);
+EncoderNodeOptions read_encoder_node_options_file(const std::string& path);
+
+// The effective configuration, in the layout read_encoder_node_options() reads.
+std::string to_yaml(const EncoderNodeOptions& options);
+
+}  // namespace pixyslam::encoder_node

@@ -1,0 +1,198 @@
+#include "pixyslam/encoder_node/encoder_node.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <utility>
+#include <variant>
+
+#include "pixyslam/encoder_node/odometry_conversions.h"
+
+namespace pixyslam::encoder_node {
+
+EncoderNode::EncoderNode(const EncoderNodeOptions& options, bridge::LogFunction log)
+    : EncoderNode(options,
+                  std::make_unique<bridge::SerialByteSource>(options.encoder.serial_device, options.encoder.baud),
+                  std::move(log)) {}
+
+EncoderNode::EncoderNode(const EncoderNodeOptions& options, std::unique_ptr<bridge::ByteSource> source,
+                         bridge::LogFunction log, bridge::ClockFunction clock)
+    : options_(options),
+      log_(log ? std::move(log) : bridge::stderr_log("encoder_bridge")),
+      odometry_(options.encoder),
+      accumulator_(options.encoder.publish_rate_hz),
+      clock_(options.clock_window_s) {
+  participant_ = std::make_unique<dds::Participant>(options_.dds, "encoder_bridge");
+  writer_ = std::make_unique<dds::Writer<msg::Odometry>>(*participant_);
+  reader_ = std::make_unique<bridge::DeviceReader>(std::move(source),
+                                                   bridge::device_reader_options(options_.process), log_,
+                                                   clock ? std::move(clock) : bridge::ClockFunction(&dds::now_ns));
+}
+
+EncoderNode::~EncoderNode() {
+  stop();
+  reader_.reset();
+  writer_.reset();
+  participant_.reset();
+}
+
+void EncoderNode::start() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (started_) return;
+    started_ = true;
+    next_status_ = std::chrono::steady_clock::now() +
+                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                       std::chrono::duration<double>(options_.process.status_period_s));
+  }
+  log_("reading '" + reader_->device_name() + "', publishing odometry at " +
+       bridge::yaml_number(options_.encoder.publish_rate_hz) + " Hz on '" + std::string(dds::kOdometryTopic) +
+       "'");
+  reader_->start({[this] { on_open(); },
+                  [this](const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns) {
+                    on_bytes(data, size, receive_ns);
+                  },
+                  [this](std::uint64_t now_ns) { on_poll(now_ns); }});
+}
+
+void EncoderNode::stop() {
+  reader_->stop();
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!started_ || stopped_) return;
+  stopped_ = true;
+  for (const std::string& line : status_lines_locked()) log_("final " + line);
+}
+
+bool EncoderNode::wait_for_subscribers(int count, std::chrono::milliseconds timeout) const {
+  return writer_->wait_for_readers(count, timeout);
+}
+
+EncoderNodeCounters EncoderNode::counters() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  EncoderNodeCounters c;
+  c.device = reader_->counters();
+  c.parser = parser_.counters();
+  c.wheel = odometry_.counters();
+  c.accumulator = accumulator_.counters();
+  c.clock = clock_.counters();
+  c.published = published_;
+  c.publish_failures = publish_failures_;
+  c.empty_periods = empty_periods_;
+  return c;
+}
+
+std::vector<std::string> EncoderNode::status_lines() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return status_lines_locked();
+}
+
+std::vector<std::string> EncoderNode::status_lines_locked() const {
+  const bridge::DeviceCounters d = reader_->counters();
+  const encoder::ArduinoParserCounters& p = parser_.counters();
+  const encoder::WheelCounters& w = odometry_.counters();
+  const ArduinoClock::Counters& k = clock_.counters();
+  std::ostringstream device, lines, motion;
+  device << "status: device '" << reader_->device_name() << "': opens " << d.opens << ", open failures "
+         << d.open_failures << ", hang-ups " << d.hangups << ", read errors " << d.read_errors << ", bytes "
+         << d.bytes;
+  lines << "status: lines: samples " << p.samples << ", resets " << p.resets << ", rejected "
+        << p.rejected_lines() << " (framing " << p.bad_framing << ", checksum " << p.bad_checksum
+        << ", unknown type " << p.unknown_type << ", field count " << p.wrong_field_count << ", bad field "
+        << p.bad_field << ", overlong " << p.overlong_lines << ", unterminated " << p.unterminated_lines
+        << "), bytes skipped " << p.bytes_skipped;
+  motion << "status: wheel steps " << w.steps << ", duplicates " << w.duplicates << ", seq gaps "
+         << w.sequence_gaps << " (lost " << w.lost_samples << "), seq backwards " << w.sequence_backwards
+         << ", time gaps " << w.time_gaps << ", implausible " << w.implausible << ", ticks/rev mismatches "
+         << w.ticks_per_revolution_mismatches << "; clock restarts " << k.restarts << ", jumps " << k.jumps
+         << ", last excess delay " << static_cast<double>(clock_.last_excess_delay_ns()) * 1e-6
+         << " ms; odometry published " << published_ << ", failed " << publish_failures_
+         << ", empty periods " << empty_periods_;
+  return {device.str(), lines.str(), motion.str()};
+}
+
+double EncoderNode::to_seconds(std::int64_t host_ns) const {
+  return static_cast<double>(host_ns - static_cast<std::int64_t>(epoch_ns_)) * 1e-9;
+}
+
+void EncoderNode::on_open() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  clock_.restart();  // a reopened link (an Uno also resets) starts a new clock estimate
+}
+
+void EncoderNode::on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  parser_.feed(data, size, [&](const encoder::ArduinoMessage& message) {
+    if (const auto* sample = std::get_if<encoder::EncoderSample>(&message)) {
+      on_sample(*sample, receive_ns);
+    } else {
+      on_reset(std::get<encoder::EncoderReset>(message));
+    }
+  });
+}
+
+void EncoderNode::on_sample(const encoder::EncoderSample& sample, std::uint64_t receive_ns) {
+  const std::int64_t host_ns = clock_.to_host_ns(sample.arduino_time_us, static_cast<std::int64_t>(receive_ns));
+  if (!has_epoch_) {
+    const std::int64_t positive = std::max<std::int64_t>(host_ns, 0);
+    epoch_ns_ = static_cast<std::uint64_t>(positive - positive % 1000000000);
+    has_epoch_ = true;
+  }
+  const double t_s = to_seconds(host_ns);
+  sample_times_.push_back(t_s);
+  last_sample_ns_ = receive_ns;
+  const encoder::WheelUpdate update = odometry_.update(sample);
+  accumulator_.add(t_s, update, [this](const encoder::OdometryOutput& o) { publish(o); });
+  last_time_s_ = std::max(last_time_s_, t_s);
+}
+
+void EncoderNode::on_reset(const encoder::EncoderReset& reset) {
+  odometry_.reset(reset);
+  clock_.restart();
+  std::string line = "Arduino (re)started: firmware '" + reset.firmware_version + "', ticks_per_revolution " +
+                     std::to_string(reset.ticks_per_revolution);
+  if (reset.ticks_per_revolution != 0 &&
+      reset.ticks_per_revolution != static_cast<std::uint32_t>(options_.encoder.ticks_per_revolution)) {
+    line += " differs from the configured " + std::to_string(options_.encoder.ticks_per_revolution) +
+            " (the configuration is used)";
+  }
+  log_(line);
+}
+
+void EncoderNode::on_poll(std::uint64_t now_ns) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  // No sample for max_sample_gap_s: close the elapsed periods as "no data",
+  // one period at a time at most, up to max_sample_gap_s ago.
+  const auto stall_ns = static_cast<std::uint64_t>(std::llround(options_.encoder.max_sample_gap_s * 1e9));
+  if (has_epoch_ && now_ns > last_sample_ns_ + stall_ns) {
+    const double gap_s = to_seconds(static_cast<std::int64_t>(now_ns - stall_ns));
+    if (gap_s >= last_time_s_ + accumulator_.period_s()) {
+      accumulator_.mark_gap(gap_s, [this](const encoder::OdometryOutput& o) { publish(o); });
+      last_time_s_ = gap_s;
+    }
+  }
+  if (options_.process.status_period_s > 0.0 && std::chrono::steady_clock::now() >= next_status_) {
+    for (const std::string& line : status_lines_locked()) log_(line);
+    next_status_ = std::chrono::steady_clock::now() +
+                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                       std::chrono::duration<double>(options_.process.status_period_s));
+  }
+}
+
+void EncoderNode::publish(const encoder::OdometryOutput& output) {
+  // Samples stamped before the period's end that no earlier output counted.
+  const double end_s = output.t_s + output.duration_s;
+  std::uint32_t samples = 0;
+  while (!sample_times_.empty() && sample_times_.front() < end_s) {
+    ++samples;
+    sample_times_.pop_front();
+  }
+  if (samples == 0) ++empty_periods_;
+  msg::Odometry m = to_odometry_msg(output, samples, epoch_ns_);
+  if (writer_->publish(m)) {
+    ++published_;
+  } else {
+    ++publish_failures_;
+  }
+}
+
+}  // namespace pixyslam::encoder_node

@@ -1,0 +1,125 @@
+#pragma once
+
+#include <condition_variable>
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "pixyslam/dds/participant.h"
+#include "pixyslam/logger/mcap_writer.h"
+#include "pixyslam/logger_node/logger_options.h"
+
+namespace pixyslam::logger_node {
+
+namespace detail {
+class Subscription;
+}  // namespace detail
+
+// Per recorded topic, since construction.
+struct TopicCounters {
+  std::string topic;
+  std::uint16_t channel_id = 0;  // MCAP channel
+  std::uint64_t received = 0;    // samples DDS delivered
+  std::uint64_t written = 0;     // MCAP messages written
+  std::uint64_t dropped = 0;     // received but not written (queue full, write failure, stopped)
+  std::uint64_t seq_gaps = 0;    // header seq numbers skipped, per DDS writer (lost before us)
+};
+
+struct LoggerCounters {
+  std::vector<TopicCounters> topics;  // in the order of options.topics
+  std::size_t queue_peak_bytes = 0;   // most payload bytes ever waiting
+  std::size_t queue_peak_messages = 0;
+  logger::McapWriterCounters file;    // of the MCAP writer (final after stop())
+  std::string error;                  // the write failure that stopped recording ("" if none)
+};
+
+// The logger process: subscribes to the configured topics and writes every
+// sample to one MCAP file (docs/mcap.md), one channel per topic.
+//
+// Per sample: the CDR payload exactly as a Fast DDS writer sends it, 4-byte
+// encapsulation header included (cdr_payload.h), on the topic's channel with
+// sequence = header.seq (low 32 bits), log_time = receive time (dds::now_ns())
+// and publish_time = header.stamp_ns. Channel: message_encoding "cdr",
+// metadata type_name, robot_id (dds.robot_id of the logger) and dds_domain_id.
+// Schema: encoding "omgidl", name = DDS type name ("pixyslam::msg::Odometry"),
+// data = the IDL with its includes inlined (msg::idl_text).
+//
+// DDS callbacks only serialize and enqueue (bounded by queue_max_bytes; a
+// sample beyond the bound is dropped and counted); ONE writer thread writes
+// the file and writes the open chunk every flush_period_s, so a crash loses at
+// most about that much. The constructor creates (truncates) the file and
+// subscribes; samples arriving before start() wait in the queue. stop()
+// unsubscribes, drains the queue and closes the file (summary and footer);
+// counters are final after it. Throws std::runtime_error if the file cannot be
+// created or DDS entities cannot be made. Thread-safe.
+class LoggerNode {
+ public:
+  explicit LoggerNode(const LoggerOptions& options);
+  ~LoggerNode();
+  LoggerNode(const LoggerNode&) = delete;
+  LoggerNode& operator=(const LoggerNode&) = delete;
+
+  // Starts the writer thread (once; no-op after stop()).
+  void start();
+  // Unsubscribes, writes everything queued, closes the file. Idempotent; the
+  // destructor calls it.
+  void stop();
+
+  LoggerCounters counters() const;
+  // True once writing failed (disk full, ...): nothing more is recorded.
+  bool failed() const;
+  // One line per topic, "TOPIC: received R, written W, dropped D, seq gaps G".
+  std::string counters_text() const;
+
+ private:
+  friend class detail::Subscription;
+
+  struct Pending {
+    std::size_t topic = 0;  // index into topics_
+    std::uint64_t seq = 0;
+    std::uint64_t log_time_ns = 0;
+    std::uint64_t publish_time_ns = 0;
+    std::vector<std::uint8_t> payload;
+  };
+
+  template <class Message>
+  void subscribe(std::size_t topic);
+  // Called from DDS callbacks; `serialized` false counts the sample as dropped.
+  void enqueue(std::size_t topic, std::uint64_t seq, std::uint64_t stamp_ns,
+               std::vector<std::uint8_t>&& payload, bool serialized);
+  void writer_loop();
+  void write_batch(std::deque<Pending>& batch);
+  // The writer thread's failure: recorded once, recording stops.
+  void record_error(const std::string& what);
+
+  LoggerOptions options_;
+  logger::McapWriter writer_;  // after construction: the writer thread's alone (stop()'s if never started)
+
+  // Queue and counters.
+  mutable std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<Pending> queue_;
+  std::size_t queued_bytes_ = 0;  // payloads in queue_ and in the batch being written
+  std::size_t queued_messages_ = 0;
+  bool accepting_ = true;         // false once stop() began or writing failed
+  bool stopping_ = false;
+  std::vector<TopicCounters> topics_;
+  LoggerCounters totals_;         // peaks, file counters, error (topics_ kept apart)
+
+  std::mutex lifecycle_mutex_;    // start() / stop()
+  bool started_ = false;
+  bool stopped_ = false;
+  std::thread thread_;
+
+  // Declared last so they go first: no callback may outlive the queue.
+  std::unique_ptr<dds::Participant> participant_;
+  mutable std::mutex subscriptions_mutex_;
+  std::vector<std::unique_ptr<detail::Subscription>> subscriptions_;  // one per topics_ entry; cleared by stop()
+};
+
+}  // namespace pixyslam::logger_node

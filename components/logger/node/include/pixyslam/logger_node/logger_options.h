@@ -1,0 +1,47 @@
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/dds/participant.h"
+#include "pixyslam/logger/mcap_writer.h"
+
+namespace pixyslam::logger_node {
+
+// zstd when the MCAP library was built with it, else none.
+logger::McapCompression default_compression();
+
+// Everything the logger process is configured with (config/logger.yaml).
+struct LoggerOptions {
+  // `logger.output_file`: the MCAP file, created or truncated; a relative path
+  // is relative to the working directory. `logger --out` overrides it.
+  std::string output_file = "pixyslam_run.mcap";
+  // `logger.topics`: DDS topic names to record (known_topics()); empty = all.
+  std::vector<std::string> topics;
+  // `logger.chunk_size_bytes`: uncompressed bytes per MCAP chunk before it is written.
+  std::size_t chunk_size_bytes = std::size_t{1} << 20;
+  // `logger.compression`: none | zstd | lz4 (chunk compression).
+  logger::McapCompression compression = default_compression();
+  // `logger.flush_period_s`: the open chunk is written at least this often, so
+  // a crash loses at most about this much (0: only when a chunk is full).
+  double flush_period_s = 1.0;
+  // `logger.fsync`: fsync(2) after every chunk, not only fflush (survives a power cut).
+  bool fsync = false;
+  // `logger.queue_max_bytes`: payload bytes waiting for the writer thread;
+  // samples beyond it are dropped and counted.
+  std::size_t queue_max_bytes = std::size_t{64} << 20;
+  dds::DdsOptions dds;  // `dds:`
+};
+
+// Reads `logger:` (required) and `dds:` (optional) from the top level and calls
+// root.finish(). `config_dir` resolves a relative dds.profiles_file. Throws
+// config::ConfigError naming the file and key path.
+LoggerOptions read_logger_options(config::YamlReader& root, const std::string& config_dir);
+LoggerOptions read_logger_options_file(const std::string& path);
+
+// The effective configuration, in the layout read_logger_options() reads.
+std::string to_yaml(const LoggerOptions& options);
+
+}  // namespace pixyslam::logger_node

@@ -1,0 +1,110 @@
+#include "pixyslam/logger_node/logger_options.h"
+
+#include <set>
+#include <sstream>
+
+#include "pixyslam/app/command_line.h"
+#include "pixyslam/logger_node/cdr_payload.h"
+
+namespace pixyslam::logger_node {
+
+logger::McapCompression default_compression() {
+  return logger::mcap_compression_available(logger::McapCompression::kZstd) ? logger::McapCompression::kZstd
+                                                                            : logger::McapCompression::kNone;
+}
+
+namespace {
+
+std::vector<std::string> all_topics() {
+  std::vector<std::string> out;
+  for (const TopicInfo& t : known_topics()) out.push_back(t.topic);
+  return out;
+}
+
+std::string topic_list() {
+  std::string out;
+  for (const TopicInfo& t : known_topics()) out += (out.empty() ? "" : ", ") + t.topic;
+  return out;
+}
+
+logger::McapCompression read_compression(config::YamlReader& reader, logger::McapCompression fallback) {
+  const std::string fallback_name =
+      fallback == logger::McapCompression::kNone ? "none" : logger::mcap_compression_name(fallback);
+  const std::string name = reader.choice("compression", {"none", "zstd", "lz4"}, fallback_name);
+  const logger::McapCompression c = name == "zstd"  ? logger::McapCompression::kZstd
+                                    : name == "lz4" ? logger::McapCompression::kLz4
+                                                    : logger::McapCompression::kNone;
+  if (!logger::mcap_compression_available(c)) {
+    reader.fail("compression", "'" + name + "' is not available in this build (install lib" + name +
+                                   "-dev and rebuild, or use none)");
+  }
+  return c;
+}
+
+}  // namespace
+
+LoggerOptions read_logger_options(config::YamlReader& root, const std::string& config_dir) {
+  LoggerOptions o;
+  config::YamlReader section = root.child("logger");
+  o.output_file = section.text("output_file", o.output_file);
+  if (o.output_file.empty()) section.fail("output_file", "must not be empty");
+  if (section.has("topics")) {
+    o.topics = section.text_list("topics");
+    if (o.topics.empty()) section.fail("topics", "empty list (leave the key out to record every topic)");
+    std::set<std::string> seen;
+    for (std::size_t i = 0; i < o.topics.size(); ++i) {
+      const std::string key = "topics[" + std::to_string(i) + "]";
+      if (find_topic(o.topics[i]) == nullptr) {
+        section.fail(key, "unknown topic '" + o.topics[i] + "' (known: " + topic_list() + ")");
+      }
+      if (!seen.insert(o.topics[i]).second) section.fail(key, "topic '" + o.topics[i] + "' given twice");
+    }
+  } else {
+    o.topics = all_topics();
+  }
+  o.chunk_size_bytes = static_cast<std::size_t>(
+      section.integer("chunk_size_bytes", 4096, std::int64_t{1} << 28, static_cast<std::int64_t>(o.chunk_size_bytes)));
+  o.compression = read_compression(section, o.compression);
+  o.flush_period_s = section.number("flush_period_s", 0.0, 3600.0, o.flush_period_s);
+  o.fsync = section.boolean("fsync", o.fsync);
+  o.queue_max_bytes = static_cast<std::size_t>(section.integer(
+      "queue_max_bytes", std::int64_t{1} << 20, std::int64_t{1} << 32, static_cast<std::int64_t>(o.queue_max_bytes)));
+  section.finish();
+
+  if (root.has("dds")) {
+    config::YamlReader dds = root.child("dds");
+    o.dds = dds::read_dds_options(dds, config_dir);
+  }
+  root.finish();
+  return o;
+}
+
+LoggerOptions read_logger_options_file(const std::string& path) {
+  config::YamlReader root = config::YamlReader::from_file(path);
+  return read_logger_options(root, app::folder_of(path));
+}
+
+std::string to_yaml(const LoggerOptions& o) {
+  std::ostringstream os;
+  os << "logger:\n"
+     << "  output_file: '" << o.output_file << "'\n"
+     << "  topics: [";
+  for (std::size_t i = 0; i < o.topics.size(); ++i) os << (i ? ", " : "") << o.topics[i];
+  os << "]\n"
+     << "  chunk_size_bytes: " << o.chunk_size_bytes << "\n"
+     << "  compression: "
+     << (o.compression == logger::McapCompression::kNone ? "none" : logger::mcap_compression_name(o.compression))
+     << "\n"
+     << "  flush_period_s: " << o.flush_period_s << "\n"
+     << "  fsync: " << (o.fsync ? "true" : "false") << "\n"
+     << "  queue_max_bytes: " << o.queue_max_bytes << "\n"
+     << "dds:\n"
+     << "  domain_id: " << o.dds.domain_id << "\n"
+     << "  profiles_file: '" << o.dds.profiles_file << "'\n"
+     << "  participant_profile: " << o.dds.participant_profile << "\n"
+     << "  robot_id: " << o.dds.robot_id << "\n"
+     << "  type_information: " << (o.dds.type_information ? "true" : "false") << "\n";
+  return os.str();
+}
+
+}  // namespace pixyslam::logger_node

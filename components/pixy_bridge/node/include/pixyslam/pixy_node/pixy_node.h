@@ -1,0 +1,94 @@
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "landmark_observation.h"
+#include "pixyslam/bridge/byte_source.h"
+#include "pixyslam/bridge/device_reader.h"
+#include "pixyslam/dds/endpoints.h"
+#include "pixyslam/pixy/pixy_block_parser.h"
+#include "pixyslam/pixy/pixy_geometry.h"
+#include "pixyslam/pixy_node/pixy_node_options.h"
+
+namespace pixyslam::pixy_node {
+
+struct PixyNodeCounters {
+  bridge::DeviceCounters device;
+  pixy::PixyParserCounters parser;
+  pixy::DetectionCounters detections;
+  std::uint64_t published = 0;           // LandmarkObservation messages written
+  std::uint64_t publish_failures = 0;    // writes DDS refused
+  std::uint64_t frames_timed_out = 0;    // frames closed by frame_timeout_s (not by the next frame)
+  std::uint64_t detections_dropped = 0;  // beyond the message's bound
+};
+
+// The pixy_bridge process: reads the Pixy's UART block stream from a byte
+// source (the serial device, or a test's twin) on one reader thread, parses it
+// into frames (PixyBlockParser), turns each frame's blocks into landmark
+// range/bearing detections (to_detections, seed paper Eq. 5/6) and publishes one
+// msg::LandmarkObservation per camera frame, also frames without detections,
+// frame "camera".
+//
+// Stamp: the host time (dds::now_ns() domain) at which the frame's last block
+// was read (for a frame without blocks: its start), minus camera_latency_s.
+// A frame is complete when the next frame starts, or when no data came for it
+// for frame_timeout_s (the camera sends nothing while it sees nothing).
+//
+// Device trouble is logged naming the device and retried every
+// reopen_period_s; it never stops the node. Counters go to the log every
+// status_period_s and at stop(). Thread-safe.
+class PixyNode {
+ public:
+  // Reads options.serial_device at options.baud.
+  explicit PixyNode(const PixyNodeOptions& options, bridge::LogFunction log = bridge::stderr_log("pixy_bridge"));
+  // Reads `source` instead; `clock` (default dds::now_ns) stamps what it reads.
+  PixyNode(const PixyNodeOptions& options, std::unique_ptr<bridge::ByteSource> source, bridge::LogFunction log,
+           bridge::ClockFunction clock = {});
+  ~PixyNode();
+  PixyNode(const PixyNode&) = delete;
+  PixyNode& operator=(const PixyNode&) = delete;
+
+  // Starts the reader thread.
+  void start();
+  // Joins the reader thread (within ~50 ms) and logs the counters; idempotent.
+  void stop();
+
+  // Waits until `count` readers matched the observation writer; false on timeout.
+  bool wait_for_subscribers(int count, std::chrono::milliseconds timeout) const;
+  PixyNodeCounters counters() const;
+  // The counters as log lines.
+  std::vector<std::string> status_lines() const;
+
+ private:
+  void on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns);
+  void on_poll(std::uint64_t now_ns);
+  void publish(const pixy::PixyFrame& frame, std::uint64_t end_ns);
+  std::vector<std::string> status_lines_locked() const;
+
+  PixyNodeOptions options_;
+  bridge::LogFunction log_;
+  std::unique_ptr<dds::Participant> participant_;
+  std::unique_ptr<dds::Writer<msg::LandmarkObservation>> writer_;
+
+  // Reader-thread state; others read it under mutex_.
+  mutable std::mutex mutex_;
+  pixy::PixyBlockParser parser_;
+  pixy::DetectionCounters detection_counters_;
+  std::uint64_t frame_end_ns_ = 0;  // host time the open frame last advanced (opened or got a block)
+  std::chrono::steady_clock::time_point next_status_;
+  std::uint64_t published_ = 0;
+  std::uint64_t publish_failures_ = 0;
+  std::uint64_t frames_timed_out_ = 0;
+  std::uint64_t detections_dropped_ = 0;
+  bool started_ = false;
+  bool stopped_ = false;
+
+  std::unique_ptr<bridge::DeviceReader> reader_;  // last: its thread uses the members above
+};
+
+}  // namespace pixyslam::pixy_node

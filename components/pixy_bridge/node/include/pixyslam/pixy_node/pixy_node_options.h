@@ -1,0 +1,33 @@
+#pragma once
+
+#include <string>
+
+#include "pixyslam/bridge/bridge_options.h"
+#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/dds/participant.h"
+#include "pixyslam/pixy/pixy_options.h"
+
+namespace pixyslam::pixy_node {
+
+// Everything the pixy_bridge process is configured with (config/pixy_bridge.yaml).
+struct PixyNodeOptions {
+  // `node:` -- the serial link and the process.
+  std::string serial_device = "/dev/serial0";  // the Pi's GPIO UART wired to the Pixy's UART
+  long baud = 19200;                           // the Pixy's UART default (PixyMon: Interface > UART baudrate)
+  double camera_latency_s = 0.0;   // subtracted from the host time a frame was read (exposure to UART)
+  double frame_timeout_s = 0.05;   // an open frame without new data this long is complete
+  bridge::BridgeProcessOptions process;  // reopen_period_s, status_period_s
+  pixy::PixyOptions pixy;  // `pixy:` camera model and signature -> landmark map
+  dds::DdsOptions dds;     // `dds:`
+};
+
+// Reads `pixy:` (required), `node:` and `dds:` (optional) from the top level of
+// a file and calls root.finish(). `config_dir` resolves a relative
+// dds.profiles_file. Throws config::ConfigError naming the file and key path.
+PixyNodeOptions read_pixy_node_options(config::YamlReader& root, const std::string& config_dir);
+PixyNodeOptions read_pixy_node_options_file(const std::string& path);
+
+// The effective configuration, in the layout read_pixy_node_options() reads.
+std::string to_yaml(const PixyNodeOptions& options);
+
+}  // namespace pixyslam::pixy_node

@@ -1,0 +1,82 @@
+#include "pixyslam/pixy_node/pixy_node_options.h"
+
+#include <sstream>
+
+#include "pixyslam/app/command_line.h"
+#include "pixyslam/serial/serial_port.h"
+
+namespace pixyslam::pixy_node {
+namespace {
+
+std::string baud_list() {
+  std::string s;
+  for (const long b : serial::supported_bauds()) s += (s.empty() ? "" : ", ") + std::to_string(b);
+  return s;
+}
+
+}  // namespace
+
+PixyNodeOptions read_pixy_node_options(config::YamlReader& root, const std::string& config_dir) {
+  PixyNodeOptions o;
+  if (root.has("node")) {
+    config::YamlReader node = root.child("node");
+    o.serial_device = node.text("serial_device", o.serial_device);
+    if (o.serial_device.empty() || o.serial_device.front() != '/') {
+      node.fail("serial_device",
+                "value '" + o.serial_device + "' is not an absolute path (e.g. /dev/serial0)");
+    }
+    o.baud = static_cast<long>(node.integer("baud", 1, 4000000, o.baud));
+    if (!serial::is_supported_baud(o.baud)) {
+      node.fail("baud", "value " + std::to_string(o.baud) + " is not a supported serial rate (" +
+                            baud_list() + ")");
+    }
+    o.camera_latency_s = node.number("camera_latency_s", 0.0, 1.0, o.camera_latency_s);
+    o.frame_timeout_s = node.number("frame_timeout_s", 0.005, 10.0, o.frame_timeout_s);
+    o.process = bridge::read_bridge_process_options(node);
+    node.finish();
+  }
+  config::YamlReader pixy = root.child("pixy");
+  o.pixy = pixy::read_pixy_options(pixy);
+  if (root.has("dds")) {
+    config::YamlReader dds = root.child("dds");
+    o.dds = dds::read_dds_options(dds, config_dir);
+  }
+  root.finish();
+  return o;
+}
+
+PixyNodeOptions read_pixy_node_options_file(const std::string& path) {
+  config::YamlReader root = config::YamlReader::from_file(path);
+  return read_pixy_node_options(root, app::folder_of(path));
+}
+
+std::string to_yaml(const PixyNodeOptions& o) {
+  using bridge::yaml_number;
+  const pixy::CameraModel& c = o.pixy.camera;
+  std::ostringstream os;
+  os << "node:\n"
+     << "  serial_device: " << bridge::yaml_quoted(o.serial_device) << "\n"
+     << "  baud: " << o.baud << "\n"
+     << "  camera_latency_s: " << yaml_number(o.camera_latency_s) << "\n"
+     << "  frame_timeout_s: " << yaml_number(o.frame_timeout_s) << "\n"
+     << bridge::to_yaml_lines(o.process)
+     << "pixy:\n"
+     << "  focal_length_mm: " << yaml_number(c.focal_length_mm) << "\n"
+     << "  sensor_height_mm: " << yaml_number(c.sensor_height_mm) << "\n"
+     << "  sensor_width_mm: " << yaml_number(c.sensor_width_mm) << "\n"
+     << "  image_width_px: " << c.image_width_px << "\n"
+     << "  image_height_px: " << c.image_height_px << "\n"
+     << "  landmark_height_m: " << yaml_number(c.landmark_height_m) << "\n"
+     << "  min_height_to_width: " << yaml_number(c.min_height_to_width) << "\n"
+     << "  max_height_to_width: " << yaml_number(c.max_height_to_width) << "\n"
+     << "  range_sigma_fraction: " << yaml_number(c.range_sigma_fraction) << "\n"
+     << "  bearing_sigma_rad: " << yaml_number(c.bearing_sigma_rad) << "\n"
+     << "  landmarks:" << (o.pixy.signatures.size() == 0 ? " {}" : "") << "\n";
+  for (const auto& [signature, id] : o.pixy.signatures.entries()) {
+    os << "    \"" << pixy::signature_tags(signature) << "\": " << id << "\n";
+  }
+  os << bridge::to_yaml(o.dds);
+  return os.str();
+}
+
+}  // namespace pixyslam::pixy_node

@@ -1,0 +1,610 @@
+// The logger: sequence analysis (pure), CDR payloads, options from YAML, and a
+// LoggerNode on the shipped loopback profile recording what writers in this
+// test publish, read back with McapReader.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "pixyslam/dds/endpoints.h"
+#include "pixyslam/log_tool/sequence_check.h"
+#include "pixyslam/logger/mcap_reader.h"
+#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/logger_node/logger_node.h"
+#include "pixyslam/logger_node/logger_options.h"
+
+namespace pixyslam::logger_node {
+namespace {
+
+using log_tool::analyze_sequence;
+using log_tool::describe;
+using log_tool::SequenceReport;
+
+// ---------------------------------------------------------------- sequences
+
+TEST(SequenceCheck, OneToNInAnyOrderIsComplete) {
+  const SequenceReport r = analyze_sequence({3, 1, 2, 4, 5});
+  EXPECT_TRUE(r.complete());
+  EXPECT_EQ(r.count, 5u);
+  EXPECT_EQ(r.min, 1u);
+  EXPECT_EQ(r.max, 5u);
+  EXPECT_EQ(r.backwards, 1u);  // 1 after 3
+  EXPECT_EQ(describe(r), "seq 1..5: 1 out of order");
+  EXPECT_EQ(describe(analyze_sequence({1, 2, 3})), "seq 1..3");
+}
+
+TEST(SequenceCheck, EmptyStreamIsComplete) {
+  const SequenceReport r = analyze_sequence({});
+  EXPECT_TRUE(r.complete());
+  EXPECT_EQ(describe(r), "no messages");
+}
+
+TEST(SequenceCheck, GapsAndDuplicatesAreCountedAndListed) {
+  // Missing 1 (a late start), 5-7 and 10; 8 twice, 9 three times.
+  const SequenceReport r = analyze_sequence({2, 3, 4, 8, 8, 9, 9, 9, 11});
+  EXPECT_FALSE(r.complete());
+  EXPECT_EQ(r.missing, 5u);
+  ASSERT_EQ(r.missing_ranges.size(), 3u);
+  EXPECT_EQ(r.missing_ranges[0].first, 1u);
+  EXPECT_EQ(r.missing_ranges[0].last, 1u);
+  EXPECT_EQ(r.missing_ranges[1].first, 5u);
+  EXPECT_EQ(r.missing_ranges[1].last, 7u);
+  EXPECT_EQ(r.duplicates, 3u);
+  EXPECT_EQ(r.duplicated, (std::vector<std::uint64_t>{8, 9}));
+  EXPECT_EQ(r.distinct, 6u);
+  EXPECT_EQ(describe(r), "seq 2..11: 5 missing (1, 5-7, 10), 3 duplicates (8, 9)");
+}
+
+TEST(SequenceCheck, ZeroIsNotAValidSeq) {
+  const SequenceReport r = analyze_sequence({0, 1, 2});
+  EXPECT_FALSE(r.complete());
+  EXPECT_EQ(r.zeros, 1u);
+  EXPECT_EQ(r.missing, 0u);
+  EXPECT_EQ(describe(r), "seq 0..2: 1 with seq 0");
+}
+
+TEST(SequenceCheck, ListsAreBoundedButCountsAreNot) {
+  std::vector<std::uint64_t> seqs;
+  for (std::uint64_t s = 2; s <= 40; s += 2) seqs.push_back(s);  // every odd number missing
+  const SequenceReport r = analyze_sequence(seqs, 3);
+  EXPECT_EQ(r.missing, 20u);
+  EXPECT_EQ(r.missing_ranges.size(), 3u);
+  EXPECT_EQ(describe(r), "seq 2..40: 20 missing (1, 3, 5, ...)");
+}
+
+// ---------------------------------------------------------------- CDR payloads
+
+msg::Odometry odometry(int i) {
+  msg::Odometry m;
+  m.header().stamp_ns(1'700'000'000'000'000'000ull + static_cast<std::uint64_t>(i) * 100'000'000ull);
+  m.header().frame_id("base_link");
+  m.v_mps(0.01 * i);
+  m.w_radps(-0.002 * i);
+  m.period_s(0.1);
+  m.distance_m(0.001 * i);
+  m.rotation_rad(-0.0002 * i);
+  m.encoder_samples(static_cast<std::uint32_t>(i % 7));
+  return m;
+}
+
+TEST(CdrPayload, CarriesTheEncapsulationHeaderAndRoundTrips) {
+  msg::Odometry m = odometry(3);
+  m.header().seq(42);
+  m.header().robot_id("r1");
+  const std::vector<std::uint8_t> bytes = to_cdr(m);
+  ASSERT_GE(bytes.size(), 4u);
+  EXPECT_EQ(bytes[0], 0x00);  // CDR_LE, options 0
+  EXPECT_EQ(bytes[1], 0x01);
+  EXPECT_EQ(bytes[2], 0x00);
+  EXPECT_EQ(bytes[3], 0x00);
+  msg::Odometry back;
+  std::string error;
+  ASSERT_TRUE(from_cdr(bytes, back, error)) << error;
+  EXPECT_EQ(back, m);
+
+  SampleHeader header;
+  ASSERT_TRUE(decode_header("pixyslam::msg::Odometry", bytes.data(), bytes.size(), header, error)) << error;
+  EXPECT_EQ(header.seq, 42u);
+  EXPECT_EQ(header.stamp_ns, m.header().stamp_ns());
+  EXPECT_EQ(header.robot_id, "r1");
+  EXPECT_EQ(header.frame_id, "base_link");
+}
+
+TEST(CdrPayload, StrictDecodingRejectsCutPaddedAndMistypedPayloads) {
+  msg::Odometry m = odometry(5);
+  m.header().robot_id("r1");
+  std::vector<std::uint8_t> bytes = to_cdr(m);
+  SampleHeader header;
+  std::string error;
+
+  std::vector<std::uint8_t> cut(bytes.begin(), bytes.end() - 3);
+  EXPECT_FALSE(decode_header("pixyslam::msg::Odometry", cut.data(), cut.size(), header, error));
+  EXPECT_FALSE(error.empty());
+
+  std::vector<std::uint8_t> padded = bytes;  // alignment padding (zeros) is fine
+  padded.insert(padded.end(), {0, 0});
+  EXPECT_TRUE(decode_header("pixyslam::msg::Odometry", padded.data(), padded.size(), header, error)) << error;
+  std::vector<std::uint8_t> garbage = bytes;  // anything else after the sample is not
+  garbage.insert(garbage.end(), {0xAB, 0xCD, 0xEF, 0x01, 0x02, 0x03, 0x04, 0x05});
+  EXPECT_FALSE(decode_header("pixyslam::msg::Odometry", garbage.data(), garbage.size(), header, error));
+
+  // An Odometry payload is not a MapState.
+  EXPECT_FALSE(decode_header("pixyslam::msg::MapState", bytes.data(), bytes.size(), header, error));
+  EXPECT_FALSE(decode_header("pixyslam::msg::Nope", bytes.data(), bytes.size(), header, error));
+  EXPECT_NE(error.find("unknown type"), std::string::npos) << error;
+  EXPECT_FALSE(decode_header("pixyslam::msg::Odometry", bytes.data(), 2, header, error));
+}
+
+TEST(CdrPayload, KnownTopicsAreTheSystemsTopicsWithTheirDdsTypeNames) {
+  const auto& topics = known_topics();
+  ASSERT_EQ(topics.size(), 4u);
+  EXPECT_EQ(topics[0].topic, dds::kOdometryTopic);
+  EXPECT_EQ(topics[0].type_name, "pixyslam::msg::Odometry");
+  EXPECT_EQ(topics[0].idl_stem, "odometry");
+  EXPECT_EQ(topics[2].type_name, "pixyslam::msg::MapState");
+  ASSERT_NE(find_topic("pixyslam/ground_truth"), nullptr);
+  EXPECT_EQ(find_topic("pixyslam/ground_truth")->type_name, "pixyslam::msg::GroundTruth");
+  EXPECT_EQ(find_topic("odometry"), nullptr);
+}
+
+// ---------------------------------------------------------------- options
+
+std::string config_error(const std::string& yaml) {
+  auto root = config::YamlReader::from_string(yaml, "logger_test.yaml");
+  try {
+    read_logger_options(root, "/cfg");
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(LoggerOptions, ShippedConfigLoads) {
+  const LoggerOptions o = read_logger_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/logger.yaml");
+  EXPECT_EQ(o.output_file, "pixyslam_run.mcap");
+  EXPECT_EQ(o.topics.size(), 4u);
+  EXPECT_EQ(o.chunk_size_bytes, 1048576u);
+  EXPECT_EQ(o.compression, default_compression());
+  EXPECT_DOUBLE_EQ(o.flush_period_s, 1.0);
+  EXPECT_FALSE(o.fsync);
+  EXPECT_EQ(o.dds.profiles_file, std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml");
+  EXPECT_TRUE(std::filesystem::exists(o.dds.profiles_file));
+}
+
+TEST(LoggerOptions, DefaultsRecordEveryTopic) {
+  auto root = config::YamlReader::from_string("logger: {}\n", "logger_test.yaml");
+  const LoggerOptions o = read_logger_options(root, "/cfg");
+  ASSERT_EQ(o.topics.size(), known_topics().size());
+  EXPECT_EQ(o.topics[3], "pixyslam/ground_truth");
+  EXPECT_EQ(o.compression, default_compression());
+  EXPECT_DOUBLE_EQ(o.flush_period_s, 1.0);
+}
+
+TEST(LoggerOptions, SelectedTopicsAndCompression) {
+  auto root = config::YamlReader::from_string(
+      "logger:\n  topics: [pixyslam/map_state]\n  compression: none\n  fsync: true\n"
+      "dds:\n  profiles_file: dds/loopback.xml\n",
+      "logger_test.yaml");
+  const LoggerOptions o = read_logger_options(root, "/cfg");
+  EXPECT_EQ(o.topics, std::vector<std::string>{"pixyslam/map_state"});
+  EXPECT_EQ(o.compression, logger::McapCompression::kNone);
+  EXPECT_TRUE(o.fsync);
+  EXPECT_EQ(o.dds.profiles_file, "/cfg/dds/loopback.xml");
+}
+
+TEST(LoggerOptions, ErrorsNameTheFileAndTheKey) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"logger:\n  flush_period_sec: 1\n", "key 'logger.flush_period_sec': unknown key"},
+      {"logger:\n  topics: [pixyslam/odometry, pixyslam/odometri]\n", "key 'logger.topics[1]': unknown topic"},
+      {"logger:\n  topics: [pixyslam/odometry, pixyslam/odometry]\n", "key 'logger.topics[1]': topic"},
+      {"logger:\n  topics: []\n", "key 'logger.topics': empty list"},
+      {"logger:\n  compression: gzip\n", "key 'logger.compression': value 'gzip' is not one of"},
+      {"logger:\n  flush_period_s: -1\n", "key 'logger.flush_period_s': value -1 is out of range"},
+      {"logger:\n  chunk_size_bytes: 10\n", "key 'logger.chunk_size_bytes'"},
+      {"logger:\n  output_file: ''\n", "key 'logger.output_file': must not be empty"},
+      {"logger:\n  fsync: maybe\n", "key 'logger.fsync'"},
+      {"dds: {}\n", "key 'logger': missing"},
+      {"logger: {}\ndds:\n  domain_id: 999\n", "key 'dds.domain_id'"},
+      {"logger: {}\nextra: 1\n", "key 'extra': unknown key"},
+  };
+  for (const auto& [yaml, expected] : cases) {
+    const std::string error = config_error(yaml);
+    EXPECT_EQ(error.rfind("logger_test.yaml: ", 0), 0u) << error;
+    EXPECT_NE(error.find(expected), std::string::npos) << "YAML:\n" << yaml << "error: " << error;
+  }
+}
+
+// ---------------------------------------------------------------- the node
+
+// The logger records everything on its domain, so these tests use a domain of
+// their own: other DDS tests (RESOURCE_LOCK serialises only one ctest run) and
+// anything else on domain 0 of this machine would be recorded too.
+dds::DdsOptions loopback_options() {
+  dds::DdsOptions o;
+  o.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml";
+  o.domain_id = 100 + static_cast<int>(::getpid() % 100);
+  o.robot_id = "test_robot";
+  return o;
+}
+
+// A file in the temp folder, removed at the end unless kept.
+class TempFile {
+ public:
+  explicit TempFile(const std::string& name, const char* keep_env = nullptr) {
+    const char* keep = keep_env ? std::getenv(keep_env) : nullptr;
+    if (keep != nullptr && *keep != '\0') {
+      path_ = keep;
+      keep_ = true;
+    } else {
+      path_ = (std::filesystem::temp_directory_path() /
+               ("pixyslam_" + name + "_" + std::to_string(::getpid()) + ".mcap"))
+                  .string();
+    }
+    std::filesystem::remove(path_);
+  }
+  ~TempFile() {
+    if (!keep_) std::filesystem::remove(path_);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  bool keep_ = false;
+};
+
+LoggerOptions node_options(const std::string& path) {
+  LoggerOptions o;
+  o.output_file = path;
+  o.dds = loopback_options();
+  o.chunk_size_bytes = 4096;  // many chunks, so that a cut file still holds some
+  return o;
+}
+
+bool wait_until(const std::function<bool()>& done, std::chrono::seconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return true;
+}
+
+std::uint64_t received(const LoggerNode& node, const std::string& topic) {
+  for (const TopicCounters& t : node.counters().topics) {
+    if (t.topic == topic) return t.received;
+  }
+  return 0;
+}
+
+const TopicCounters& topic_counters(const LoggerCounters& c, const std::string& topic) {
+  for (const TopicCounters& t : c.topics) {
+    if (t.topic == topic) return t;
+  }
+  throw std::runtime_error("no counters for " + topic);
+}
+
+msg::LandmarkObservation observation(int i) {
+  msg::LandmarkObservation m;
+  m.header().stamp_ns(1'700'000'000'000'000'000ull + static_cast<std::uint64_t>(i) * 100'000'000ull + 7);
+  m.header().frame_id("camera");
+  m.camera_frame(static_cast<std::uint32_t>(1000 + i));
+  m.blocks_in_frame(static_cast<std::uint32_t>(i % 4 + 1));
+  m.blocks_rejected(1);
+  for (int k = 0; k < i % 4; ++k) {
+    msg::LandmarkDetection d;
+    d.landmark_id(10 + k);
+    d.range_m(1.0 + 0.1 * i + k);
+    d.bearing_rad(-0.3 + 0.05 * k);
+    d.range_sigma_m(0.07);
+    d.bearing_sigma_rad(0.027);
+    msg::PixyBlock block;
+    block.signature(static_cast<std::uint16_t>(012 + k));
+    block.x_px(static_cast<std::uint16_t>(100 + i));
+    block.y_px(50);
+    block.width_px(12);
+    block.height_px(30);
+    block.angle_deg(static_cast<std::int16_t>(-k));
+    d.block(block);
+    m.detections().push_back(d);
+  }
+  return m;
+}
+
+msg::MapState map_state(int i) {
+  msg::MapState m;
+  m.header().stamp_ns(1'700'000'000'000'000'000ull + static_cast<std::uint64_t>(i) * 100'000'000ull + 9);
+  m.header().frame_id("map");
+  msg::Pose2D mean;
+  mean.x_m(0.1 * i);
+  mean.y_m(-0.05 * i);
+  mean.theta_rad(0.01 * i);
+  m.mean_pose(mean);
+  m.best_pose(mean);
+  for (int k = 0; k < 9; ++k) m.pose_covariance()[static_cast<std::size_t>(k)] = 0.001 * (k + 1) * (i + 1);
+  m.effective_sample_size(50.0 + i);
+  m.particle_count(100);
+  for (int k = 0; k < 5; ++k) m.particle_poses().push_back(mean);
+  for (int k = 0; k < i % 6; ++k) {
+    msg::LandmarkEstimate l;
+    l.landmark_id(10 + k);
+    l.x_m(1.0 * k);
+    l.y_m(2.0 * k);
+    l.cov_xx_m2(0.01);
+    l.cov_xy_m2(0.001);
+    l.cov_yy_m2(0.02);
+    l.times_observed(static_cast<std::uint32_t>(i));
+    m.landmarks().push_back(l);
+  }
+  m.update_time_s(0.0001 * i);
+  m.odometry_sequence(static_cast<std::uint64_t>(5 * i));
+  m.observation_sequence(static_cast<std::uint64_t>(i));
+  return m;
+}
+
+msg::GroundTruth ground_truth(int i) {
+  msg::GroundTruth m;
+  m.header().stamp_ns(1'700'000'000'000'000'000ull + static_cast<std::uint64_t>(i) * 100'000'000ull + 3);
+  m.header().frame_id("map");
+  msg::Pose2D pose;
+  pose.x_m(0.2 * i);
+  m.pose(pose);
+  m.v_mps(0.3);
+  m.w_radps(0.01 * i);
+  for (int k = 0; k < 3; ++k) {
+    msg::TrueLandmark l;
+    l.landmark_id(10 + k);
+    l.x_m(1.5 * k);
+    l.y_m(-1.5 * k);
+    m.landmarks().push_back(l);
+  }
+  return m;
+}
+
+// Every message of `topic` in `reader`, decoded; checks the MCAP fields
+// against the header on the way.
+template <class Message>
+std::vector<Message> decoded(const logger::McapReader& reader, const std::string& topic) {
+  std::vector<Message> out;
+  const logger::McapChannel* channel = reader.find_channel(topic);
+  EXPECT_NE(channel, nullptr) << topic;
+  if (channel == nullptr) return out;
+  for (const logger::McapMessage& m : reader.messages()) {
+    if (m.channel_id != channel->id) continue;
+    Message message;
+    std::string error;
+    EXPECT_TRUE(from_cdr(m.data, message, error)) << topic << ": " << error;
+    EXPECT_EQ(m.sequence, static_cast<std::uint32_t>(message.header().seq())) << topic;
+    EXPECT_EQ(m.publish_time_ns, message.header().stamp_ns()) << topic;
+    out.push_back(message);
+  }
+  return out;
+}
+
+template <class Message>
+void expect_recorded(const logger::McapReader& reader, const std::vector<Message>& sent) {
+  const std::string topic(dds::MessageTraits<Message>::topic);
+  const std::vector<Message> got = decoded<Message>(reader, topic);
+  ASSERT_EQ(got.size(), sent.size()) << topic;
+  std::vector<std::uint64_t> seqs;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    EXPECT_EQ(got[i], sent[i]) << topic << " message " << i;
+    seqs.push_back(got[i].header().seq());
+  }
+  const SequenceReport r = analyze_sequence(seqs);
+  EXPECT_TRUE(r.complete()) << topic << ": " << describe(r);
+  EXPECT_EQ(r.backwards, 0u) << topic;
+  EXPECT_EQ(r.max, sent.size()) << topic;
+}
+
+// The recording that the log_tool_* ctests check with pixyslam_log (they set
+// PIXYSLAM_LOGGER_TEST_OUT to keep it): 500 Odometry, 50 LandmarkObservation,
+// 100 MapState, 20 GroundTruth.
+TEST(LoggerNode, RecordsEveryTopicExactly) {
+  const TempFile file("test_logger_recording", "PIXYSLAM_LOGGER_TEST_OUT");
+  const std::uint64_t start_ns = dds::now_ns();
+  LoggerNode node(node_options(file.path()));
+  node.start();
+
+  dds::Participant robot(loopback_options(), "test_robot");
+  dds::Writer<msg::Odometry> odometry_writer(robot);
+  dds::Writer<msg::LandmarkObservation> observation_writer(robot);
+  dds::Writer<msg::MapState> map_writer(robot);
+  dds::Writer<msg::GroundTruth> truth_writer(robot);
+  ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(map_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(truth_writer.wait_for_readers(1, std::chrono::seconds(10)));
+
+  std::vector<msg::Odometry> odometry_sent;
+  std::vector<msg::LandmarkObservation> observations_sent;
+  std::vector<msg::MapState> maps_sent;
+  std::vector<msg::GroundTruth> truths_sent;
+  for (int i = 0; i < 500; ++i) {
+    odometry_sent.push_back(odometry(i));
+    ASSERT_TRUE(odometry_writer.publish(odometry_sent.back()));  // fills seq and robot_id
+    if (i % 10 == 0) {
+      observations_sent.push_back(observation(i / 10));
+      ASSERT_TRUE(observation_writer.publish(observations_sent.back()));
+    }
+    if (i % 5 == 0) {
+      // The MapState writer keeps only the last sample (transient local, depth
+      // 1): at the estimator's pace every one arrives; a burst could lose some.
+      maps_sent.push_back(map_state(i / 5));
+      ASSERT_TRUE(map_writer.publish(maps_sent.back()));
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    if (i % 25 == 0) {
+      truths_sent.push_back(ground_truth(i / 25));
+      ASSERT_TRUE(truth_writer.publish(truths_sent.back()));
+    }
+  }
+  ASSERT_EQ(observations_sent.size(), 50u);
+  ASSERT_EQ(maps_sent.size(), 100u);
+  ASSERT_EQ(truths_sent.size(), 20u);
+  EXPECT_TRUE(wait_until(
+      [&] {
+        return received(node, "pixyslam/odometry") == 500 && received(node, "pixyslam/map_state") == 100 &&
+               received(node, "pixyslam/landmark_observation") == 50 && received(node, "pixyslam/ground_truth") == 20;
+      },
+      std::chrono::seconds(20)))
+      << node.counters_text();
+  node.stop();
+  const std::uint64_t end_ns = dds::now_ns();
+
+  const LoggerCounters c = node.counters();
+  EXPECT_TRUE(c.error.empty()) << c.error;
+  const std::map<std::string, std::uint64_t> expected = {{"pixyslam/odometry", 500},
+                                                         {"pixyslam/landmark_observation", 50},
+                                                         {"pixyslam/map_state", 100},
+                                                         {"pixyslam/ground_truth", 20}};
+  ASSERT_EQ(c.topics.size(), 4u);
+  for (const auto& [topic, count] : expected) {
+    const TopicCounters& t = topic_counters(c, topic);
+    EXPECT_EQ(t.received, count) << topic;
+    EXPECT_EQ(t.written, count) << topic;
+    EXPECT_EQ(t.dropped, 0u) << topic;
+    EXPECT_EQ(t.seq_gaps, 0u) << topic;
+  }
+  EXPECT_EQ(c.file.messages, 670u);
+  EXPECT_GT(c.file.chunks, 1u);
+  EXPECT_GT(c.queue_peak_messages, 0u);
+  EXPECT_NE(node.counters_text().find("pixyslam/odometry: received 500, written 500, dropped 0, seq gaps 0"),
+            std::string::npos)
+      << node.counters_text();
+
+  const logger::McapReader reader(file.path());
+  EXPECT_TRUE(reader.clean()) << reader.diagnostics_text();
+  ASSERT_TRUE(reader.statistics().has_value());
+  EXPECT_EQ(reader.statistics()->message_count, 670u);
+  EXPECT_EQ(reader.messages().size(), 670u);
+  for (const logger::McapChunkInfo& chunk : reader.chunks()) {
+    EXPECT_EQ(chunk.compression, logger::mcap_compression_name(default_compression()));
+  }
+
+  // Channels and schemas.
+  ASSERT_EQ(reader.channels().size(), 4u);
+  ASSERT_EQ(reader.schemas().size(), 4u);
+  for (const TopicInfo& info : known_topics()) {
+    const logger::McapChannel* channel = reader.find_channel(info.topic);
+    ASSERT_NE(channel, nullptr) << info.topic;
+    EXPECT_EQ(channel->message_encoding, "cdr");
+    EXPECT_EQ(channel->metadata.at("type_name"), info.type_name);
+    EXPECT_EQ(channel->metadata.at("robot_id"), "test_robot");
+    const logger::McapSchema* schema = reader.find_schema(channel->schema_id);
+    ASSERT_NE(schema, nullptr) << info.topic;
+    EXPECT_EQ(schema->name, info.type_name);
+    EXPECT_EQ(schema->encoding, "omgidl");
+    EXPECT_EQ(schema->data, std::string(msg::idl_text(info.idl_stem)));
+    EXPECT_NE(schema->data.find("struct MessageHeader"), std::string::npos);  // includes inlined
+  }
+
+  // Every message: bytes decode to what was sent; MCAP fields; times.
+  expect_recorded(reader, odometry_sent);
+  expect_recorded(reader, observations_sent);
+  expect_recorded(reader, maps_sent);
+  expect_recorded(reader, truths_sent);
+  std::uint64_t previous_log_time = 0;
+  for (const logger::McapMessage& m : reader.messages()) {
+    EXPECT_GE(m.log_time_ns, start_ns);
+    EXPECT_LE(m.log_time_ns, end_ns);
+    EXPECT_GE(m.log_time_ns, previous_log_time);  // written in receive order
+    previous_log_time = m.log_time_ns;
+  }
+  // The bytes are what a Fast DDS writer sends for that sample.
+  const logger::McapChannel* odometry_channel = reader.find_channel("pixyslam/odometry");
+  const auto first = std::find_if(reader.messages().begin(), reader.messages().end(),
+                                  [&](const logger::McapMessage& m) { return m.channel_id == odometry_channel->id; });
+  ASSERT_NE(first, reader.messages().end());
+  EXPECT_EQ(first->data, to_cdr(odometry_sent.front()));
+}
+
+TEST(LoggerNode, DropsAndCountsSamplesBeyondTheQueueBound) {
+  const TempFile file("test_logger_bound");
+  LoggerOptions options = node_options(file.path());
+  options.topics = {"pixyslam/odometry"};
+  dds::Participant robot(loopback_options(), "test_robot");
+  dds::Writer<msg::Odometry> writer(robot);
+  // Room for exactly 10 samples of this size (robot_id and frame_id fixed).
+  msg::Odometry probe = odometry(0);
+  probe.header().robot_id("test_robot");
+  options.queue_max_bytes = 10 * to_cdr(probe).size();
+
+  LoggerNode node(options);  // not started: nothing leaves the queue
+  ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(10)));
+  for (int i = 0; i < 30; ++i) {
+    msg::Odometry m = odometry(i);
+    ASSERT_TRUE(writer.publish(m));
+  }
+  ASSERT_TRUE(wait_until([&] { return received(node, "pixyslam/odometry") == 30; }, std::chrono::seconds(10)))
+      << node.counters_text();
+  LoggerCounters c = node.counters();
+  EXPECT_EQ(c.topics[0].dropped, 20u);
+  EXPECT_EQ(c.queue_peak_messages, 10u);
+  EXPECT_EQ(c.queue_peak_bytes, options.queue_max_bytes);
+
+  node.stop();  // writes what is queued, then closes
+  c = node.counters();
+  EXPECT_EQ(c.topics[0].written, 10u);
+  EXPECT_EQ(c.topics[0].dropped, 20u);
+  const logger::McapReader reader(file.path());
+  EXPECT_TRUE(reader.clean()) << reader.diagnostics_text();
+  ASSERT_EQ(reader.messages().size(), 10u);
+  EXPECT_EQ(reader.channels().size(), 1u);
+  std::vector<std::uint64_t> seqs;
+  for (const logger::McapMessage& m : reader.messages()) seqs.push_back(m.sequence);
+  EXPECT_EQ(describe(analyze_sequence(seqs)), "seq 1..10");
+}
+
+TEST(LoggerNode, FlushTimerBoundsWhatACrashLoses) {
+  const TempFile file("test_logger_flush");
+  LoggerOptions options = node_options(file.path());
+  options.topics = {"pixyslam/odometry"};
+  options.chunk_size_bytes = std::size_t{1} << 20;  // never full in this test
+  options.flush_period_s = 0.2;
+  LoggerNode node(options);
+  node.start();
+  dds::Participant robot(loopback_options(), "test_robot");
+  dds::Writer<msg::Odometry> writer(robot);
+  ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(10)));
+  for (int i = 0; i < 50; ++i) {
+    msg::Odometry m = odometry(i);
+    ASSERT_TRUE(writer.publish(m));
+  }
+  ASSERT_TRUE(wait_until([&] { return node.counters().topics[0].written == 50; }, std::chrono::seconds(10)))
+      << node.counters_text();
+  // Still recording (no footer yet), as a killed logger would leave the file.
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  {
+    const logger::McapReader reader(file.path());
+    EXPECT_FALSE(reader.recovery().footer_present);
+    EXPECT_EQ(reader.recovery().messages_recovered, 50u) << reader.diagnostics_text();
+    EXPECT_EQ(reader.messages().size(), 50u);
+  }
+  node.stop();
+  const logger::McapReader reader(file.path());
+  EXPECT_TRUE(reader.clean()) << reader.diagnostics_text();
+  EXPECT_EQ(reader.messages().size(), 50u);
+}
+
+TEST(LoggerNode, UnwritableFileIsAnErrorNamingIt) {
+  LoggerOptions options = node_options("/nonexistent_dir/run.mcap");
+  try {
+    LoggerNode node(options);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent_dir/run.mcap"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace pixyslam::logger_node

@@ -1,0 +1,447 @@
+// The pixy bridge's node layer: message conversion, options, and the node
+// driven by a scripted byte source (Pixy frames from encode_frame, garbage and
+// a corrupted block mixed in), publishing LandmarkObservation over DDS on the
+// loopback profile to a reader in the same test.
+#include <unistd.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "pixyslam/bridge/byte_source.h"
+#include "pixyslam/dds/endpoints.h"
+#include "pixyslam/pixy/pixy_block_parser.h"
+#include "pixyslam/pixy/pixy_geometry.h"
+#include "pixyslam/pixy_node/observation_conversions.h"
+#include "pixyslam/pixy_node/pixy_node.h"
+#include "pixyslam/pixy_node/pixy_node_options.h"
+
+namespace pixyslam::pixy_node {
+namespace {
+
+using std::chrono::milliseconds;
+
+// Blocks of the shipped signature map (config/pixy_bridge.yaml): "12" -> 1, "13" -> 2.
+pixy::PixyBlock landmark_1() {
+  pixy::PixyBlock b;
+  b.colour_code = true;
+  b.signature = 012;
+  b.x = 160;
+  b.y = 100;
+  b.width = 20;
+  b.height = 42;  // height/width 2.1
+  b.angle_deg = -3;
+  return b;
+}
+
+pixy::PixyBlock landmark_2() {
+  pixy::PixyBlock b;
+  b.colour_code = true;
+  b.signature = 013;
+  b.x = 80;
+  b.y = 90;
+  b.width = 10;
+  b.height = 21;
+  b.angle_deg = 5;
+  return b;
+}
+
+pixy::PixyBlock unknown_code() {  // tags 7, 7: not in the map
+  pixy::PixyBlock b = landmark_1();
+  b.signature = 077;
+  return b;
+}
+
+// ---------------------------------------------------------------- conversions
+
+TEST(ObservationConversions, BlockAndDetectionKeepEveryField) {
+  pixy::Detection d;
+  d.landmark_id = 7;
+  d.range_m = 1.25;
+  d.bearing_rad = -0.1;
+  d.range_sigma_m = 0.0625;
+  d.bearing_sigma_rad = 0.027;
+  d.block = landmark_1();
+  const msg::LandmarkDetection m = to_detection_msg(d);
+  EXPECT_EQ(m.landmark_id(), 7);
+  EXPECT_DOUBLE_EQ(m.range_m(), 1.25);
+  EXPECT_DOUBLE_EQ(m.bearing_rad(), -0.1);
+  EXPECT_DOUBLE_EQ(m.range_sigma_m(), 0.0625);
+  EXPECT_DOUBLE_EQ(m.bearing_sigma_rad(), 0.027);
+  EXPECT_EQ(m.block().signature(), 012);
+  EXPECT_EQ(m.block().x_px(), 160);
+  EXPECT_EQ(m.block().y_px(), 100);
+  EXPECT_EQ(m.block().width_px(), 20);
+  EXPECT_EQ(m.block().height_px(), 42);
+  EXPECT_EQ(m.block().angle_deg(), -3);
+}
+
+TEST(ObservationConversions, FrameCountsBlocksAndRejections) {
+  pixy::PixyFrame frame;
+  frame.index = 41;
+  frame.blocks = {landmark_1(), unknown_code(), landmark_2()};
+  pixy::Detection d;
+  d.landmark_id = 1;
+  d.block = landmark_1();
+  const msg::LandmarkObservation m = to_observation_msg(frame, {d}, 123456789u);
+  EXPECT_EQ(m.header().stamp_ns(), 123456789u);
+  EXPECT_EQ(m.header().frame_id(), "camera");
+  EXPECT_EQ(m.camera_frame(), 41u);
+  EXPECT_EQ(m.blocks_in_frame(), 3u);
+  EXPECT_EQ(m.blocks_rejected(), 2u);
+  ASSERT_EQ(m.detections().size(), 1u);
+  EXPECT_EQ(m.detections()[0].landmark_id(), 1);
+
+  const msg::LandmarkObservation empty = to_observation_msg(pixy::PixyFrame{}, {}, 5u);
+  EXPECT_EQ(empty.blocks_in_frame(), 0u);
+  EXPECT_EQ(empty.blocks_rejected(), 0u);
+  EXPECT_TRUE(empty.detections().empty());
+}
+
+TEST(ObservationConversions, DetectionsBeyondTheBoundAreLeftOut) {
+  pixy::PixyFrame frame;
+  std::vector<pixy::Detection> detections(kMaxDetectionsPerMessage + 6);
+  frame.blocks.resize(detections.size());
+  for (std::size_t i = 0; i < detections.size(); ++i) detections[i].landmark_id = static_cast<int>(i);
+  const msg::LandmarkObservation m = to_observation_msg(frame, detections, 1u);
+  ASSERT_EQ(m.detections().size(), kMaxDetectionsPerMessage);
+  EXPECT_EQ(m.detections().back().landmark_id(), static_cast<int>(kMaxDetectionsPerMessage) - 1);
+  EXPECT_EQ(m.blocks_rejected(), 0u);
+}
+
+// ---------------------------------------------------------------- options
+
+std::string config_error_of(const std::string& text) {
+  try {
+    auto root = config::YamlReader::from_string(text, "test.yaml");
+    read_pixy_node_options(root, "/cfg");
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+const char* kPixyYaml = "pixy:\n  landmark_height_m: 0.08\n  landmarks:\n    \"12\": 1\n";
+
+TEST(PixyNodeOptions, ShippedConfigLoadsWithNodeAndDds) {
+  const PixyNodeOptions o = read_pixy_node_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/pixy_bridge.yaml");
+  EXPECT_EQ(o.serial_device, "/dev/serial0");
+  EXPECT_EQ(o.baud, 19200);
+  EXPECT_DOUBLE_EQ(o.camera_latency_s, 0.0);
+  EXPECT_EQ(o.pixy.signatures.size(), 20u);
+  EXPECT_EQ(o.dds.profiles_file, std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml");
+}
+
+TEST(PixyNodeOptions, EffectiveConfigurationReadsBack) {
+  auto root = config::YamlReader::from_string(
+      std::string("node:\n  serial_device: /dev/ttyUSB3\n  baud: 115200\n  camera_latency_s: 0.02\n"
+                  "  frame_timeout_s: 0.1\n  reopen_period_s: 2\n  status_period_s: 5\n") +
+          kPixyYaml + "dds:\n  robot_id: r2\n  profiles_file: p.xml\n",
+      "test.yaml");
+  const PixyNodeOptions o = read_pixy_node_options(root, "/cfg");
+  EXPECT_EQ(o.dds.profiles_file, "/cfg/p.xml");
+  auto again_root = config::YamlReader::from_string(to_yaml(o), "again.yaml");
+  const PixyNodeOptions again = read_pixy_node_options(again_root, "/elsewhere");
+  EXPECT_EQ(to_yaml(again), to_yaml(o));
+  EXPECT_EQ(again.serial_device, "/dev/ttyUSB3");
+  EXPECT_EQ(again.baud, 115200);
+  EXPECT_DOUBLE_EQ(again.camera_latency_s, 0.02);
+  EXPECT_DOUBLE_EQ(again.frame_timeout_s, 0.1);
+  EXPECT_DOUBLE_EQ(again.process.reopen_period_s, 2.0);
+  EXPECT_DOUBLE_EQ(again.process.status_period_s, 5.0);
+  EXPECT_EQ(again.pixy.signatures.landmark_of_signature(012), std::optional<int>(1));
+  EXPECT_EQ(again.dds.robot_id, "r2");
+}
+
+TEST(PixyNodeOptions, ErrorsNameTheFileAndTheKey) {
+  struct Case {
+    std::string yaml;
+    std::string expected;
+  };
+  const std::string pixy = kPixyYaml;
+  const std::vector<Case> cases = {
+      {"node:\n  baud: 12345\n" + pixy, "test.yaml: key 'node.baud': value 12345 is not a supported serial rate"},
+      {"node:\n  serial_device: ttyS0\n" + pixy, "test.yaml: key 'node.serial_device': value 'ttyS0' is not an absolute path"},
+      {"node:\n  camera_latency_s: 2\n" + pixy, "test.yaml: key 'node.camera_latency_s': value 2"},
+      {"node:\n  reopen_period_s: 0\n" + pixy, "test.yaml: key 'node.reopen_period_s'"},
+      {"node:\n  latency_s: 0\n" + pixy, "test.yaml: key 'node.latency_s': unknown key"},
+      {pixy + "dds:\n  domain_id: -1\n", "test.yaml: key 'dds.domain_id'"},
+      {pixy + "extra: 1\n", "test.yaml: key 'extra': unknown key"},
+      {"node: {}\n", "test.yaml: key 'pixy': missing"},
+  };
+  for (const Case& c : cases) {
+    const std::string e = config_error_of(c.yaml);
+    EXPECT_NE(e.find(c.expected), std::string::npos) << "got: " << e << "\nyaml:\n" << c.yaml;
+  }
+}
+
+TEST(PixyNodeOptions, FileErrorsNameThePath) {
+  const std::string path = ::testing::TempDir() + "pixy_node_options_" + std::to_string(::getpid()) + ".yaml";
+  {
+    std::ofstream out(path);
+    out << "node:\n  frame_timeout_s: 0\n" << kPixyYaml;
+  }
+  try {
+    read_pixy_node_options_file(path);
+    ADD_FAILURE() << "expected a config error";
+  } catch (const config::ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path + ": key 'node.frame_timeout_s'"), std::string::npos) << what;
+  }
+  std::remove(path.c_str());
+}
+
+// ---------------------------------------------------------------- the node over DDS
+
+// The shipped loopback profile on a domain and with a robot id of this
+// process: test cases that ctest runs at the same time (each in a process of
+// its own) neither share ports nor see each other's messages.
+dds::DdsOptions loopback_options() {
+  dds::DdsOptions o;
+  o.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml";
+  o.domain_id = 170 + static_cast<int>(::getpid() % 60);
+  o.robot_id = "pixy_test_" + std::to_string(::getpid());
+  return o;
+}
+
+// Collects the observations the test's own participant receives. One for the
+// whole program, created before any node: the loopback profile's initial
+// peers reach participants 0-3 of a domain on this host (Fast DDS's default
+// range), ids are never reused within a process, and two participants can
+// find each other when one of them is in that range.
+class ObservationInbox {
+ public:
+  static ObservationInbox& instance() {
+    if (slot() == nullptr) slot() = new ObservationInbox;  // deleted by InboxCleanup
+    return *slot();
+  }
+  static void destroy() {
+    delete slot();
+    slot() = nullptr;
+  }
+
+  // Forgets what arrived so far (messages of earlier tests).
+  void clear() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    got_.clear();
+  }
+  std::vector<msg::LandmarkObservation> wait_for(std::size_t count, milliseconds timeout) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait_for(lock, timeout, [&] { return got_.size() >= count; });
+    return got_;
+  }
+  std::uint64_t lost() const { return reader_.lost(); }
+
+ private:
+  static ObservationInbox*& slot() {
+    static ObservationInbox* inbox = nullptr;
+    return inbox;
+  }
+  ObservationInbox()
+      : participant_(loopback_options(), "test_observation_reader"),
+        reader_(participant_, [this](const msg::LandmarkObservation& m) {
+          if (m.header().robot_id() != loopback_options().robot_id) return;
+          std::lock_guard<std::mutex> lock(mutex_);
+          got_.push_back(m);
+          cv_.notify_all();
+        }) {}
+
+  dds::Participant participant_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::vector<msg::LandmarkObservation> got_;
+  dds::Reader<msg::LandmarkObservation> reader_;
+};
+
+// Destroys the inbox before main returns (DDS entities must not outlive main).
+class InboxCleanup : public ::testing::Environment {
+ public:
+  void TearDown() override { ObservationInbox::destroy(); }
+};
+::testing::Environment* const kInboxCleanup = ::testing::AddGlobalTestEnvironment(new InboxCleanup);
+
+constexpr std::uint64_t kBaseNs = 1700000000000000000ull;
+constexpr std::uint64_t kFrameNs = 20000000ull;  // 50 frames per second
+constexpr std::uint64_t kLatencyNs = 3000000ull;
+
+std::uint64_t arrival_ns(std::size_t frame) { return kBaseNs + kFrameNs * frame; }
+
+// Frame i: 0 mod 4 -> landmark 1; 1 -> landmarks 1 and 2 and an unknown code;
+// 2 -> no blocks; 3 -> only the unknown code.
+std::vector<pixy::PixyBlock> blocks_of_frame(std::size_t i) {
+  switch (i % 4) {
+    case 0: return {landmark_1()};
+    case 1: return {landmark_1(), landmark_2(), unknown_code()};
+    case 2: return {};
+    default: return {unknown_code()};
+  }
+}
+
+TEST(PixyNode, PublishesOneObservationPerFrameAndSkipsBadBytes) {
+  // Given 20 camera frames, one chunk each, with garbage before some frames
+  // and a corrupted block inside frame 5,
+  constexpr std::size_t kFrames = 20;
+  auto script = std::make_shared<bridge::ByteScript>();
+  const std::vector<std::uint8_t> garbage = {0x01, 0x02, 0x03};
+  std::size_t garbage_bytes = 0;
+  for (std::size_t i = 0; i < kFrames; ++i) {
+    std::vector<std::uint8_t> chunk;
+    if (i % 8 == 0 && i > 0) {  // never right after an empty frame's lone sync word
+      chunk = garbage;
+      garbage_bytes += garbage.size();
+    }
+    const std::vector<std::uint8_t> frame = pixy::encode_frame(blocks_of_frame(i));
+    chunk.insert(chunk.end(), frame.begin(), frame.end());
+    if (i == 5) {
+      std::vector<std::uint8_t> bad;
+      pixy::encode_block(landmark_2(), bad);
+      bad[6] ^= 0x40;  // x changes, the checksum no longer matches
+      chunk.insert(chunk.end(), bad.begin(), bad.end());
+    }
+    script->add_bytes(chunk, arrival_ns(i));
+  }
+  // The camera then sends nothing: the last frame completes by frame_timeout_s.
+  script->add_idle(arrival_ns(kFrames - 1) + 1000000000ull);
+
+  PixyNodeOptions options;
+  options.pixy = [] {
+    auto root = config::YamlReader::from_file(std::string(PIXYSLAM_CONFIG_DIR) + "/pixy_bridge.yaml");
+    return read_pixy_node_options(root, PIXYSLAM_CONFIG_DIR).pixy;
+  }();
+  options.dds = loopback_options();
+  options.camera_latency_s = 1e-9 * static_cast<double>(kLatencyNs);
+  options.process.status_period_s = 0.0;
+  std::vector<std::string> log;
+  std::mutex log_mutex;
+  ObservationInbox& inbox = ObservationInbox::instance();
+  inbox.clear();
+  PixyNode node(
+      options, std::make_unique<bridge::ScriptedByteSource>(script, "/dev/pixy_test"),
+      [&](const std::string& line) {
+        std::lock_guard<std::mutex> lock(log_mutex);
+        log.push_back(line);
+      },
+      bridge::ByteScript::clock(script));
+  ASSERT_TRUE(node.wait_for_subscribers(1, std::chrono::seconds(10)));
+  node.start();
+
+  // Then one observation per frame arrives, in order, also for frames without
+  // detections, stamped when the frame's last block was read minus the latency.
+  std::vector<msg::LandmarkObservation> got = inbox.wait_for(kFrames, std::chrono::seconds(10));
+  ASSERT_EQ(got.size(), kFrames);
+  std::this_thread::sleep_for(milliseconds(200));
+  ASSERT_EQ(inbox.wait_for(kFrames + 1, milliseconds(1)).size(), kFrames) << "an extra message";
+  node.stop();
+
+  const pixy::CameraModel camera = options.pixy.camera;
+  for (std::size_t i = 0; i < kFrames; ++i) {
+    SCOPED_TRACE("frame " + std::to_string(i));
+    const msg::LandmarkObservation& m = got[i];
+    EXPECT_EQ(m.header().seq(), i + 1);
+    EXPECT_EQ(m.header().robot_id(), loopback_options().robot_id);
+    EXPECT_EQ(m.header().frame_id(), "camera");
+    EXPECT_EQ(m.camera_frame(), i);
+    // A frame without blocks is known only when the next frame's first word
+    // arrives (a lone sync word is ambiguous until then).
+    const std::size_t read_with = blocks_of_frame(i).empty() ? i + 1 : i;
+    EXPECT_EQ(m.header().stamp_ns(), arrival_ns(read_with) - kLatencyNs);
+    switch (i % 4) {
+      case 0:
+        EXPECT_EQ(m.blocks_in_frame(), 1u);
+        EXPECT_EQ(m.blocks_rejected(), 0u);
+        ASSERT_EQ(m.detections().size(), 1u);
+        break;
+      case 1:
+        EXPECT_EQ(m.blocks_in_frame(), 3u);  // frame 5's corrupted block is not counted
+        EXPECT_EQ(m.blocks_rejected(), 1u);
+        ASSERT_EQ(m.detections().size(), 2u);
+        EXPECT_EQ(m.detections()[1].landmark_id(), 2);
+        EXPECT_DOUBLE_EQ(m.detections()[1].range_m(), pixy::range_m(camera, 21));
+        break;
+      case 2:
+        EXPECT_EQ(m.blocks_in_frame(), 0u);
+        EXPECT_TRUE(m.detections().empty());
+        break;
+      default:
+        EXPECT_EQ(m.blocks_in_frame(), 1u);
+        EXPECT_EQ(m.blocks_rejected(), 1u);
+        EXPECT_TRUE(m.detections().empty());
+    }
+    if (!m.detections().empty()) {
+      const msg::LandmarkDetection& d = m.detections()[0];
+      EXPECT_EQ(d.landmark_id(), 1);
+      EXPECT_DOUBLE_EQ(d.range_m(), pixy::range_m(camera, 42));
+      EXPECT_DOUBLE_EQ(d.bearing_rad(), pixy::bearing_rad(camera, 160));
+      EXPECT_DOUBLE_EQ(d.range_sigma_m(), camera.range_sigma_fraction * pixy::range_m(camera, 42));
+      EXPECT_DOUBLE_EQ(d.bearing_sigma_rad(), camera.bearing_sigma_rad);
+      EXPECT_EQ(d.block().signature(), 012);
+      EXPECT_EQ(d.block().x_px(), 160);
+      EXPECT_EQ(d.block().height_px(), 42);
+      EXPECT_EQ(d.block().angle_deg(), -3);
+    }
+  }
+  EXPECT_EQ(inbox.lost(), 0u);
+
+  // And the bad bytes were counted and skipped.
+  const PixyNodeCounters c = node.counters();
+  EXPECT_EQ(c.parser.frames, kFrames);
+  EXPECT_EQ(c.parser.checksum_errors, 1u);
+  EXPECT_GE(c.parser.bytes_skipped, garbage_bytes);
+  EXPECT_GE(c.parser.resyncs, 2u);
+  EXPECT_EQ(c.published, kFrames);
+  EXPECT_EQ(c.frames_timed_out, 1u);
+  EXPECT_EQ(c.detections.detections, 5u * 1 + 5u * 2);
+  EXPECT_EQ(c.detections.unknown_signature, 5u + 5u);
+  std::lock_guard<std::mutex> lock(log_mutex);
+  bool final_status = false;
+  for (const std::string& line : log) final_status |= line.find("final status: frames 20") != std::string::npos;
+  EXPECT_TRUE(final_status);
+}
+
+TEST(PixyNode, MissingDeviceIsLoggedAndRetried) {
+  auto script = std::make_shared<bridge::ByteScript>();
+  script->fail_next_opens(3);
+  const std::vector<std::uint8_t> frame = pixy::encode_frame({landmark_1()});
+  script->add_bytes(frame, kBaseNs);
+  script->add_bytes(frame, kBaseNs + kFrameNs);
+  PixyNodeOptions options;
+  options.pixy.signatures.add(012, 1);
+  options.dds = loopback_options();
+  options.process.reopen_period_s = 0.01;
+  options.process.status_period_s = 0.0;
+  std::vector<std::string> log;
+  std::mutex log_mutex;
+  ObservationInbox& inbox = ObservationInbox::instance();
+  inbox.clear();
+  PixyNode node(
+      options, std::make_unique<bridge::ScriptedByteSource>(script, "/dev/ttyPIXY9"),
+      [&](const std::string& line) {
+        std::lock_guard<std::mutex> lock(log_mutex);
+        log.push_back(line);
+      },
+      bridge::ByteScript::clock(script));
+  ASSERT_TRUE(node.wait_for_subscribers(1, std::chrono::seconds(10)));
+  node.start();
+  EXPECT_EQ(inbox.wait_for(1, std::chrono::seconds(10)).size(), 1u);  // frame 0; frame 1 still open
+  node.stop();
+  EXPECT_EQ(node.counters().device.open_failures, 3u);
+  std::lock_guard<std::mutex> lock(log_mutex);
+  ASSERT_FALSE(log.empty());
+  bool named = false;
+  for (const std::string& line : log) {
+    named |= line.find("cannot open serial device '/dev/ttyPIXY9'") != std::string::npos;
+  }
+  EXPECT_TRUE(named);
+}
+
+}  // namespace
+}  // namespace pixyslam::pixy_node
