@@ -585,9 +585,9 @@ TEST(RobotSimConfig, ShippedFilesLoadAndShareOneTruth) {
   const std::string dir = PIXYSLAM_CONFIG_DIR;
   const RobotSimConfig c =
       load_robot_sim_config(dir + "/robot_sim.yaml", dir + "/pixy_bridge.yaml", dir + "/encoder_bridge.yaml");
-  // robot_sim.yaml lists the defaults, but for poles of ratio 2.1 (80 x 38 mm).
+  // robot_sim.yaml lists the defaults, but for poles that image at 2.1:1 (80 x 42 mm).
   HardwareOptions expected;
-  expected.pole_width_m = 0.038;
+  expected.pole_width_m = 0.042;
   EXPECT_EQ(to_yaml(c.hardware), to_yaml(expected));
   EXPECT_EQ(c.encoder.ticks_per_revolution, 1320);
   EXPECT_DOUBLE_EQ(c.pixy.camera.landmark_height_m, 0.08);

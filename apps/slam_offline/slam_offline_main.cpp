@@ -9,6 +9,7 @@
 #include <map>
 #include <string>
 
+#include "hardware_input.h"
 #include "mrclam_dataset.h"
 #include "offline_run.h"
 #include "pixyslam/config/yaml_reader.h"
@@ -22,7 +23,10 @@ using namespace pixyslam;
 
 constexpr const char* kUsage =
     "usage: slam_offline sim    --config FILE --out DIR [--seed S]\n"
-    "       slam_offline mrclam --dataset DIR --robot N --config FILE --out DIR [--seed S]\n";
+    "       slam_offline mrclam --dataset DIR --robot N --config FILE --out DIR [--seed S]\n"
+    "       slam_offline hardware --config FILE --sim-config FILE --out DIR [--seed S] [--duration S]\n"
+    "         (hardware: the robot_sim hardware decoded by the bridges' parsers; the\n"
+    "          pixy/encoder configs are taken from beside --sim-config)\n";
 
 struct Args {
   std::string mode;
@@ -38,10 +42,12 @@ Args parse_args(int argc, char** argv) {
   if (argc < 2) throw std::invalid_argument("missing mode (sim or mrclam)");
   Args a;
   a.mode = argv[1];
-  if (a.mode != "sim" && a.mode != "mrclam") throw std::invalid_argument("unknown mode '" + a.mode + "'");
+  if (a.mode != "sim" && a.mode != "mrclam" && a.mode != "hardware") {
+    throw std::invalid_argument("unknown mode '" + a.mode + "'");
+  }
   for (int i = 2; i < argc; ++i) {
     const std::string key = argv[i];
-    static const char* known[] = {"--config", "--out", "--seed", "--dataset", "--robot"};
+    static const char* known[] = {"--config", "--out", "--seed", "--dataset", "--robot", "--sim-config", "--duration"};
     bool ok = false;
     for (const char* k : known) ok = ok || key == k;
     if (!ok) throw std::invalid_argument("unknown argument '" + key + "'");
@@ -78,7 +84,20 @@ int run(const Args& args) {
 
   offline::RunInput input;
   std::string title;
-  if (args.mode == "sim") {
+  if (args.mode == "hardware") {
+    // The estimator's file: only its filter matters offline.
+    const std::string sim_config = args.get("sim-config");
+    const std::string folder = std::filesystem::path(sim_config).parent_path().string();
+    robot_sim::RobotSimConfig hw = robot_sim::load_robot_sim_config(
+        sim_config, (std::filesystem::path(folder) / "pixy_bridge.yaml").string(),
+        (std::filesystem::path(folder) / "encoder_bridge.yaml").string());
+    if (args.values.count("seed")) hw.hardware.seed = options.seed;
+    double duration = 85.0;
+    if (args.values.count("duration")) duration = std::stod(args.get("duration"));
+    input = offline::hardware_input(hw, duration);
+    title = "emulated hardware, " + std::to_string(input.landmarks.size()) + " visible poles, " +
+            std::to_string(input.frames.size()) + " frames with detections";
+  } else if (args.mode == "sim") {
     config::YamlReader world_yaml = root.child("world");
     const sim::WorldOptions world = sim::read_world_options(world_yaml);
     root.finish();

@@ -29,6 +29,15 @@ void validate(const CameraModel& c) {
   require(std::isfinite(c.range_sigma_fraction) && c.range_sigma_fraction > 0.0,
           "range_sigma_fraction must be > 0");
   require(std::isfinite(c.bearing_sigma_rad) && c.bearing_sigma_rad > 0.0, "bearing_sigma_rad must be > 0");
+  require(std::isfinite(c.range_sigma_floor_m) && c.range_sigma_floor_m >= 0.0, "range_sigma_floor_m must be >= 0");
+  require(std::isfinite(c.block_height_sigma_px) && c.block_height_sigma_px >= 0.0,
+          "block_height_sigma_px must be >= 0");
+}
+
+double range_sigma_m(const CameraModel& c, double range, double block_height_px) {
+  const double proportional = c.range_sigma_fraction * range;
+  const double pixel = block_height_px > 0.0 ? range * c.block_height_sigma_px / block_height_px : 0.0;
+  return std::sqrt(c.range_sigma_floor_m * c.range_sigma_floor_m + proportional * proportional + pixel * pixel);
 }
 
 double range_m(const CameraModel& c, double block_height_px) {
@@ -138,7 +147,7 @@ std::vector<Detection> to_detections(const PixyFrame& frame, const SignatureMap&
     d.landmark_id = *id;
     d.range_m = range_m(camera, b.height);
     d.bearing_rad = bearing_rad(camera, b.x);
-    d.range_sigma_m = camera.range_sigma_fraction * d.range_m;
+    d.range_sigma_m = range_sigma_m(camera, d.range_m, b.height);
     d.bearing_sigma_rad = camera.bearing_sigma_rad;
     d.block = b;
 

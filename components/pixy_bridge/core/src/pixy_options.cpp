@@ -57,6 +57,8 @@ PixyOptions read_pixy_options(config::YamlReader& p) {
   }
   c.range_sigma_fraction = p.number("range_sigma_fraction", 1e-6, 1.0, c.range_sigma_fraction);
   c.bearing_sigma_rad = p.number("bearing_sigma_rad", 1e-6, 1.0, c.bearing_sigma_rad);
+  c.range_sigma_floor_m = p.number("range_sigma_floor_m", 0.0, 10.0, c.range_sigma_floor_m);
+  c.block_height_sigma_px = p.number("block_height_sigma_px", 0.0, 100.0, c.block_height_sigma_px);
   config::YamlReader lm = p.child("landmarks");
   o.signatures = read_landmarks(lm);
   p.finish();

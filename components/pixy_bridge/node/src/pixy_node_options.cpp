@@ -70,6 +70,8 @@ std::string to_yaml(const PixyNodeOptions& o) {
      << "  min_height_to_width: " << yaml_number(c.min_height_to_width) << "\n"
      << "  max_height_to_width: " << yaml_number(c.max_height_to_width) << "\n"
      << "  range_sigma_fraction: " << yaml_number(c.range_sigma_fraction) << "\n"
+     << "  range_sigma_floor_m: " << yaml_number(c.range_sigma_floor_m) << "\n"
+     << "  block_height_sigma_px: " << yaml_number(c.block_height_sigma_px) << "\n"
      << "  bearing_sigma_rad: " << yaml_number(c.bearing_sigma_rad) << "\n"
      << "  landmarks:" << (o.pixy.signatures.size() == 0 ? " {}" : "") << "\n";
   for (const auto& [signature, id] : o.pixy.signatures.entries()) {

@@ -29,9 +29,12 @@ struct CameraModel {
   double min_height_to_width = 2.0;
   double max_height_to_width = 2.2;
 
-  // Noise attached to every detection: range sd = range_sigma_fraction * range
-  // (Eq. 5 gives dr/r = -dh_s/h_s, so a fixed pixel error is a fixed fraction).
+  // Noise attached to every detection (see range_sigma_m below): a floor, a
+  // fraction of the range, and the block height's pixel error through Eq. 5
+  // (dr/r = -dh_s/h_s: one pixel matters more the smaller the block).
   double range_sigma_fraction = 0.05;
+  double range_sigma_floor_m = 0.0;
+  double block_height_sigma_px = 0.0;
   double bearing_sigma_rad = 0.027;
 };
 
@@ -43,6 +46,10 @@ void validate(const CameraModel& camera);
 // (Strictly the depth along the optical axis; the paper uses it as the range.)
 // Infinite for a height of 0.
 double range_m(const CameraModel& camera, double block_height_px);
+
+// Range sd of a detection at `range` from a block `block_height_px` tall:
+//   sqrt(floor^2 + (fraction r)^2 + (r sigma_px / h_s)^2).
+double range_sigma_m(const CameraModel& camera, double range, double block_height_px);
 
 // Bearing to a block centred on column `block_x_px`, seed paper Eq. 6:
 //   phi = atan(w_s * S_w / (f * I_w)), w_s = I_w / 2 - x.
