@@ -322,3 +322,17 @@ TEST(PixyOptions, ShippedConfigLoads) {
   EXPECT_EQ(o.signatures.entries().size(), 20u);
   EXPECT_DOUBLE_EQ(o.camera.focal_length_mm, 2.8);
 }
+
+TEST(RangeSigma, CombinesFloorFractionAndPixelError) {
+  pixyslam::pixy::CameraModel c;
+  c.range_sigma_floor_m = 0.07;
+  c.range_sigma_fraction = 0.01;
+  c.block_height_sigma_px = 0.5;
+  // At 2 m from a 9.2 px block: sqrt(0.07^2 + 0.02^2 + (2 * 0.5 / 9.2)^2).
+  EXPECT_NEAR(pixyslam::pixy::range_sigma_m(c, 2.0, 9.2), std::sqrt(0.0049 + 0.0004 + std::pow(1.0 / 9.2, 2)), 1e-12);
+  // The pixel term grows with the square of the range at fixed pole size.
+  const double near = pixyslam::pixy::range_sigma_m(c, 0.5, 36.8);
+  const double far = pixyslam::pixy::range_sigma_m(c, 3.0, 6.13);
+  EXPECT_LT(near, 0.075);
+  EXPECT_GT(far, 0.25);
+}

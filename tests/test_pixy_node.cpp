@@ -381,7 +381,7 @@ TEST(PixyNode, PublishesOneObservationPerFrameAndSkipsBadBytes) {
       EXPECT_EQ(d.landmark_id(), 1);
       EXPECT_DOUBLE_EQ(d.range_m(), pixy::range_m(camera, 42));
       EXPECT_DOUBLE_EQ(d.bearing_rad(), pixy::bearing_rad(camera, 160));
-      EXPECT_DOUBLE_EQ(d.range_sigma_m(), camera.range_sigma_fraction * pixy::range_m(camera, 42));
+      EXPECT_DOUBLE_EQ(d.range_sigma_m(), pixy::range_sigma_m(camera, pixy::range_m(camera, 42), 42));
       EXPECT_DOUBLE_EQ(d.bearing_sigma_rad(), camera.bearing_sigma_rad);
       EXPECT_EQ(d.block().signature(), 012);
       EXPECT_EQ(d.block().x_px(), 160);
