@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Integration test of the whole system on loopback: robot_sim, both bridges,
+# the estimator, the logger and the evaluator started by pixyslam_launch from
+# a copy of config/ on a DDS domain of its own. Passes if every process ends
+# cleanly, the evaluator's ATE is under MAX_ATE (so MapState arrived and the
+# map is near the truth), and the log holds every message each publisher sent
+# (seq 1..N per topic, N = the publisher's own count).
+#   run_system_test.sh BIN_DIR CONFIG_DIR SIM_DURATION_S MAX_ATE_M
+set -euo pipefail
+bin=$1 config=$2 duration=$3 max_ate=$4
+work=$(mktemp -d /tmp/pixyslam_system_test.XXXXXX)
+trap 'rm -rf "$work"' EXIT
+cp -r "$config" "$work/config"
+domain=$((120 + $$ % 100))
+sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/config/*.yaml
+sed -i "s/^  duration_s: [0-9.]* /  duration_s: $duration /" "$work/config/robot_sim.yaml"
+sed -i "s/--max-ate, '0.10'/--max-ate, '$max_ate'/" "$work/config/launch_sim.yaml"
+
+status=0
+"$bin/pixyslam_launch" "$work/config/launch_sim.yaml" --run-dir "$work/run" > "$work/out.log" 2>&1 || status=$?
+grep -v "robot_sim: t \|status: " "$work/out.log"
+if [[ $status -ne 0 ]]; then
+  echo "FAIL: pixyslam_launch exited with $status"
+  exit 1
+fi
+
+# What each publisher says it sent (its final status line).
+count() { grep -oE "$1" "$work/out.log" | tail -1 | grep -oE '[0-9]+' | head -1; }
+odometry=$(count 'odometry published [0-9]+')
+observations=$(count 'observations published [0-9]+')
+truth=$(count '[0-9]+ ground truth messages')
+maps=$(grep -E '\[slam_estimator\].*steps [0-9]+' "$work/out.log" | tail -1 | grep -oE 'steps [0-9]+' | grep -oE '[0-9]+')
+echo "publishers: odometry $odometry, observations $observations, map states $maps, ground truth $truth"
+for n in "$odometry" "$observations" "$truth" "$maps"; do
+  if [[ -z "$n" || "$n" -eq 0 ]]; then echo "FAIL: a publisher count is missing or zero"; exit 1; fi
+done
+"$bin/pixyslam_log" check "$work/run/run.mcap" \
+  --expect "pixyslam/odometry=$odometry" --expect "pixyslam/landmark_observation=$observations" \
+  --expect "pixyslam/map_state=$maps" --expect "pixyslam/ground_truth=$truth"
+echo "PASS"
