@@ -19,6 +19,7 @@
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/dds/endpoints.h"
 #include "process_group.h"
+#include "../tests/sim_sensor_messages.h"
 
 namespace pixyslam::bench {
 namespace {
@@ -102,12 +103,7 @@ int run(int argc, char** argv) {
                                               std::chrono::duration<double>(e.send_s)));
     if (e.odometry) {
       const slam::OdometrySample& s = run.odometry[e.index];
-      msg::Odometry m;
-      m.header().stamp_ns(to_ns(s.t_s));
-      m.header().frame_id("base_link");
-      m.v_mps(s.v_mps);
-      m.w_radps(s.w_radps);
-      m.period_s(period);
+      msg::Odometry m = test_support::odometry_msg(s, period, to_ns(s.t_s));
       {
         std::lock_guard<std::mutex> lock(mutex);
         published_ns[odometry_writer.published() + 1] = dds::now_ns();
@@ -115,18 +111,7 @@ int run(int argc, char** argv) {
       odometry_writer.publish(m);
     } else {
       const slam::ObservationFrame& f = run.frames[e.index];
-      msg::LandmarkObservation m;
-      m.header().stamp_ns(to_ns(f.t_s));
-      m.header().frame_id("camera");
-      for (const slam::RangeBearing& rb : f.detections) {
-        msg::LandmarkDetection d;
-        d.landmark_id(rb.landmark_id);
-        d.range_m(rb.range_m);
-        d.bearing_rad(rb.bearing_rad);
-        d.range_sigma_m(0.07);
-        d.bearing_sigma_rad(0.027);
-        m.detections().push_back(d);
-      }
+      msg::LandmarkObservation m = test_support::observation_msg(f, to_ns(f.t_s));
       observation_writer.publish(m);
     }
   }

@@ -8,11 +8,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <condition_variable>
 #include <cstdint>
 #include <fstream>
 #include <memory>
-#include <mutex>
 #include <random>
 #include <string>
 #include <thread>
@@ -20,6 +18,7 @@
 
 #include <gtest/gtest.h>
 
+#include "dds_test_support.h"
 #include "pixyslam/bridge/byte_source.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/encoder/arduino_line_parser.h"
@@ -33,6 +32,7 @@ namespace pixyslam::encoder_node {
 namespace {
 
 using std::chrono::milliseconds;
+using test_support::LogLines;
 
 constexpr std::int64_t kMs = 1000000;  // ns
 
@@ -204,16 +204,7 @@ TEST(EncoderNodeOptions, FileErrorsNameThePath) {
 
 // ---------------------------------------------------------------- the node over DDS
 
-// The shipped loopback profile on a domain and with a robot id of this
-// process: test cases that ctest runs at the same time (each in a process of
-// its own) neither share ports nor see each other's messages.
-dds::DdsOptions loopback_options() {
-  dds::DdsOptions o;
-  o.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml";
-  o.domain_id = 100 + static_cast<int>(::getpid() % 64);
-  o.robot_id = "encoder_test_" + std::to_string(::getpid());
-  return o;
-}
+dds::DdsOptions loopback_options() { return test_support::loopback_options(100, 64, "encoder_test_"); }
 
 EncoderNodeOptions node_options() {
   EncoderNodeOptions o;
@@ -223,87 +214,11 @@ EncoderNodeOptions node_options() {
   return o;
 }
 
-// Collects the Odometry messages the test's own participant receives. One
-// for the whole program, created before any node: the loopback profile's initial
-// peers reach participants 0-3 of a domain on this host (Fast DDS's default
-// range), ids are never reused within a process, and two participants can
-// find each other when one of them is in that range.
-class OdometryInbox {
- public:
-  static OdometryInbox& instance() {
-    if (slot() == nullptr) slot() = new OdometryInbox;  // deleted by InboxCleanup
-    return *slot();
-  }
-  static void destroy() {
-    delete slot();
-    slot() = nullptr;
-  }
-
-  // Forgets what arrived so far (messages of earlier tests).
-  void clear() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    got_.clear();
-  }
-  // Waits until at least `count` messages arrived; returns all received so far.
-  std::vector<msg::Odometry> wait_for(std::size_t count, milliseconds timeout) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    cv_.wait_for(lock, timeout, [&] { return got_.size() >= count; });
-    return got_;
-  }
-  std::uint64_t lost() const { return reader_.lost(); }
-
- private:
-  static OdometryInbox*& slot() {
-    static OdometryInbox* inbox = nullptr;
-    return inbox;
-  }
-  OdometryInbox()
-      : participant_(loopback_options(), "test_odometry_reader"),
-        reader_(participant_, [this](const msg::Odometry& m) {
-          if (m.header().robot_id() != loopback_options().robot_id) return;
-          std::lock_guard<std::mutex> lock(mutex_);
-          got_.push_back(m);
-          cv_.notify_all();
-        }) {}
-
-  dds::Participant participant_;
-  std::mutex mutex_;
-  std::condition_variable cv_;
-  std::vector<msg::Odometry> got_;
-  dds::Reader<msg::Odometry> reader_;
-};
-
-// Destroys the inbox before main returns (DDS entities must not outlive main).
-class InboxCleanup : public ::testing::Environment {
- public:
-  void TearDown() override { OdometryInbox::destroy(); }
-};
-::testing::Environment* const kInboxCleanup = ::testing::AddGlobalTestEnvironment(new InboxCleanup);
-
-// Log lines of a node, for assertions.
-struct LogLines {
-  std::shared_ptr<std::mutex> mutex = std::make_shared<std::mutex>();
-  std::shared_ptr<std::vector<std::string>> lines = std::make_shared<std::vector<std::string>>();
-  bridge::LogFunction sink() const {
-    return [m = mutex, l = lines](const std::string& line) {
-      std::lock_guard<std::mutex> lock(*m);
-      l->push_back(line);
-    };
-  }
-  bool contains(const std::string& a, const std::string& b = "") const {
-    std::lock_guard<std::mutex> lock(*mutex);
-    for (const std::string& line : *lines) {
-      if (line.find(a) != std::string::npos && line.find(b) != std::string::npos) return true;
-    }
-    return false;
-  }
-  std::string all() const {
-    std::lock_guard<std::mutex> lock(*mutex);
-    std::string s;
-    for (const std::string& line : *lines) s += line + "\n";
-    return s;
-  }
-};
+// The Odometry the test's own participant receives (test_support::Inbox).
+using OdometryInbox = test_support::Inbox<msg::Odometry>;
+OdometryInbox& odometry_inbox() { return OdometryInbox::instance(loopback_options(), "test_odometry_reader"); }
+::testing::Environment* const kInboxCleanup =
+    ::testing::AddGlobalTestEnvironment(new test_support::InboxCleanup<msg::Odometry>);
 
 constexpr std::uint64_t kBaseNs = 1700000000000000000ull;  // host time of Arduino time 0 (a whole second)
 constexpr std::uint32_t kStartUs = 1000000;                 // the first sample, 1 s after boot
@@ -355,7 +270,7 @@ TEST(EncoderNode, PublishesOnePeriodAtATimeWithMappedStampsAndSkipsBadBytes) {
   }
   // When the node reads them and a reader listens,
   LogLines log;
-  OdometryInbox& inbox = OdometryInbox::instance();
+  OdometryInbox& inbox = odometry_inbox();
   inbox.clear();
   EncoderNode node(node_options(), std::make_unique<bridge::ScriptedByteSource>(script), log.sink(),
                    bridge::ByteScript::clock(script));
@@ -438,7 +353,7 @@ TEST(EncoderNode, MissingAndHungUpDeviceIsLoggedAndReopened) {
   for (std::uint32_t j = 10; j < 20; ++j) script->add_bytes(encoder::format_line(sample_number(j)), arrival_ns(j, prng));
 
   LogLines log;
-  OdometryInbox& inbox = OdometryInbox::instance();
+  OdometryInbox& inbox = odometry_inbox();
   inbox.clear();
   EncoderNode node(node_options(), std::make_unique<bridge::ScriptedByteSource>(script, "/dev/ttyTEST7"),
                    log.sink(), bridge::ByteScript::clock(script));
@@ -473,7 +388,7 @@ TEST(EncoderNode, ReadsARealPseudoTerminalAndReportsItsHangup) {
   EncoderNodeOptions options = node_options();
   options.encoder.serial_device = device;
   LogLines log;
-  OdometryInbox& inbox = OdometryInbox::instance();
+  OdometryInbox& inbox = odometry_inbox();
   inbox.clear();
   EncoderNode node(options, log.sink());
   ASSERT_TRUE(node.wait_for_subscribers(1, std::chrono::seconds(10)));

@@ -13,6 +13,7 @@
 #include "pixyslam/sim/sim_world.h"
 #include "pixyslam/slam_node/estimator_node.h"
 #include "pixyslam/slam_node/map_state_conversions.h"
+#include "sim_sensor_messages.h"
 
 namespace pixyslam::slam_node {
 namespace {
@@ -22,32 +23,6 @@ EstimatorOptions test_options() {
   o.status_period_s = 0.0;
   o.dds.robot_id = "test_robot";
   return o;
-}
-
-msg::Odometry to_message(const slam::OdometrySample& s, double period_s, std::uint64_t base_ns) {
-  msg::Odometry m;
-  m.header().stamp_ns(to_stamp_ns(s.t_s, base_ns));
-  m.header().frame_id("base_link");
-  m.v_mps(s.v_mps);
-  m.w_radps(s.w_radps);
-  m.period_s(period_s);
-  return m;
-}
-
-msg::LandmarkObservation to_message(const slam::ObservationFrame& f, std::uint64_t base_ns) {
-  msg::LandmarkObservation m;
-  m.header().stamp_ns(to_stamp_ns(f.t_s, base_ns));
-  m.header().frame_id("camera");
-  for (const slam::RangeBearing& rb : f.detections) {
-    msg::LandmarkDetection d;
-    d.landmark_id(rb.landmark_id);
-    d.range_m(rb.range_m);
-    d.bearing_rad(rb.bearing_rad);
-    d.range_sigma_m(0.07);
-    d.bearing_sigma_rad(0.027);
-    m.detections().push_back(d);
-  }
-  return m;
 }
 
 TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
@@ -86,10 +61,12 @@ TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
         f == run.frames.size() ||
         (o < run.odometry.size() && run.odometry[o].t_s + period <= run.frames[f].t_s);
     if (send_odometry) {
-      msg::Odometry m = to_message(run.odometry[o++], period, base_ns);
+      const slam::OdometrySample& s = run.odometry[o++];
+      msg::Odometry m = test_support::odometry_msg(s, period, to_stamp_ns(s.t_s, base_ns));
       ASSERT_TRUE(odometry_writer.publish(m));
     } else {
-      msg::LandmarkObservation m = to_message(run.frames[f++], base_ns);
+      const slam::ObservationFrame& frame = run.frames[f++];
+      msg::LandmarkObservation m = test_support::observation_msg(frame, to_stamp_ns(frame.t_s, base_ns));
       ASSERT_TRUE(observation_writer.publish(m));
     }
     if ((o + f) % 50 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));

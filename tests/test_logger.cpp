@@ -22,6 +22,7 @@
 #include "pixyslam/logger_node/cdr_payload.h"
 #include "pixyslam/logger_node/logger_node.h"
 #include "pixyslam/logger_node/logger_options.h"
+#include "pixyslam/logger_node/topic_selection.h"
 
 namespace pixyslam::logger_node {
 namespace {
@@ -157,6 +158,65 @@ TEST(CdrPayload, KnownTopicsAreTheSystemsTopicsWithTheirDdsTypeNames) {
   EXPECT_EQ(find_topic("odometry"), nullptr);
 }
 
+// ---------------------------------------------------------------- topic patterns, file names
+
+TEST(TopicSelection, GlobMatchesWholeNames) {
+  EXPECT_TRUE(glob_match("pixyslam/*", "pixyslam/odometry"));
+  EXPECT_TRUE(glob_match("*", "pixyslam/odometry"));
+  EXPECT_TRUE(glob_match("*/odometry", "pixyslam/odometry"));
+  EXPECT_TRUE(glob_match("pixyslam/*_*", "pixyslam/map_state"));
+  EXPECT_TRUE(glob_match("pixyslam/?ap_state", "pixyslam/map_state"));
+  EXPECT_TRUE(glob_match("pixyslam/odometry", "pixyslam/odometry"));
+  EXPECT_FALSE(glob_match("pixyslam/odometr", "pixyslam/odometry"));
+  EXPECT_FALSE(glob_match("pixyslam/*_*", "pixyslam/odometry"));
+  EXPECT_FALSE(glob_match("pixyslam/?", "pixyslam/odometry"));
+  EXPECT_FALSE(glob_match("other/*", "pixyslam/odometry"));
+  EXPECT_TRUE(glob_match("**a*", "a"));
+  EXPECT_FALSE(glob_match("", "a"));
+  EXPECT_TRUE(glob_match("", ""));
+}
+
+const std::vector<std::string> kKnown = {"pixyslam/odometry", "pixyslam/landmark_observation",
+                                         "pixyslam/map_state", "pixyslam/ground_truth"};
+
+TEST(TopicSelection, IncludesExcludesAndKeepsTheKnownOrder) {
+  EXPECT_EQ(select_topics({"pixyslam/*", "!pixyslam/ground_truth"}, kKnown).topics,
+            (std::vector<std::string>{"pixyslam/odometry", "pixyslam/landmark_observation", "pixyslam/map_state"}));
+  EXPECT_EQ(select_topics({"!pixyslam/ground_truth", "!*observation"}, kKnown).topics,
+            (std::vector<std::string>{"pixyslam/odometry", "pixyslam/map_state"}));
+  EXPECT_EQ(select_topics({"pixyslam/map_state", "pixyslam/odometry"}, kKnown).topics,
+            (std::vector<std::string>{"pixyslam/odometry", "pixyslam/map_state"}));
+  EXPECT_EQ(select_topics({"pixyslam/*o*", "pixyslam/odometry"}, kKnown).topics.size(), 3u);  // overlap is fine
+}
+
+TEST(TopicSelection, ErrorsNameThePattern) {
+  TopicSelection s = select_topics({"pixyslam/odometry", "pixyslam/odometri"}, kKnown);
+  EXPECT_EQ(s.bad_pattern, 1u);
+  EXPECT_NE(s.error.find("unknown topic 'pixyslam/odometri'"), std::string::npos) << s.error;
+  s = select_topics({"other/*"}, kKnown);
+  EXPECT_NE(s.error.find("pattern 'other/*' matches no known topic"), std::string::npos) << s.error;
+  s = select_topics({"pixyslam/*", "!pixyslam/*"}, kKnown);
+  EXPECT_EQ(s.error, "the patterns select no topic");
+  EXPECT_TRUE(s.topics.empty());
+  s = select_topics({"!x"}, kKnown);
+  EXPECT_NE(s.error.find("unknown topic 'x'"), std::string::npos) << s.error;
+  s = select_topics({"pixyslam/*", "!"}, kKnown);
+  EXPECT_EQ(s.bad_pattern, 1u);
+  EXPECT_EQ(s.error, "empty topic pattern");
+  s = select_topics({"!pixyslam/map_state", "!pixyslam/map_state"}, kKnown);
+  EXPECT_NE(s.error.find("given twice"), std::string::npos) << s.error;
+  EXPECT_FALSE(select_topics({}, kKnown).error.empty());
+}
+
+TEST(RotatedFileName, IndexGoesBeforeTheExtension) {
+  EXPECT_EQ(rotated_file_name("run.mcap", 0), "run_000.mcap");
+  EXPECT_EQ(rotated_file_name("run.mcap", 12), "run_012.mcap");
+  EXPECT_EQ(rotated_file_name("run.mcap", 1234), "run_1234.mcap");
+  EXPECT_EQ(rotated_file_name("/tmp/a.b/run", 1), "/tmp/a.b/run_001");
+  EXPECT_EQ(rotated_file_name("dir/.hidden", 2), "dir/.hidden_002");
+  EXPECT_EQ(rotated_file_name("dir/run.x.mcap", 3), "dir/run.x_003.mcap");
+}
+
 // ---------------------------------------------------------------- options
 
 std::string config_error(const std::string& yaml) {
@@ -202,12 +262,39 @@ TEST(LoggerOptions, SelectedTopicsAndCompression) {
   EXPECT_EQ(o.dds.profiles_file, "/cfg/dds/loopback.xml");
 }
 
+TEST(LoggerOptions, TopicPatternsAndRotation) {
+  auto root = config::YamlReader::from_string(
+      "logger:\n  topics: ['pixyslam/*', '!pixyslam/ground_truth']\n  rotate_size_bytes: 1000000\n"
+      "  rotate_period_s: 60\n",
+      "logger_test.yaml");
+  const LoggerOptions o = read_logger_options(root, "/cfg");
+  EXPECT_EQ(o.topics,
+            (std::vector<std::string>{"pixyslam/odometry", "pixyslam/landmark_observation", "pixyslam/map_state"}));
+  EXPECT_EQ(o.rotate_size_bytes, 1000000u);
+  EXPECT_DOUBLE_EQ(o.rotate_period_s, 60.0);
+  EXPECT_TRUE(rotation_enabled(o));
+  // The effective configuration reads back the same.
+  auto again = config::YamlReader::from_string(to_yaml(o), "effective.yaml");
+  const LoggerOptions back = read_logger_options(again, "/cfg");
+  EXPECT_EQ(back.topics, o.topics);
+  EXPECT_EQ(back.rotate_size_bytes, o.rotate_size_bytes);
+  EXPECT_DOUBLE_EQ(back.rotate_period_s, o.rotate_period_s);
+
+  const LoggerOptions shipped = read_logger_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/logger.yaml");
+  EXPECT_FALSE(rotation_enabled(shipped));
+}
+
 TEST(LoggerOptions, ErrorsNameTheFileAndTheKey) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"logger:\n  flush_period_sec: 1\n", "key 'logger.flush_period_sec': unknown key"},
       {"logger:\n  topics: [pixyslam/odometry, pixyslam/odometri]\n", "key 'logger.topics[1]': unknown topic"},
       {"logger:\n  topics: [pixyslam/odometry, pixyslam/odometry]\n", "key 'logger.topics[1]': topic"},
       {"logger:\n  topics: []\n", "key 'logger.topics': empty list"},
+      {"logger:\n  topics: ['pixyslam/*', 'other/*']\n", "key 'logger.topics[1]': pattern 'other/*' matches no"},
+      {"logger:\n  topics: ['pixyslam/*', '!pixyslam/*']\n", "key 'logger.topics[1]': the patterns select no topic"},
+      {"logger:\n  rotate_size_bytes: 1000\n", "key 'logger.rotate_size_bytes': value 1000 is too small"},
+      {"logger:\n  rotate_size_bytes: -1\n", "key 'logger.rotate_size_bytes'"},
+      {"logger:\n  rotate_period_s: 0.5\n", "key 'logger.rotate_period_s'"},
       {"logger:\n  compression: gzip\n", "key 'logger.compression': value 'gzip' is not one of"},
       {"logger:\n  flush_period_s: -1\n", "key 'logger.flush_period_s': value -1 is out of range"},
       {"logger:\n  chunk_size_bytes: 10\n", "key 'logger.chunk_size_bytes'"},
@@ -594,6 +681,118 @@ TEST(LoggerNode, FlushTimerBoundsWhatACrashLoses) {
   const logger::McapReader reader(file.path());
   EXPECT_TRUE(reader.clean()) << reader.diagnostics_text();
   EXPECT_EQ(reader.messages().size(), 50u);
+}
+
+// Reads rotated files base_000, base_001, ... (until one is missing).
+std::vector<std::string> rotated_files(const std::string& base) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; std::filesystem::exists(rotated_file_name(base, i)); ++i) {
+    out.push_back(rotated_file_name(base, i));
+  }
+  return out;
+}
+
+void remove_rotated(const std::string& base) {
+  for (const std::string& f : rotated_files(base)) std::filesystem::remove(f);
+}
+
+// Each file complete and clean, with every selected channel; together, seq
+// 1..count of Odometry in order.
+void expect_complete_rotation(const std::vector<std::string>& files, const LoggerCounters& c,
+                              std::size_t channels, std::uint64_t count) {
+  ASSERT_EQ(c.files.size(), files.size());
+  std::vector<std::uint64_t> seqs;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const logger::McapReader reader(files[i]);
+    EXPECT_TRUE(reader.clean()) << files[i] << ":\n" << reader.diagnostics_text();
+    EXPECT_EQ(reader.channels().size(), channels) << files[i];
+    EXPECT_EQ(reader.schemas().size(), channels) << files[i];
+    EXPECT_EQ(c.files[i].path, files[i]);
+    EXPECT_TRUE(c.files[i].closed);
+    EXPECT_EQ(c.files[i].counters.messages, reader.messages().size()) << files[i];
+    ASSERT_TRUE(reader.statistics().has_value());
+    EXPECT_EQ(reader.statistics()->message_count, reader.messages().size());
+    const logger::McapChannel* odometry = reader.find_channel("pixyslam/odometry");
+    ASSERT_NE(odometry, nullptr) << files[i];
+    for (const logger::McapMessage& m : reader.messages()) {
+      if (m.channel_id == odometry->id) seqs.push_back(m.sequence);
+    }
+  }
+  const SequenceReport r = analyze_sequence(seqs);
+  EXPECT_EQ(describe(r), "seq 1.." + std::to_string(count));
+  EXPECT_EQ(r.backwards, 0u);
+  EXPECT_EQ(c.file.messages, count);
+}
+
+TEST(LoggerNode, RotatesBySizeIntoCompleteFiles) {
+  const TempFile base("test_logger_rotate_size");
+  remove_rotated(base.path());
+  LoggerOptions options = node_options(base.path());
+  options.topics = {"pixyslam/*", "!pixyslam/ground_truth"};
+  options.rotate_size_bytes = 65536;
+  options.compression = logger::McapCompression::kNone;  // sizes as written
+  LoggerNode node(options);
+  node.start();
+  dds::Participant robot(loopback_options(), "test_robot");
+  dds::Writer<msg::Odometry> writer(robot);
+  ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(10)));
+  constexpr int kCount = 2000;
+  for (int i = 0; i < kCount; ++i) {
+    msg::Odometry m = odometry(i);
+    ASSERT_TRUE(writer.publish(m));
+  }
+  ASSERT_TRUE(wait_until([&] { return received(node, "pixyslam/odometry") == kCount; }, std::chrono::seconds(20)))
+      << node.counters_text();
+  node.stop();
+  EXPECT_FALSE(std::filesystem::exists(base.path()));  // only the indexed names
+  const std::vector<std::string> files = rotated_files(base.path());
+  const LoggerCounters c = node.counters();
+  EXPECT_TRUE(c.error.empty()) << c.error;
+  EXPECT_GE(files.size(), 3u);
+  expect_complete_rotation(files, c, 3, kCount);
+  for (std::size_t i = 0; i + 1 < files.size(); ++i) {
+    const auto size = std::filesystem::file_size(files[i]);
+    EXPECT_GE(size + 8192, options.rotate_size_bytes) << files[i];  // rotated near the limit,
+    EXPECT_LE(size, options.rotate_size_bytes + 16384) << files[i];  // not far beyond it (+ summary)
+  }
+  remove_rotated(base.path());
+}
+
+TEST(LoggerNode, RotatesByPeriod) {
+  const TempFile base("test_logger_rotate_period");
+  remove_rotated(base.path());
+  LoggerOptions options = node_options(base.path());
+  options.topics = {"pixyslam/odometry"};
+  options.rotate_period_s = 1.0;
+  options.flush_period_s = 0.1;
+  LoggerNode node(options);
+  node.start();
+  dds::Participant robot(loopback_options(), "test_robot");
+  dds::Writer<msg::Odometry> writer(robot);
+  ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(10)));
+  constexpr int kCount = 250;  // 2.5 s at 100 Hz: three files
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < kCount; ++i) {
+    std::this_thread::sleep_until(start + std::chrono::milliseconds(10 * i));
+    msg::Odometry m = odometry(i);
+    ASSERT_TRUE(writer.publish(m));
+  }
+  ASSERT_TRUE(wait_until([&] { return received(node, "pixyslam/odometry") == kCount; }, std::chrono::seconds(20)))
+      << node.counters_text();
+  node.stop();
+  const std::vector<std::string> files = rotated_files(base.path());
+  const LoggerCounters c = node.counters();
+  EXPECT_TRUE(c.error.empty()) << c.error;
+  EXPECT_GE(files.size(), 3u);
+  EXPECT_LE(files.size(), 4u);
+  expect_complete_rotation(files, c, 1, kCount);
+  remove_rotated(base.path());
+}
+
+TEST(LoggerNode, BadTopicPatternIsAnError) {
+  LoggerOptions options = node_options("/tmp/unused.mcap");
+  options.topics = {"nothing/*"};
+  EXPECT_THROW(LoggerNode node(options), std::invalid_argument);
 }
 
 TEST(LoggerNode, UnwritableFileIsAnErrorNamingIt) {

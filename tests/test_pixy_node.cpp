@@ -5,18 +5,17 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <condition_variable>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "dds_test_support.h"
 #include "pixyslam/bridge/byte_source.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/pixy/pixy_block_parser.h"
@@ -29,6 +28,7 @@ namespace pixyslam::pixy_node {
 namespace {
 
 using std::chrono::milliseconds;
+using test_support::LogLines;
 
 // Blocks of the shipped signature map (config/pixy_bridge.yaml): "12" -> 1, "13" -> 2.
 pixy::PixyBlock landmark_1() {
@@ -202,72 +202,15 @@ TEST(PixyNodeOptions, FileErrorsNameThePath) {
 
 // ---------------------------------------------------------------- the node over DDS
 
-// The shipped loopback profile on a domain and with a robot id of this
-// process: test cases that ctest runs at the same time (each in a process of
-// its own) neither share ports nor see each other's messages.
-dds::DdsOptions loopback_options() {
-  dds::DdsOptions o;
-  o.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml";
-  o.domain_id = 170 + static_cast<int>(::getpid() % 60);
-  o.robot_id = "pixy_test_" + std::to_string(::getpid());
-  return o;
+dds::DdsOptions loopback_options() { return test_support::loopback_options(170, 60, "pixy_test_"); }
+
+// The observations the test's own participant receives (test_support::Inbox).
+using ObservationInbox = test_support::Inbox<msg::LandmarkObservation>;
+ObservationInbox& observation_inbox() {
+  return ObservationInbox::instance(loopback_options(), "test_observation_reader");
 }
-
-// Collects the observations the test's own participant receives. One for the
-// whole program, created before any node: the loopback profile's initial
-// peers reach participants 0-3 of a domain on this host (Fast DDS's default
-// range), ids are never reused within a process, and two participants can
-// find each other when one of them is in that range.
-class ObservationInbox {
- public:
-  static ObservationInbox& instance() {
-    if (slot() == nullptr) slot() = new ObservationInbox;  // deleted by InboxCleanup
-    return *slot();
-  }
-  static void destroy() {
-    delete slot();
-    slot() = nullptr;
-  }
-
-  // Forgets what arrived so far (messages of earlier tests).
-  void clear() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    got_.clear();
-  }
-  std::vector<msg::LandmarkObservation> wait_for(std::size_t count, milliseconds timeout) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    cv_.wait_for(lock, timeout, [&] { return got_.size() >= count; });
-    return got_;
-  }
-  std::uint64_t lost() const { return reader_.lost(); }
-
- private:
-  static ObservationInbox*& slot() {
-    static ObservationInbox* inbox = nullptr;
-    return inbox;
-  }
-  ObservationInbox()
-      : participant_(loopback_options(), "test_observation_reader"),
-        reader_(participant_, [this](const msg::LandmarkObservation& m) {
-          if (m.header().robot_id() != loopback_options().robot_id) return;
-          std::lock_guard<std::mutex> lock(mutex_);
-          got_.push_back(m);
-          cv_.notify_all();
-        }) {}
-
-  dds::Participant participant_;
-  std::mutex mutex_;
-  std::condition_variable cv_;
-  std::vector<msg::LandmarkObservation> got_;
-  dds::Reader<msg::LandmarkObservation> reader_;
-};
-
-// Destroys the inbox before main returns (DDS entities must not outlive main).
-class InboxCleanup : public ::testing::Environment {
- public:
-  void TearDown() override { ObservationInbox::destroy(); }
-};
-::testing::Environment* const kInboxCleanup = ::testing::AddGlobalTestEnvironment(new InboxCleanup);
+::testing::Environment* const kInboxCleanup =
+    ::testing::AddGlobalTestEnvironment(new test_support::InboxCleanup<msg::LandmarkObservation>);
 
 constexpr std::uint64_t kBaseNs = 1700000000000000000ull;
 constexpr std::uint64_t kFrameNs = 20000000ull;  // 50 frames per second
@@ -320,17 +263,11 @@ TEST(PixyNode, PublishesOneObservationPerFrameAndSkipsBadBytes) {
   options.dds = loopback_options();
   options.camera_latency_s = 1e-9 * static_cast<double>(kLatencyNs);
   options.process.status_period_s = 0.0;
-  std::vector<std::string> log;
-  std::mutex log_mutex;
-  ObservationInbox& inbox = ObservationInbox::instance();
+  LogLines log;
+  ObservationInbox& inbox = observation_inbox();
   inbox.clear();
-  PixyNode node(
-      options, std::make_unique<bridge::ScriptedByteSource>(script, "/dev/pixy_test"),
-      [&](const std::string& line) {
-        std::lock_guard<std::mutex> lock(log_mutex);
-        log.push_back(line);
-      },
-      bridge::ByteScript::clock(script));
+  PixyNode node(options, std::make_unique<bridge::ScriptedByteSource>(script, "/dev/pixy_test"), log.sink(),
+                bridge::ByteScript::clock(script));
   ASSERT_TRUE(node.wait_for_subscribers(1, std::chrono::seconds(10)));
   node.start();
 
@@ -401,10 +338,7 @@ TEST(PixyNode, PublishesOneObservationPerFrameAndSkipsBadBytes) {
   EXPECT_EQ(c.frames_timed_out, 1u);
   EXPECT_EQ(c.detections.detections, 5u * 1 + 5u * 2);
   EXPECT_EQ(c.detections.unknown_signature, 5u + 5u);
-  std::lock_guard<std::mutex> lock(log_mutex);
-  bool final_status = false;
-  for (const std::string& line : log) final_status |= line.find("final status: frames 20") != std::string::npos;
-  EXPECT_TRUE(final_status);
+  EXPECT_TRUE(log.contains("final status: frames 20"));
 }
 
 TEST(PixyNode, MissingDeviceIsLoggedAndRetried) {
@@ -418,29 +352,18 @@ TEST(PixyNode, MissingDeviceIsLoggedAndRetried) {
   options.dds = loopback_options();
   options.process.reopen_period_s = 0.01;
   options.process.status_period_s = 0.0;
-  std::vector<std::string> log;
-  std::mutex log_mutex;
-  ObservationInbox& inbox = ObservationInbox::instance();
+  LogLines log;
+  ObservationInbox& inbox = observation_inbox();
   inbox.clear();
-  PixyNode node(
-      options, std::make_unique<bridge::ScriptedByteSource>(script, "/dev/ttyPIXY9"),
-      [&](const std::string& line) {
-        std::lock_guard<std::mutex> lock(log_mutex);
-        log.push_back(line);
-      },
-      bridge::ByteScript::clock(script));
+  PixyNode node(options, std::make_unique<bridge::ScriptedByteSource>(script, "/dev/ttyPIXY9"), log.sink(),
+                bridge::ByteScript::clock(script));
   ASSERT_TRUE(node.wait_for_subscribers(1, std::chrono::seconds(10)));
   node.start();
   EXPECT_EQ(inbox.wait_for(1, std::chrono::seconds(10)).size(), 1u);  // frame 0; frame 1 still open
   node.stop();
   EXPECT_EQ(node.counters().device.open_failures, 3u);
-  std::lock_guard<std::mutex> lock(log_mutex);
   ASSERT_FALSE(log.empty());
-  bool named = false;
-  for (const std::string& line : log) {
-    named |= line.find("cannot open serial device '/dev/ttyPIXY9'") != std::string::npos;
-  }
-  EXPECT_TRUE(named);
+  EXPECT_TRUE(log.contains("cannot open serial device '/dev/ttyPIXY9'"));
 }
 
 }  // namespace

@@ -6,18 +6,17 @@
 // The bridge configs default to the files beside --config. Exits 0 when the
 // run's duration is over (or on SIGINT/SIGTERM).
 #include <cstdio>
-#include <exception>
 #include <string>
 
 #include "pixyslam/app/command_line.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
-#include "pixyslam/config/yaml_reader.h"
 #include "robot_sim_node.h"
 
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
-  try {
+  return app::run_main("robot_sim", [&] {
     const app::CommandLine args(argc, argv, {"config", "pixy-config", "encoder-config", "duration", "arduino-link", "pixy-link"});
     if (args.help()) {
       std::puts("usage: robot_sim --config FILE [--pixy-config FILE] [--encoder-config FILE] [--duration S]\n"
@@ -35,11 +34,5 @@ int main(int argc, char** argv) {
     robot_sim::RobotSimNode node(c);
     node.run();
     return 0;
-  } catch (const config::ConfigError& e) {
-    std::fprintf(stderr, "robot_sim: config error: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "robot_sim: %s\n", e.what());
-    return 1;
-  }
+  });
 }

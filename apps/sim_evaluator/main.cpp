@@ -7,13 +7,13 @@
 // Exit code 3 if the ATE exceeds --max-ate or nothing was estimated.
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "pixyslam/app/command_line.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/dds/endpoints.h"
@@ -114,18 +114,12 @@ int run(const app::CommandLine& args) {
 
 int main(int argc, char** argv) {
   pixyslam::app::StopSignal::install();
-  try {
+  return pixyslam::app::run_main("sim_evaluator", [&] {
     const pixyslam::app::CommandLine args(argc, argv, {"dds-config", "out", "max-ate"});
     if (args.help()) {
       std::puts("usage: sim_evaluator --dds-config FILE [--out DIR] [--max-ate M]");
       return 0;
     }
     return pixyslam::sim_evaluator::run(args);
-  } catch (const pixyslam::config::ConfigError& e) {
-    std::fprintf(stderr, "sim_evaluator: config error: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "sim_evaluator: %s\n", e.what());
-    return 1;
-  }
+  });
 }

@@ -7,14 +7,12 @@
 // configuration or command-line error, 1 for any other failure.
 #include <chrono>
 #include <cstdio>
-#include <exception>
-#include <fstream>
-#include <stdexcept>
-#include <string>
+#include <optional>
 
 #include "pixyslam/app/command_line.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
-#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/bridge/bridge_options.h"
 #include "pixyslam/encoder_node/encoder_node.h"
 
 int main(int argc, char** argv) {
@@ -24,38 +22,16 @@ int main(int argc, char** argv) {
       "usage: encoder_bridge --config FILE [--device PATH] [--dds-config FILE]";
 
   encoder_node::EncoderNodeOptions options;
-  try {
-    const app::CommandLine args(argc, argv, {"config", "device", "dds-config"});
-    if (args.help()) {
-      std::puts(kUsage);
-      return 0;
-    }
-    const std::string& config_file = args.get("config");
-    options = encoder_node::read_encoder_node_options_file(config_file);
-    if (args.has("device")) {
-      options.encoder.serial_device = args.get("device");
-      if (options.encoder.serial_device.empty() || options.encoder.serial_device.front() != '/') {
-        throw std::invalid_argument("--device '" + options.encoder.serial_device + "' is not an absolute path");
-      }
-    }
-    if (args.has("dds-config")) options.dds.profiles_file = args.get("dds-config");
-    const std::string& profiles = options.dds.profiles_file;
-    if (!profiles.empty() && !std::ifstream(profiles).good()) {
-      throw config::ConfigError((args.has("dds-config") ? std::string("--dds-config")
-                                                        : config_file + ": key 'dds.profiles_file'") +
-                                ": cannot read '" + profiles + "'");
-    }
-  } catch (const config::ConfigError& e) {
-    std::fprintf(stderr, "encoder_bridge: config error: %s\n", e.what());
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "encoder_bridge: %s\n%s\n", e.what(), kUsage);
-    return 2;
-  }
-  std::printf("# encoder_bridge: effective configuration\n%s", encoder_node::to_yaml(options).c_str());
-  std::fflush(stdout);
+  const std::optional<int> early_exit =
+      app::set_up("encoder_bridge", kUsage, argc, argv, {"config", "device", "dds-config"},
+                  [&](const app::CommandLine& args) {
+                    options = encoder_node::read_encoder_node_options_file(args.get("config"));
+                    bridge::apply_command_line(args, options.encoder.serial_device, options.dds);
+                  });
+  if (early_exit) return *early_exit;
+  app::print_effective_configuration("encoder_bridge", encoder_node::to_yaml(options));
 
-  try {
+  return app::run_main("encoder_bridge", [&] {
     encoder_node::EncoderNode node(options);
     node.start();
     while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
@@ -63,8 +39,5 @@ int main(int argc, char** argv) {
     node.stop();
     std::fprintf(stderr, "encoder_bridge: stopped (signal %d)\n", app::StopSignal::signal_number());
     return 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "encoder_bridge: %s\n", e.what());
-    return 1;
-  }
+  });
 }

@@ -1,10 +1,12 @@
 // logger: records DDS topics to an MCAP file until SIGINT/SIGTERM.
 //   logger --config config/logger.yaml [--out FILE.mcap]
-// --out overrides logger.output_file. Prints the effective configuration to
-// stdout, logs to stderr; on a stop it drains what was received, closes the
-// file (summary and footer) and prints per-topic counts. Exit status: 0 after
-// a clean stop, 2 for a configuration or command-line error, 1 for any other
-// failure (e.g. the file could not be written).
+// --out overrides logger.output_file (with rotation: the base of the names,
+// run.mcap -> run_000.mcap, run_001.mcap, ...). Prints the effective
+// configuration to stdout, logs to stderr; on a stop it drains what was
+// received, closes the file (summary and footer) and prints per-topic counts,
+// then one line per file: "logger: file PATH: M messages, C chunks, B bytes".
+// Exit status: 0 after a clean stop, 2 for a configuration or command-line
+// error, 1 for any other failure (e.g. the file could not be written).
 #include <chrono>
 #include <cstdio>
 #include <exception>
@@ -42,8 +44,8 @@ int main(int argc, char** argv) {
   try {
     logger_node::LoggerNode node(options);
     node.start();
-    std::fprintf(stderr, "logger: recording %zu topics to %s\n", options.topics.size(),
-                 options.output_file.c_str());
+    std::fprintf(stderr, "logger: recording %zu topics to %s%s\n", options.topics.size(),
+                 options.output_file.c_str(), logger_node::rotation_enabled(options) ? " (rotating: _000, _001, ...)" : "");
     while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
       if (node.failed()) break;
     }
@@ -55,8 +57,14 @@ int main(int argc, char** argv) {
                    static_cast<unsigned long long>(t.written), static_cast<unsigned long long>(t.dropped),
                    static_cast<unsigned long long>(t.seq_gaps));
     }
-    std::fprintf(stderr, "logger: %s: %llu messages, %llu chunks, %llu bytes; queue peak %zu messages / %zu bytes\n",
-                 options.output_file.c_str(), static_cast<unsigned long long>(c.file.messages),
+    for (const logger_node::LoggedFile& f : c.files) {
+      std::fprintf(stderr, "logger: file %s: %llu messages, %llu chunks, %llu bytes\n", f.path.c_str(),
+                   static_cast<unsigned long long>(f.counters.messages),
+                   static_cast<unsigned long long>(f.counters.chunks),
+                   static_cast<unsigned long long>(f.counters.bytes_written));
+    }
+    std::fprintf(stderr, "logger: %s: %zu file(s), %llu messages, %llu chunks, %llu bytes; queue peak %zu messages / %zu bytes\n",
+                 options.output_file.c_str(), c.files.size(), static_cast<unsigned long long>(c.file.messages),
                  static_cast<unsigned long long>(c.file.chunks),
                  static_cast<unsigned long long>(c.file.bytes_written), c.queue_peak_messages,
                  c.queue_peak_bytes);

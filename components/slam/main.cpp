@@ -3,13 +3,12 @@
 //   slam_estimator --config config/slam_estimator.yaml [--seed S] [--out DIR]
 // --out writes DIR/trajectory.csv (every MapState's mean pose) and DIR/landmarks.csv at exit.
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <string>
 
 #include "pixyslam/app/command_line.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
-#include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/slam_node/estimator_node.h"
 #include "pixyslam/eval/csv_io.h"
 
@@ -38,7 +37,7 @@ void write_outputs(const std::string& dir, const pixyslam::slam_node::EstimatorN
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
-  try {
+  return app::run_main("slam_estimator", [&] {
     const app::CommandLine args(argc, argv, {"config", "seed", "out"});
     if (args.help()) {
       std::puts("usage: slam_estimator --config FILE [--seed S] [--out DIR]");
@@ -59,11 +58,5 @@ int main(int argc, char** argv) {
       write_outputs(args.get("out"), node);
     }
     return 0;
-  } catch (const config::ConfigError& e) {
-    std::fprintf(stderr, "slam_estimator: config error: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "slam_estimator: %s\n", e.what());
-    return 1;
-  }
+  });
 }

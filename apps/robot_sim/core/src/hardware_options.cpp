@@ -1,11 +1,11 @@
 #include "pixyslam/robot_sim/hardware_options.h"
 
-#include <array>
-#include <charconv>
 #include <cstdint>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+
+#include "pixyslam/config/yaml_text.h"
 
 namespace pixyslam::robot_sim {
 namespace {
@@ -41,12 +41,6 @@ bool valid_version(const std::string& v) {
     if (!ok) return false;
   }
   return true;
-}
-
-std::string number_text(double v) {
-  std::array<char, 32> buf{};
-  const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
-  return std::string(buf.data(), r.ptr);
 }
 
 }  // namespace
@@ -103,35 +97,32 @@ HardwareOptions read_hardware_options(config::YamlReader& r) {
   o.send_empty_frames = r.boolean("send_empty_frames", o.send_empty_frames);
   o.physics_step_s = r.number("physics_step_s", kMinStep, kMaxStep, o.physics_step_s);
   r.finish();
-  try {
-    validate(o);
-  } catch (const std::invalid_argument& e) {
-    throw config::ConfigError(r.origin() + ": mapping '" + r.path() + "': " + e.what());
-  }
+  r.check_mapping([&] { validate(o); });
   return o;
 }
 
 std::string to_yaml(const HardwareOptions& o) {
+  using config::yaml_number;
   std::ostringstream os;
   os << "hardware:\n"
      << "  seed: " << o.seed << "\n"
-     << "  arduino_rate_hz: " << number_text(o.arduino_rate_hz) << "\n"
+     << "  arduino_rate_hz: " << yaml_number(o.arduino_rate_hz) << "\n"
      << "  arduino_start_time_us: " << o.arduino_start_time_us << "\n"
      << "  start_ticks: " << o.start_ticks << "\n"
      << "  firmware_version: \"" << o.firmware_version << "\"\n"
-     << "  v_sigma_mps: " << number_text(o.v_sigma_mps) << "\n"
-     << "  w_sigma_radps: " << number_text(o.w_sigma_radps) << "\n"
-     << "  noise_reference_rate_hz: " << number_text(o.noise_reference_rate_hz) << "\n"
-     << "  pixy_rate_hz: " << number_text(o.pixy_rate_hz) << "\n"
-     << "  range_sigma_m: " << number_text(o.range_sigma_m) << "\n"
-     << "  bearing_sigma_rad: " << number_text(o.bearing_sigma_rad) << "\n"
-     << "  pole_width_m: " << number_text(o.pole_width_m) << "\n"
-     << "  min_range_m: " << number_text(o.min_range_m) << "\n"
-     << "  max_range_m: " << number_text(o.max_range_m) << "\n"
+     << "  v_sigma_mps: " << yaml_number(o.v_sigma_mps) << "\n"
+     << "  w_sigma_radps: " << yaml_number(o.w_sigma_radps) << "\n"
+     << "  noise_reference_rate_hz: " << yaml_number(o.noise_reference_rate_hz) << "\n"
+     << "  pixy_rate_hz: " << yaml_number(o.pixy_rate_hz) << "\n"
+     << "  range_sigma_m: " << yaml_number(o.range_sigma_m) << "\n"
+     << "  bearing_sigma_rad: " << yaml_number(o.bearing_sigma_rad) << "\n"
+     << "  pole_width_m: " << yaml_number(o.pole_width_m) << "\n"
+     << "  min_range_m: " << yaml_number(o.min_range_m) << "\n"
+     << "  max_range_m: " << yaml_number(o.max_range_m) << "\n"
      << "  min_block_area_px: " << o.min_block_area_px << "\n"
      << "  colour_code_angle_deg: " << o.colour_code_angle_deg << "\n"
      << "  send_empty_frames: " << (o.send_empty_frames ? "true" : "false") << "\n"
-     << "  physics_step_s: " << number_text(o.physics_step_s) << "\n";
+     << "  physics_step_s: " << yaml_number(o.physics_step_s) << "\n";
   return os.str();
 }
 

@@ -1,8 +1,8 @@
 #include "pixyslam/bridge/bridge_options.h"
 
-#include <array>
-#include <charconv>
 #include <cmath>
+#include <fstream>
+#include <stdexcept>
 
 namespace pixyslam::bridge {
 
@@ -19,19 +19,20 @@ DeviceReaderOptions device_reader_options(const BridgeProcessOptions& o) {
   return d;
 }
 
-std::string yaml_number(double value) {
-  std::array<char, 32> buf{};
-  const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), value);
-  return std::string(buf.data(), r.ptr);
-}
-
-std::string yaml_quoted(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
+void apply_command_line(const app::CommandLine& args, std::string& serial_device, dds::DdsOptions& dds) {
+  if (args.has("device")) {
+    serial_device = args.get("device");
+    if (serial_device.empty() || serial_device.front() != '/') {
+      throw std::invalid_argument("--device '" + serial_device + "' is not an absolute path");
+    }
   }
-  return out + "\"";
+  if (args.has("dds-config")) dds.profiles_file = args.get("dds-config");
+  const std::string& profiles = dds.profiles_file;
+  if (!profiles.empty() && !std::ifstream(profiles).good()) {
+    throw config::ConfigError((args.has("dds-config") ? std::string("--dds-config")
+                                                      : args.get("config") + ": key 'dds.profiles_file'") +
+                              ": cannot read '" + profiles + "'");
+  }
 }
 
 std::string to_yaml_lines(const BridgeProcessOptions& o) {

@@ -48,6 +48,13 @@ DeviceCounters DeviceReader::counters() const {
   return counters_;
 }
 
+std::string DeviceReader::status_line() const {
+  const DeviceCounters d = counters();
+  return "status: device '" + device_name_ + "': opens " + std::to_string(d.opens) + ", open failures " +
+         std::to_string(d.open_failures) + ", hang-ups " + std::to_string(d.hangups) + ", read errors " +
+         std::to_string(d.read_errors) + ", bytes " + std::to_string(d.bytes);
+}
+
 template <class Call>
 void DeviceReader::run_handler(const char* name, const Call& call) {
   try {

@@ -2,9 +2,12 @@
 
 #include "pixyslam/dds/topics.h"
 
+#include <cerrno>
 #include <chrono>
 #include <mutex>
 #include <stdexcept>
+
+#include <unistd.h>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -66,6 +69,13 @@ Participant::Participant(const DdsOptions& options, const std::string& name) : o
                              "'");
   }
   qos.name(name);
+  // Who this is, for inspection tools (pixyslam_spy participants): sent in discovery.
+  char host[256] = {};
+  if (gethostname(host, sizeof(host) - 1) != 0) host[0] = '\0';
+  const std::string process = program_invocation_short_name;  // glibc: argv[0] without folder
+  qos.properties().properties().emplace_back("pixyslam.host", host, true);
+  qos.properties().properties().emplace_back("pixyslam.pid", std::to_string(getpid()), true);
+  qos.properties().properties().emplace_back("pixyslam.process", process, true);
   participant_ = factory->create_participant(options.domain_id, qos);
   if (participant_ == nullptr) {
     throw std::runtime_error("cannot create DDS participant '" + name + "' on domain " +

@@ -1,9 +1,10 @@
 #include "pixyslam/encoder/encoder_options.h"
 
 #include <array>
-#include <charconv>
 #include <sstream>
 #include <stdexcept>
+
+#include "pixyslam/config/yaml_text.h"
 
 namespace pixyslam::encoder {
 namespace {
@@ -20,21 +21,6 @@ constexpr double kMinBaseM = 0.01, kMaxBaseM = 5.0;
 constexpr double kMinRateHz = 0.1, kMaxRateHz = 100.0;
 constexpr double kMinSpeedMps = 0.01, kMaxSpeedMps = 20.0;
 constexpr double kMinGapS = 0.001, kMaxGapS = 60.0;
-
-std::string number_text(double v) {
-  std::array<char, 32> buf{};
-  const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
-  return std::string(buf.data(), r.ptr);
-}
-
-std::string quoted(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
 
 void check_range(const char* name, double v, double lo, double hi) {
   if (!(v >= lo && v <= hi)) {
@@ -101,11 +87,7 @@ EncoderOptions read_encoder_options(config::YamlReader& r) {
   o.max_wheel_speed_mps = r.number("max_wheel_speed_mps", kMinSpeedMps, kMaxSpeedMps, o.max_wheel_speed_mps);
   o.max_sample_gap_s = r.number("max_sample_gap_s", kMinGapS, kMaxGapS, o.max_sample_gap_s);
   r.finish();
-  try {
-    validate(o);
-  } catch (const std::invalid_argument& e) {
-    throw config::ConfigError(r.origin() + ": mapping '" + r.path() + "': " + e.what());
-  }
+  r.check_mapping([&] { validate(o); });
   return o;
 }
 
@@ -122,18 +104,19 @@ EncoderOptions read_encoder_options_file(const std::string& path) {
 }
 
 std::string to_yaml(const EncoderOptions& o) {
+  using config::yaml_number;
   std::ostringstream os;
   os << "encoder_bridge:\n"
-     << "  serial_device: " << quoted(o.serial_device) << "\n"
+     << "  serial_device: " << config::yaml_quoted(o.serial_device) << "\n"
      << "  baud: " << o.baud << "\n"
-     << "  wheel_radius_m: " << number_text(o.wheel_radius_m) << "\n"
+     << "  wheel_radius_m: " << yaml_number(o.wheel_radius_m) << "\n"
      << "  ticks_per_revolution: " << o.ticks_per_revolution << "\n"
-     << "  wheel_base_m: " << number_text(o.wheel_base_m) << "\n"
+     << "  wheel_base_m: " << yaml_number(o.wheel_base_m) << "\n"
      << "  left_sign: " << o.left_sign << "\n"
      << "  right_sign: " << o.right_sign << "\n"
-     << "  publish_rate_hz: " << number_text(o.publish_rate_hz) << "\n"
-     << "  max_wheel_speed_mps: " << number_text(o.max_wheel_speed_mps) << "\n"
-     << "  max_sample_gap_s: " << number_text(o.max_sample_gap_s) << "\n";
+     << "  publish_rate_hz: " << yaml_number(o.publish_rate_hz) << "\n"
+     << "  max_wheel_speed_mps: " << yaml_number(o.max_wheel_speed_mps) << "\n"
+     << "  max_sample_gap_s: " << yaml_number(o.max_sample_gap_s) << "\n";
   return os.str();
 }
 

@@ -18,65 +18,42 @@ EncoderNode::EncoderNode(const EncoderNodeOptions& options, bridge::LogFunction 
 EncoderNode::EncoderNode(const EncoderNodeOptions& options, std::unique_ptr<bridge::ByteSource> source,
                          bridge::LogFunction log, bridge::ClockFunction clock)
     : options_(options),
-      log_(log ? std::move(log) : bridge::stderr_log("encoder_bridge")),
       odometry_(options.encoder),
       accumulator_(options.encoder.publish_rate_hz),
-      clock_(options.clock_window_s) {
-  participant_ = std::make_unique<dds::Participant>(options_.dds, "encoder_bridge");
-  writer_ = std::make_unique<dds::Writer<msg::Odometry>>(*participant_);
-  reader_ = std::make_unique<bridge::DeviceReader>(std::move(source),
-                                                   bridge::device_reader_options(options_.process), log_,
-                                                   clock ? std::move(clock) : bridge::ClockFunction(&dds::now_ns));
-}
+      clock_(options.clock_window_s),
+      runtime_("encoder_bridge", options.dds, options.process, std::move(source), std::move(log),
+               std::move(clock), mutex_) {}
 
-EncoderNode::~EncoderNode() {
-  stop();
-  reader_.reset();
-  writer_.reset();
-  participant_.reset();
-}
+EncoderNode::~EncoderNode() { stop(); }
 
 void EncoderNode::start() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (started_) return;
-    started_ = true;
-    next_status_ = std::chrono::steady_clock::now() +
-                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                       std::chrono::duration<double>(options_.process.status_period_s));
-  }
-  log_("reading '" + reader_->device_name() + "', publishing odometry at " +
-       bridge::yaml_number(options_.encoder.publish_rate_hz) + " Hz on '" + std::string(dds::kOdometryTopic) +
-       "'");
-  reader_->start({[this] { on_open(); },
+  runtime_.start("reading '" + runtime_.device_name() + "', publishing odometry at " +
+                     bridge::yaml_number(options_.encoder.publish_rate_hz) + " Hz on '" +
+                     std::string(dds::kOdometryTopic) + "'",
+                 {[this] { on_open(); },
                   [this](const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns) {
                     on_bytes(data, size, receive_ns);
                   },
-                  [this](std::uint64_t now_ns) { on_poll(now_ns); }});
+                  [this](std::uint64_t now_ns) { on_poll(now_ns); },
+                  [this] { return status_lines_locked(); }});
 }
 
-void EncoderNode::stop() {
-  reader_->stop();
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!started_ || stopped_) return;
-  stopped_ = true;
-  for (const std::string& line : status_lines_locked()) log_("final " + line);
-}
+void EncoderNode::stop() { runtime_.stop(); }
 
 bool EncoderNode::wait_for_subscribers(int count, std::chrono::milliseconds timeout) const {
-  return writer_->wait_for_readers(count, timeout);
+  return runtime_.wait_for_readers(count, timeout);
 }
 
 EncoderNodeCounters EncoderNode::counters() const {
   std::lock_guard<std::mutex> lock(mutex_);
   EncoderNodeCounters c;
-  c.device = reader_->counters();
+  c.device = runtime_.device_counters();
   c.parser = parser_.counters();
   c.wheel = odometry_.counters();
   c.accumulator = accumulator_.counters();
   c.clock = clock_.counters();
-  c.published = published_;
-  c.publish_failures = publish_failures_;
+  c.published = runtime_.published();
+  c.publish_failures = runtime_.publish_failures();
   c.empty_periods = empty_periods_;
   return c;
 }
@@ -87,14 +64,10 @@ std::vector<std::string> EncoderNode::status_lines() const {
 }
 
 std::vector<std::string> EncoderNode::status_lines_locked() const {
-  const bridge::DeviceCounters d = reader_->counters();
   const encoder::ArduinoParserCounters& p = parser_.counters();
   const encoder::WheelCounters& w = odometry_.counters();
   const ArduinoClock::Counters& k = clock_.counters();
-  std::ostringstream device, lines, motion;
-  device << "status: device '" << reader_->device_name() << "': opens " << d.opens << ", open failures "
-         << d.open_failures << ", hang-ups " << d.hangups << ", read errors " << d.read_errors << ", bytes "
-         << d.bytes;
+  std::ostringstream lines, motion;
   lines << "status: lines: samples " << p.samples << ", resets " << p.resets << ", rejected "
         << p.rejected_lines() << " (framing " << p.bad_framing << ", checksum " << p.bad_checksum
         << ", unknown type " << p.unknown_type << ", field count " << p.wrong_field_count << ", bad field "
@@ -105,9 +78,9 @@ std::vector<std::string> EncoderNode::status_lines_locked() const {
          << ", time gaps " << w.time_gaps << ", implausible " << w.implausible << ", ticks/rev mismatches "
          << w.ticks_per_revolution_mismatches << "; clock restarts " << k.restarts << ", jumps " << k.jumps
          << ", last excess delay " << static_cast<double>(clock_.last_excess_delay_ns()) * 1e-6
-         << " ms; odometry published " << published_ << ", failed " << publish_failures_
+         << " ms; odometry published " << runtime_.published() << ", failed " << runtime_.publish_failures()
          << ", empty periods " << empty_periods_;
-  return {device.str(), lines.str(), motion.str()};
+  return {runtime_.device_status_line(), lines.str(), motion.str()};
 }
 
 double EncoderNode::to_seconds(std::int64_t host_ns) const {
@@ -115,12 +88,10 @@ double EncoderNode::to_seconds(std::int64_t host_ns) const {
 }
 
 void EncoderNode::on_open() {
-  std::lock_guard<std::mutex> lock(mutex_);
   clock_.restart();  // a reopened link (an Uno also resets) starts a new clock estimate
 }
 
 void EncoderNode::on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns) {
-  std::lock_guard<std::mutex> lock(mutex_);
   parser_.feed(data, size, [&](const encoder::ArduinoMessage& message) {
     if (const auto* sample = std::get_if<encoder::EncoderSample>(&message)) {
       on_sample(*sample, receive_ns);
@@ -155,11 +126,10 @@ void EncoderNode::on_reset(const encoder::EncoderReset& reset) {
     line += " differs from the configured " + std::to_string(options_.encoder.ticks_per_revolution) +
             " (the configuration is used)";
   }
-  log_(line);
+  runtime_.log(line);
 }
 
 void EncoderNode::on_poll(std::uint64_t now_ns) {
-  std::lock_guard<std::mutex> lock(mutex_);
   // No sample for max_sample_gap_s: close the elapsed periods as "no data",
   // one period at a time at most, up to max_sample_gap_s ago.
   const auto stall_ns = static_cast<std::uint64_t>(std::llround(options_.encoder.max_sample_gap_s * 1e9));
@@ -169,12 +139,6 @@ void EncoderNode::on_poll(std::uint64_t now_ns) {
       accumulator_.mark_gap(gap_s, [this](const encoder::OdometryOutput& o) { publish(o); });
       last_time_s_ = gap_s;
     }
-  }
-  if (options_.process.status_period_s > 0.0 && std::chrono::steady_clock::now() >= next_status_) {
-    for (const std::string& line : status_lines_locked()) log_(line);
-    next_status_ = std::chrono::steady_clock::now() +
-                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                       std::chrono::duration<double>(options_.process.status_period_s));
   }
 }
 
@@ -188,11 +152,7 @@ void EncoderNode::publish(const encoder::OdometryOutput& output) {
   }
   if (samples == 0) ++empty_periods_;
   msg::Odometry m = to_odometry_msg(output, samples, epoch_ns_);
-  if (writer_->publish(m)) {
-    ++published_;
-  } else {
-    ++publish_failures_;
-  }
+  runtime_.publish(m);
 }
 
 }  // namespace pixyslam::encoder_node

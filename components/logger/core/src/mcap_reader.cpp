@@ -72,6 +72,17 @@ struct RecordError {
   std::string message;
 };
 
+// The content of a uint32 byte-length prefixed Map or Array field. With
+// `entry_bytes` > 0 its length must be a multiple of that (else RecordError
+// "<what> of N bytes").
+ByteSource take_prefixed(ByteSource& s, std::size_t entry_bytes = 0, const char* what = "") {
+  const std::uint32_t bytes = s.u32();
+  if (entry_bytes > 0 && bytes % entry_bytes != 0) {
+    throw RecordError{std::string(what) + " of " + std::to_string(bytes) + " bytes"};
+  }
+  return ByteSource(s.take(bytes), bytes);
+}
+
 McapSchema parse_schema(ByteSource& s) {
   McapSchema schema;
   schema.id = s.u16();
@@ -82,8 +93,7 @@ McapSchema parse_schema(ByteSource& s) {
 }
 
 std::map<std::string, std::string> parse_string_map(ByteSource& s) {
-  const std::uint32_t bytes = s.u32();
-  ByteSource m(s.take(bytes), bytes);
+  ByteSource m = take_prefixed(s);
   std::map<std::string, std::string> out;
   while (m.remaining() > 0) {
     std::string key = m.str();
@@ -115,9 +125,7 @@ McapMessage parse_message(ByteSource& s) {
 }
 
 std::map<std::uint16_t, std::uint64_t> parse_u16_u64_map(ByteSource& s) {
-  const std::uint32_t bytes = s.u32();
-  if (bytes % 10 != 0) throw RecordError{"Map<uint16, uint64> of " + std::to_string(bytes) + " bytes"};
-  ByteSource m(s.take(bytes), bytes);
+  ByteSource m = take_prefixed(s, 10, "Map<uint16, uint64>");
   std::map<std::uint16_t, std::uint64_t> out;
   while (m.remaining() > 0) {
     const std::uint16_t key = m.u16();
@@ -478,9 +486,7 @@ class McapReader::Parser {
 
   void check_message_index(ByteSource& s, std::uint64_t pos, std::size_t len) {
     const std::uint16_t channel_id = s.u16();
-    const std::uint32_t bytes = s.u32();
-    if (bytes % 16 != 0) throw RecordError{"records array of " + std::to_string(bytes) + " bytes"};
-    ByteSource entries(s.take(bytes), bytes);
+    ByteSource entries = take_prefixed(s, 16, "records array");
     message_index_at_[pos] = channel_id;
     if (!have_pending_) {
       diag(pos, "Message Index record not after a Chunk");

@@ -18,6 +18,47 @@ namespace pixyslam::logger {
 
 using detail::ByteSink;
 
+namespace {
+
+// The record layouts the writer emits in more than one place (https://mcap.dev/spec).
+void put_schema(ByteSink& out, std::uint16_t id, std::string_view name, std::string_view encoding,
+                std::string_view data) {
+  const std::size_t rec = out.begin_record(detail::kOpSchema);
+  out.u16(id);
+  out.str(name);
+  out.str(encoding);
+  out.str(data);
+  out.end_record(rec);
+}
+
+void put_channel(ByteSink& out, std::uint16_t id, std::uint16_t schema_id, std::string_view topic,
+                 std::string_view message_encoding, const std::map<std::string, std::string>& metadata) {
+  const std::size_t rec = out.begin_record(detail::kOpChannel);
+  out.u16(id);
+  out.u16(schema_id);
+  out.str(topic);
+  out.str(message_encoding);
+  const std::size_t map = out.begin_u32_prefix();
+  for (const auto& [key, value] : metadata) {
+    out.str(key);
+    out.str(value);
+  }
+  out.end_u32_prefix(map);
+  out.end_record(rec);
+}
+
+// Map<uint16, uint64> (Statistics channel_message_counts, Chunk Index message_index_offsets).
+void put_u16_u64_map(ByteSink& out, const std::map<std::uint16_t, std::uint64_t>& map) {
+  const std::size_t at = out.begin_u32_prefix();
+  for (const auto& [key, value] : map) {
+    out.u16(key);
+    out.u64(value);
+  }
+  out.end_u32_prefix(at);
+}
+
+}  // namespace
+
 const char* mcap_compression_name(McapCompression compression) {
   switch (compression) {
     case McapCompression::kZstd: return "zstd";
@@ -130,12 +171,7 @@ std::uint16_t McapWriter::add_schema(std::string_view name, std::string_view enc
 
   scratch_.clear();
   ByteSink out(scratch_);
-  const std::size_t rec = out.begin_record(detail::kOpSchema);
-  out.u16(s.id);
-  out.str(s.name);
-  out.str(s.encoding);
-  out.str(s.data);
-  out.end_record(rec);
+  put_schema(out, s.id, s.name, s.encoding, s.data);
   emit_data_record(scratch_);
   schemas_.push_back(std::move(s));
   ++counters_.schemas;
@@ -160,18 +196,7 @@ std::uint16_t McapWriter::add_channel(std::string_view topic, std::string_view m
 
   scratch_.clear();
   ByteSink out(scratch_);
-  const std::size_t rec = out.begin_record(detail::kOpChannel);
-  out.u16(c.id);
-  out.u16(c.schema_id);
-  out.str(c.topic);
-  out.str(c.message_encoding);
-  const std::size_t map = out.begin_u32_prefix();
-  for (const auto& [key, value] : c.metadata) {
-    out.str(key);
-    out.str(value);
-  }
-  out.end_u32_prefix(map);
-  out.end_record(rec);
+  put_channel(out, c.id, c.schema_id, c.topic, c.message_encoding, c.metadata);
   emit_data_record(scratch_);
   channels_.push_back(std::move(c));
   ++counters_.channels;
@@ -311,31 +336,11 @@ std::vector<std::uint8_t> McapWriter::summary_section(std::uint64_t summary_star
   };
 
   std::size_t begin = bytes.size();
-  for (const SchemaInfo& s : schemas_) {
-    const std::size_t rec = out.begin_record(detail::kOpSchema);
-    out.u16(s.id);
-    out.str(s.name);
-    out.str(s.encoding);
-    out.str(s.data);
-    out.end_record(rec);
-  }
+  for (const SchemaInfo& s : schemas_) put_schema(out, s.id, s.name, s.encoding, s.data);
   close_group(detail::kOpSchema, begin);
 
   begin = bytes.size();
-  for (const ChannelInfo& c : channels_) {
-    const std::size_t rec = out.begin_record(detail::kOpChannel);
-    out.u16(c.id);
-    out.u16(c.schema_id);
-    out.str(c.topic);
-    out.str(c.message_encoding);
-    const std::size_t map = out.begin_u32_prefix();
-    for (const auto& [key, value] : c.metadata) {
-      out.str(key);
-      out.str(value);
-    }
-    out.end_u32_prefix(map);
-    out.end_record(rec);
-  }
+  for (const ChannelInfo& c : channels_) put_channel(out, c.id, c.schema_id, c.topic, c.message_encoding, c.metadata);
   close_group(detail::kOpChannel, begin);
 
   begin = bytes.size();
@@ -349,12 +354,7 @@ std::vector<std::uint8_t> McapWriter::summary_section(std::uint64_t summary_star
     out.u32(static_cast<std::uint32_t>(chunk_indexes_.size()));
     out.u64(message_start_time_);
     out.u64(message_end_time_);
-    const std::size_t map = out.begin_u32_prefix();
-    for (const auto& [channel_id, count] : channel_message_counts_) {
-      out.u16(channel_id);
-      out.u64(count);
-    }
-    out.end_u32_prefix(map);
+    put_u16_u64_map(out, channel_message_counts_);
     out.end_record(rec);
   }
   close_group(detail::kOpStatistics, begin);
@@ -367,12 +367,7 @@ std::vector<std::uint8_t> McapWriter::summary_section(std::uint64_t summary_star
     out.u64(ci.message_end_time);
     out.u64(ci.chunk_start_offset);
     out.u64(ci.chunk_length);
-    const std::size_t map = out.begin_u32_prefix();
-    for (const auto& [channel_id, offset] : ci.message_index_offsets) {
-      out.u16(channel_id);
-      out.u64(offset);
-    }
-    out.end_u32_prefix(map);
+    put_u16_u64_map(out, ci.message_index_offsets);
     out.u64(ci.message_index_length);
     out.str(compression);
     out.u64(ci.compressed_size);

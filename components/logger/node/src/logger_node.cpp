@@ -1,5 +1,6 @@
 #include "pixyslam/logger_node/logger_node.h"
 
+#include <algorithm>
 #include <chrono>
 #include <exception>
 #include <map>
@@ -9,6 +10,7 @@
 
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/logger_node/topic_selection.h"
 
 namespace pixyslam::logger_node {
 
@@ -57,28 +59,27 @@ class TypedSubscription final : public Subscription {
 }  // namespace detail
 
 LoggerNode::LoggerNode(const LoggerOptions& options) : options_(options) {
+  std::vector<std::string> all;
+  for (const TopicInfo& t : known_topics()) all.push_back(t.topic);
   if (options_.topics.empty()) {
-    for (const TopicInfo& t : known_topics()) options_.topics.push_back(t.topic);
+    options_.topics = all;
+  } else {
+    const TopicSelection selection = select_topics(options_.topics, all);
+    if (!selection.error.empty()) {
+      throw std::invalid_argument("logger: topics[" + std::to_string(selection.bad_pattern) + "] '" +
+                                  options_.topics[selection.bad_pattern] + "': " + selection.error);
+    }
+    options_.topics = selection.topics;
   }
-  logger::McapWriterOptions file;
-  file.chunk_size_bytes = options_.chunk_size_bytes;
-  file.compression = options_.compression;
-  file.sync_after_chunk = options_.fsync;
-  writer_.open(options_.output_file, file);
-
-  const std::map<std::string, std::string> metadata_base = {
-      {"robot_id", options_.dds.robot_id}, {"dds_domain_id", std::to_string(options_.dds.domain_id)}};
   for (const std::string& name : options_.topics) {
     const TopicInfo* info = find_topic(name);
     if (info == nullptr) throw std::invalid_argument("logger: unknown topic '" + name + "'");
-    const std::uint16_t schema = writer_.add_schema(info->type_name, "omgidl", msg::idl_text(info->idl_stem));
-    std::map<std::string, std::string> metadata = metadata_base;
-    metadata["type_name"] = info->type_name;
+    topic_infos_.push_back(info);
     TopicCounters counters;
     counters.topic = name;
-    counters.channel_id = writer_.add_channel(info->topic, "cdr", schema, metadata);
     topics_.push_back(counters);
   }
+  open_file(0);
 
   participant_ = std::make_unique<dds::Participant>(options_.dds, "logger");
   for (std::size_t i = 0; i < options_.topics.size(); ++i) {
@@ -95,6 +96,64 @@ LoggerNode::LoggerNode(const LoggerOptions& options) : options_(options) {
       throw std::logic_error("logger: no reader for topic '" + name + "'");
     }
   }
+}
+
+void LoggerNode::open_file(std::size_t index) {
+  logger::McapWriterOptions file;
+  file.chunk_size_bytes = options_.chunk_size_bytes;
+  file.compression = options_.compression;
+  file.sync_after_chunk = options_.fsync;
+  const std::string path =
+      rotation_enabled(options_) ? rotated_file_name(options_.output_file, index) : options_.output_file;
+  writer_.open(path, file);
+  file_index_ = index;
+  file_opened_ = std::chrono::steady_clock::now();
+
+  const std::map<std::string, std::string> metadata_base = {
+      {"robot_id", options_.dds.robot_id}, {"dds_domain_id", std::to_string(options_.dds.domain_id)}};
+  for (std::size_t i = 0; i < topic_infos_.size(); ++i) {
+    const TopicInfo& info = *topic_infos_[i];
+    const std::uint16_t schema = writer_.add_schema(info.type_name, "omgidl", msg::idl_text(info.idl_stem));
+    std::map<std::string, std::string> metadata = metadata_base;
+    metadata["type_name"] = info.type_name;
+    const std::uint16_t channel = writer_.add_channel(info.topic, "cdr", schema, metadata);
+    if (index == 0) {
+      topics_[i].channel_id = channel;  // the same in every file: same order
+    } else if (topics_[i].channel_id != channel) {
+      throw std::logic_error("logger: channel ids differ between rotated files");
+    }
+  }
+}
+
+void LoggerNode::rotate() {
+  writer_.close();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    closed_files_.push_back(LoggedFile{writer_.path(), writer_.counters(), true});
+  }
+  open_file(file_index_ + 1);
+  std::lock_guard<std::mutex> lock(mutex_);
+  update_file_counters();
+}
+
+bool LoggerNode::size_limit_reached() const {
+  return options_.rotate_size_bytes > 0 &&
+         writer_.counters().bytes_written + writer_.chunk_bytes_buffered() >= options_.rotate_size_bytes;
+}
+
+void LoggerNode::update_file_counters() {
+  totals_.files = closed_files_;
+  totals_.files.push_back(LoggedFile{writer_.path(), writer_.counters(), !writer_.is_open()});
+  logger::McapWriterCounters sum;
+  for (const LoggedFile& f : totals_.files) {
+    sum.messages += f.counters.messages;
+    sum.schemas += f.counters.schemas;
+    sum.channels += f.counters.channels;
+    sum.chunks += f.counters.chunks;
+    sum.bytes_written += f.counters.bytes_written;
+    sum.message_bytes += f.counters.message_bytes;
+  }
+  totals_.file = sum;
 }
 
 template <class Message>
@@ -167,9 +226,13 @@ void LoggerNode::enqueue(std::size_t topic, std::uint64_t seq, std::uint64_t sta
 
 void LoggerNode::writer_loop() {
   using Clock = std::chrono::steady_clock;
+  const auto to_duration = [](double s) {
+    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  };
   const bool timed = options_.flush_period_s > 0.0;
-  const auto period =
-      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.flush_period_s));
+  const bool rotate_by_time = options_.rotate_period_s > 0.0;
+  const auto period = to_duration(options_.flush_period_s);
+  const auto rotate_period = to_duration(options_.rotate_period_s);
   auto next_flush = Clock::now() + period;
   std::deque<Pending> batch;
   for (;;) {
@@ -177,8 +240,11 @@ void LoggerNode::writer_loop() {
     {
       std::unique_lock<std::mutex> lock(mutex_);
       const auto ready = [this] { return !queue_.empty() || stopping_; };
-      if (timed) {
-        cv_.wait_until(lock, next_flush, ready);
+      auto deadline = Clock::time_point::max();
+      if (timed) deadline = next_flush;
+      if (rotate_by_time) deadline = std::min(deadline, file_opened_ + rotate_period);
+      if (deadline != Clock::time_point::max()) {
+        cv_.wait_until(lock, deadline, ready);
       } else {
         cv_.wait(lock, ready);
       }
@@ -196,6 +262,13 @@ void LoggerNode::writer_loop() {
       }
       next_flush = Clock::now() + period;
     }
+    if (!stopping && rotate_by_time && writer_.is_open() && Clock::now() >= file_opened_ + rotate_period) {
+      try {
+        rotate();
+      } catch (const std::exception& e) {
+        record_error(e.what());
+      }
+    }
     if (stopping) break;
   }
   try {
@@ -204,7 +277,7 @@ void LoggerNode::writer_loop() {
     record_error(e.what());
   }
   std::lock_guard<std::mutex> lock(mutex_);
-  totals_.file = writer_.counters();
+  update_file_counters();
 }
 
 void LoggerNode::write_batch(std::deque<Pending>& batch) {
@@ -221,10 +294,17 @@ void LoggerNode::write_batch(std::deque<Pending>& batch) {
         writer_.write_message(topics_[p.topic].channel_id, static_cast<std::uint32_t>(p.seq), p.log_time_ns,
                               p.publish_time_ns, p.payload);
         ++written[p.topic];
+      } catch (const std::exception& e) {
+        error = e.what();
+        ++dropped[p.topic];
         continue;
+      }
+      try {
+        if (size_limit_reached()) rotate();
       } catch (const std::exception& e) {
         error = e.what();
       }
+      continue;
     }
     ++dropped[p.topic];
   }
@@ -238,7 +318,7 @@ void LoggerNode::write_batch(std::deque<Pending>& batch) {
     }
     queued_bytes_ -= bytes;
     queued_messages_ -= count;
-    totals_.file = writer_.counters();
+    update_file_counters();
   }
   if (!error.empty()) record_error(error);
 }

@@ -1,10 +1,10 @@
 #include "pixyslam/logger_node/logger_options.h"
 
-#include <set>
 #include <sstream>
 
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/logger_node/topic_selection.h"
 
 namespace pixyslam::logger_node {
 
@@ -21,11 +21,7 @@ std::vector<std::string> all_topics() {
   return out;
 }
 
-std::string topic_list() {
-  std::string out;
-  for (const TopicInfo& t : known_topics()) out += (out.empty() ? "" : ", ") + t.topic;
-  return out;
-}
+constexpr std::uint64_t kMinRotateSizeBytes = 65536;
 
 logger::McapCompression read_compression(config::YamlReader& reader, logger::McapCompression fallback) {
   const std::string fallback_name =
@@ -43,24 +39,35 @@ logger::McapCompression read_compression(config::YamlReader& reader, logger::Mca
 
 }  // namespace
 
+bool rotation_enabled(const LoggerOptions& options) {
+  return options.rotate_size_bytes > 0 || options.rotate_period_s > 0.0;
+}
+
 LoggerOptions read_logger_options(config::YamlReader& root, const std::string& config_dir) {
   LoggerOptions o;
   config::YamlReader section = root.child("logger");
   o.output_file = section.text("output_file", o.output_file);
   if (o.output_file.empty()) section.fail("output_file", "must not be empty");
   if (section.has("topics")) {
-    o.topics = section.text_list("topics");
-    if (o.topics.empty()) section.fail("topics", "empty list (leave the key out to record every topic)");
-    std::set<std::string> seen;
-    for (std::size_t i = 0; i < o.topics.size(); ++i) {
-      const std::string key = "topics[" + std::to_string(i) + "]";
-      if (find_topic(o.topics[i]) == nullptr) {
-        section.fail(key, "unknown topic '" + o.topics[i] + "' (known: " + topic_list() + ")");
-      }
-      if (!seen.insert(o.topics[i]).second) section.fail(key, "topic '" + o.topics[i] + "' given twice");
+    const std::vector<std::string> patterns = section.text_list("topics");
+    if (patterns.empty()) section.fail("topics", "empty list (leave the key out to record every topic)");
+    const TopicSelection selection = select_topics(patterns, all_topics());
+    if (!selection.error.empty()) {
+      section.fail("topics[" + std::to_string(selection.bad_pattern) + "]", selection.error);
     }
+    o.topics = selection.topics;
   } else {
     o.topics = all_topics();
+  }
+  o.rotate_size_bytes = static_cast<std::uint64_t>(
+      section.integer("rotate_size_bytes", 0, std::int64_t{1} << 40, static_cast<std::int64_t>(o.rotate_size_bytes)));
+  if (o.rotate_size_bytes != 0 && o.rotate_size_bytes < kMinRotateSizeBytes) {
+    section.fail("rotate_size_bytes", "value " + std::to_string(o.rotate_size_bytes) + " is too small: 0 (off) or at least " +
+                                          std::to_string(kMinRotateSizeBytes));
+  }
+  o.rotate_period_s = section.number("rotate_period_s", 0.0, 7 * 86400.0, o.rotate_period_s);
+  if (o.rotate_period_s != 0.0 && o.rotate_period_s < 1.0) {
+    section.fail("rotate_period_s", "value " + std::to_string(o.rotate_period_s) + " is too small: 0 (off) or at least 1");
   }
   o.chunk_size_bytes = static_cast<std::size_t>(
       section.integer("chunk_size_bytes", 4096, std::int64_t{1} << 28, static_cast<std::int64_t>(o.chunk_size_bytes)));
@@ -91,6 +98,8 @@ std::string to_yaml(const LoggerOptions& o) {
      << "  topics: [";
   for (std::size_t i = 0; i < o.topics.size(); ++i) os << (i ? ", " : "") << o.topics[i];
   os << "]\n"
+     << "  rotate_size_bytes: " << o.rotate_size_bytes << "\n"
+     << "  rotate_period_s: " << o.rotate_period_s << "\n"
      << "  chunk_size_bytes: " << o.chunk_size_bytes << "\n"
      << "  compression: "
      << (o.compression == logger::McapCompression::kNone ? "none" : logger::mcap_compression_name(o.compression))

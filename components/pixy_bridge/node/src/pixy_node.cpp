@@ -8,6 +8,15 @@
 #include "pixyslam/pixy_node/observation_conversions.h"
 
 namespace pixyslam::pixy_node {
+namespace {
+
+// The options, once the camera model passed pixy::validate() (before any DDS entity exists).
+const PixyNodeOptions& validated(const PixyNodeOptions& options) {
+  pixy::validate(options.pixy.camera);
+  return options;
+}
+
+}  // namespace
 
 PixyNode::PixyNode(const PixyNodeOptions& options, bridge::LogFunction log)
     : PixyNode(options, std::make_unique<bridge::SerialByteSource>(options.serial_device, options.baud),
@@ -15,61 +24,38 @@ PixyNode::PixyNode(const PixyNodeOptions& options, bridge::LogFunction log)
 
 PixyNode::PixyNode(const PixyNodeOptions& options, std::unique_ptr<bridge::ByteSource> source,
                    bridge::LogFunction log, bridge::ClockFunction clock)
-    : options_(options), log_(log ? std::move(log) : bridge::stderr_log("pixy_bridge")) {
-  pixy::validate(options_.pixy.camera);
-  participant_ = std::make_unique<dds::Participant>(options_.dds, "pixy_bridge");
-  writer_ = std::make_unique<dds::Writer<msg::LandmarkObservation>>(*participant_);
-  reader_ = std::make_unique<bridge::DeviceReader>(std::move(source),
-                                                   bridge::device_reader_options(options_.process), log_,
-                                                   clock ? std::move(clock) : bridge::ClockFunction(&dds::now_ns));
-}
+    : options_(validated(options)),
+      runtime_("pixy_bridge", options.dds, options.process, std::move(source), std::move(log), std::move(clock),
+               mutex_) {}
 
-PixyNode::~PixyNode() {
-  stop();
-  reader_.reset();
-  writer_.reset();
-  participant_.reset();
-}
+PixyNode::~PixyNode() { stop(); }
 
 void PixyNode::start() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (started_) return;
-    started_ = true;
-    next_status_ = std::chrono::steady_clock::now() +
-                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                       std::chrono::duration<double>(options_.process.status_period_s));
-  }
-  log_("reading '" + reader_->device_name() + "', publishing one observation per camera frame on '" +
-       std::string(dds::kLandmarkObservationTopic) + "' (" + std::to_string(options_.pixy.signatures.size()) +
-       " landmark signatures)");
-  reader_->start({{},
+  runtime_.start("reading '" + runtime_.device_name() + "', publishing one observation per camera frame on '" +
+                     std::string(dds::kLandmarkObservationTopic) + "' (" +
+                     std::to_string(options_.pixy.signatures.size()) + " landmark signatures)",
+                 {{},
                   [this](const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns) {
                     on_bytes(data, size, receive_ns);
                   },
-                  [this](std::uint64_t now_ns) { on_poll(now_ns); }});
+                  [this](std::uint64_t now_ns) { on_poll(now_ns); },
+                  [this] { return status_lines_locked(); }});
 }
 
-void PixyNode::stop() {
-  reader_->stop();
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!started_ || stopped_) return;
-  stopped_ = true;
-  for (const std::string& line : status_lines_locked()) log_("final " + line);
-}
+void PixyNode::stop() { runtime_.stop(); }
 
 bool PixyNode::wait_for_subscribers(int count, std::chrono::milliseconds timeout) const {
-  return writer_->wait_for_readers(count, timeout);
+  return runtime_.wait_for_readers(count, timeout);
 }
 
 PixyNodeCounters PixyNode::counters() const {
   std::lock_guard<std::mutex> lock(mutex_);
   PixyNodeCounters c;
-  c.device = reader_->counters();
+  c.device = runtime_.device_counters();
   c.parser = parser_.counters();
   c.detections = detection_counters_;
-  c.published = published_;
-  c.publish_failures = publish_failures_;
+  c.published = runtime_.published();
+  c.publish_failures = runtime_.publish_failures();
   c.frames_timed_out = frames_timed_out_;
   c.detections_dropped = detections_dropped_;
   return c;
@@ -81,13 +67,9 @@ std::vector<std::string> PixyNode::status_lines() const {
 }
 
 std::vector<std::string> PixyNode::status_lines_locked() const {
-  const bridge::DeviceCounters d = reader_->counters();
   const pixy::PixyParserCounters& p = parser_.counters();
   const pixy::DetectionCounters& k = detection_counters_;
-  std::ostringstream device, stream, detections;
-  device << "status: device '" << reader_->device_name() << "': opens " << d.opens << ", open failures "
-         << d.open_failures << ", hang-ups " << d.hangups << ", read errors " << d.read_errors << ", bytes "
-         << d.bytes;
+  std::ostringstream stream, detections;
   stream << "status: frames " << p.frames << " (timed out " << frames_timed_out_ << "), blocks " << p.blocks_ok
          << " (colour code " << p.colour_code_blocks_ok << ", outside a frame " << p.blocks_outside_frame
          << "), checksum errors " << p.checksum_errors << ", signature 0 " << p.zero_signature_blocks
@@ -95,13 +77,12 @@ std::vector<std::string> PixyNode::status_lines_locked() const {
   detections << "status: detections " << k.detections << " of " << k.blocks << " blocks; rejected: unknown signature "
              << k.unknown_signature << ", zero height " << k.zero_height << ", outside image " << k.outside_image
              << ", bad aspect " << k.bad_aspect << ", duplicate " << k.duplicate_landmark
-             << "; observations published " << published_ << ", failed " << publish_failures_
+             << "; observations published " << runtime_.published() << ", failed " << runtime_.publish_failures()
              << ", detections dropped " << detections_dropped_;
-  return {device.str(), stream.str(), detections.str()};
+  return {runtime_.device_status_line(), stream.str(), detections.str()};
 }
 
 void PixyNode::on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns) {
-  std::lock_guard<std::mutex> lock(mutex_);
   // A frame ends with its last block, but is known to be complete only when
   // the next frame starts. "Progress" (blocks + frame starts parsed) tells
   // whether the frame being delivered got anything from this chunk.
@@ -117,19 +98,12 @@ void PixyNode::on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_
 }
 
 void PixyNode::on_poll(std::uint64_t now_ns) {
-  std::lock_guard<std::mutex> lock(mutex_);
   const auto timeout_ns = static_cast<std::uint64_t>(std::llround(options_.frame_timeout_s * 1e9));
   if (parser_.frame_open() && now_ns > frame_end_ns_ + timeout_ns) {
     if (std::optional<pixy::PixyFrame> frame = parser_.flush()) {
       ++frames_timed_out_;
       publish(*frame, frame_end_ns_);
     }
-  }
-  if (options_.process.status_period_s > 0.0 && std::chrono::steady_clock::now() >= next_status_) {
-    for (const std::string& line : status_lines_locked()) log_(line);
-    next_status_ = std::chrono::steady_clock::now() +
-                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                       std::chrono::duration<double>(options_.process.status_period_s));
   }
 }
 
@@ -141,11 +115,7 @@ void PixyNode::publish(const pixy::PixyFrame& frame, std::uint64_t end_ns) {
   }
   const auto latency_ns = static_cast<std::uint64_t>(std::llround(options_.camera_latency_s * 1e9));
   msg::LandmarkObservation m = to_observation_msg(frame, detections, end_ns > latency_ns ? end_ns - latency_ns : 0);
-  if (writer_->publish(m)) {
-    ++published_;
-  } else {
-    ++publish_failures_;
-  }
+  runtime_.publish(m);
 }
 
 }  // namespace pixyslam::pixy_node

@@ -2,8 +2,10 @@
 
 #include <string>
 
+#include "pixyslam/app/command_line.h"
 #include "pixyslam/bridge/device_reader.h"
 #include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/config/yaml_text.h"
 #include "pixyslam/dds/participant.h"
 
 namespace pixyslam::bridge {
@@ -21,11 +23,18 @@ BridgeProcessOptions read_bridge_process_options(config::YamlReader& node);
 
 DeviceReaderOptions device_reader_options(const BridgeProcessOptions& options);
 
-// Shortest text that reads back as the same double ("0.1", "1e-05").
-std::string yaml_number(double value);
-// A double-quoted YAML string.
-std::string yaml_quoted(const std::string& text);
-// The two keys above as lines of a `node:` mapping (two-space indent).
+// The bridges' command-line overrides of what args.get("config") set:
+// --device PATH replaces `serial_device` (std::invalid_argument unless it is an
+// absolute path), --dds-config FILE replaces dds.profiles_file. The profiles
+// file must be readable: config::ConfigError naming --dds-config or the config
+// file's key dds.profiles_file otherwise.
+void apply_command_line(const app::CommandLine& args, std::string& serial_device, dds::DdsOptions& dds);
+
+// The YAML scalars of the bridges' to_yaml() (config/yaml_text.h).
+using config::yaml_number;
+using config::yaml_quoted;
+
+// reopen_period_s and status_period_s as lines of a `node:` mapping (two-space indent).
 std::string to_yaml_lines(const BridgeProcessOptions& options);
 // The options as a `dds:` mapping, as read_dds_options() reads it.
 std::string to_yaml(const dds::DdsOptions& options);

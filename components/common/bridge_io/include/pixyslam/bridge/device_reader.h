@@ -73,6 +73,8 @@ class DeviceReader {
 
   DeviceCounters counters() const;
   const std::string& device_name() const { return device_name_; }
+  // The counters as a log line: "status: device '<name>': opens N, open failures N, ...".
+  std::string status_line() const;
 
  private:
   void loop();

@@ -58,6 +58,17 @@ class YamlReader {
 
   // Throws ConfigError naming the first key of this mapping that was never read.
   void finish() const;
+  // Runs `check` (e.g. validate() of the options read from this mapping); a
+  // std::invalid_argument it throws becomes a ConfigError naming the file and
+  // this mapping: "<origin>: mapping '<path>': <what>".
+  template <class Check>
+  void check_mapping(const Check& check) const {
+    try {
+      check();
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(origin_ + ": mapping '" + path_ + "': " + e.what());
+    }
+  }
 
   const std::string& origin() const { return origin_; }
   const std::string& path() const { return path_; }

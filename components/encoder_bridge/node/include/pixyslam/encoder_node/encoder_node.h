@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "odometry.h"
+#include "pixyslam/bridge/bridge_runtime.h"
 #include "pixyslam/bridge/byte_source.h"
 #include "pixyslam/bridge/device_reader.h"
-#include "pixyslam/dds/endpoints.h"
 #include "pixyslam/encoder/arduino_line_parser.h"
 #include "pixyslam/encoder/wheel_odometry.h"
 #include "pixyslam/encoder_node/arduino_clock.h"
@@ -68,6 +68,7 @@ class EncoderNode {
   std::vector<std::string> status_lines() const;
 
  private:
+  // The reader thread's handlers, called with mutex_ held (BridgeRuntime).
   void on_open();
   void on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns);
   void on_poll(std::uint64_t now_ns);
@@ -78,9 +79,6 @@ class EncoderNode {
   std::vector<std::string> status_lines_locked() const;
 
   EncoderNodeOptions options_;
-  bridge::LogFunction log_;
-  std::unique_ptr<dds::Participant> participant_;
-  std::unique_ptr<dds::Writer<msg::Odometry>> writer_;
 
   // Reader-thread state; others read it under mutex_.
   mutable std::mutex mutex_;
@@ -93,14 +91,9 @@ class EncoderNode {
   std::deque<double> sample_times_;  // of samples not yet counted into an output, s
   double last_time_s_ = 0.0;         // latest time passed to the accumulator
   std::uint64_t last_sample_ns_ = 0;  // receive time of the latest sample
-  std::chrono::steady_clock::time_point next_status_;
-  std::uint64_t published_ = 0;
-  std::uint64_t publish_failures_ = 0;
   std::uint64_t empty_periods_ = 0;
-  bool started_ = false;
-  bool stopped_ = false;
 
-  std::unique_ptr<bridge::DeviceReader> reader_;  // last: its thread uses the members above
+  bridge::BridgeRuntime<msg::Odometry> runtime_;  // last: its thread uses the members above
 };
 
 }  // namespace pixyslam::encoder_node

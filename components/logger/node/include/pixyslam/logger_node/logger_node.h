@@ -1,5 +1,6 @@
 #pragma once
 
+#include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
@@ -12,6 +13,7 @@
 
 #include "pixyslam/dds/participant.h"
 #include "pixyslam/logger/mcap_writer.h"
+#include "pixyslam/logger_node/cdr_payload.h"
 #include "pixyslam/logger_node/logger_options.h"
 
 namespace pixyslam::logger_node {
@@ -30,11 +32,19 @@ struct TopicCounters {
   std::uint64_t seq_gaps = 0;    // header seq numbers skipped, per DDS writer (lost before us)
 };
 
+// One MCAP file of the recording.
+struct LoggedFile {
+  std::string path;
+  logger::McapWriterCounters counters;  // final once the file is closed
+  bool closed = false;                  // summary and footer written
+};
+
 struct LoggerCounters {
   std::vector<TopicCounters> topics;  // in the order of options.topics
   std::size_t queue_peak_bytes = 0;   // most payload bytes ever waiting
   std::size_t queue_peak_messages = 0;
-  logger::McapWriterCounters file;    // of the MCAP writer (final after stop())
+  logger::McapWriterCounters file;    // totals over every file (final after stop())
+  std::vector<LoggedFile> files;      // in order; one unless rotating
   std::string error;                  // the write failure that stopped recording ("" if none)
 };
 
@@ -48,6 +58,12 @@ struct LoggerCounters {
 // metadata type_name, robot_id (dds.robot_id of the logger) and dds_domain_id.
 // Schema: encoding "omgidl", name = DDS type name ("pixyslam::msg::Odometry"),
 // data = the IDL with its includes inlined (msg::idl_text).
+//
+// Rotation (rotate_size_bytes / rotate_period_s): the writer thread closes the
+// file (summary, footer: each file is a complete MCAP with every schema and
+// channel, same ids) and opens rotated_file_name(output_file, next index);
+// without rotation the one file is output_file itself. Topics may be given as
+// patterns (select_topics()); an invalid selection throws std::invalid_argument.
 //
 // DDS callbacks only serialize and enqueue (bounded by queue_max_bytes; a
 // sample beyond the bound is dropped and counted); ONE writer thread writes
@@ -94,11 +110,21 @@ class LoggerNode {
                std::vector<std::uint8_t>&& payload, bool serialized);
   void writer_loop();
   void write_batch(std::deque<Pending>& batch);
+  // Opens file `index` (rotated name when rotating) with every schema and channel.
+  void open_file(std::size_t index);
+  // Closes the current file and opens the next one. Writer thread only.
+  void rotate();
+  bool size_limit_reached() const;
+  // Copies the writer's counters into totals_ (mutex_ held).
+  void update_file_counters();
   // The writer thread's failure: recorded once, recording stops.
   void record_error(const std::string& what);
 
   LoggerOptions options_;
+  std::vector<const TopicInfo*> topic_infos_;  // per topics_ entry
   logger::McapWriter writer_;  // after construction: the writer thread's alone (stop()'s if never started)
+  std::size_t file_index_ = 0;
+  std::chrono::steady_clock::time_point file_opened_;
 
   // Queue and counters.
   mutable std::mutex mutex_;
@@ -110,6 +136,7 @@ class LoggerNode {
   bool stopping_ = false;
   std::vector<TopicCounters> topics_;
   LoggerCounters totals_;         // peaks, file counters, error (topics_ kept apart)
+  std::vector<LoggedFile> closed_files_;
 
   std::mutex lifecycle_mutex_;    // start() / stop()
   bool started_ = false;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -16,10 +17,20 @@ logger::McapCompression default_compression();
 // Everything the logger process is configured with (config/logger.yaml).
 struct LoggerOptions {
   // `logger.output_file`: the MCAP file, created or truncated; a relative path
-  // is relative to the working directory. `logger --out` overrides it.
+  // is relative to the working directory. `logger --out` overrides it. With
+  // rotation on, the files are named rotated_file_name(output_file, 0, 1, ...):
+  // run.mcap -> run_000.mcap, run_001.mcap, ...
   std::string output_file = "pixyslam_run.mcap";
-  // `logger.topics`: DDS topic names to record (known_topics()); empty = all.
+  // `logger.topics`: the DDS topics to record (known_topics()), as patterns
+  // (select_topics(): names, globs, "!" exclusions); empty = all. The reader
+  // resolves them into names, in the order of known_topics().
   std::vector<std::string> topics;
+  // `logger.rotate_size_bytes`: start a new file once this one holds this many
+  // bytes (written plus the open chunk uncompressed; 0 = never). A file may
+  // exceed it by one message and its summary.
+  std::uint64_t rotate_size_bytes = 0;
+  // `logger.rotate_period_s`: start a new file after this long (0 = never).
+  double rotate_period_s = 0.0;
   // `logger.chunk_size_bytes`: uncompressed bytes per MCAP chunk before it is written.
   std::size_t chunk_size_bytes = std::size_t{1} << 20;
   // `logger.compression`: none | zstd | lz4 (chunk compression).
@@ -34,6 +45,9 @@ struct LoggerOptions {
   std::size_t queue_max_bytes = std::size_t{64} << 20;
   dds::DdsOptions dds;  // `dds:`
 };
+
+// True when rotate_size_bytes or rotate_period_s is set.
+bool rotation_enabled(const LoggerOptions& options);
 
 // Reads `logger:` (required) and `dds:` (optional) from the top level and calls
 // root.finish(). `config_dir` resolves a relative dds.profiles_file. Throws

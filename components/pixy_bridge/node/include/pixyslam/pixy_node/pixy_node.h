@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "landmark_observation.h"
+#include "pixyslam/bridge/bridge_runtime.h"
 #include "pixyslam/bridge/byte_source.h"
 #include "pixyslam/bridge/device_reader.h"
-#include "pixyslam/dds/endpoints.h"
 #include "pixyslam/pixy/pixy_block_parser.h"
 #include "pixyslam/pixy/pixy_geometry.h"
 #include "pixyslam/pixy_node/pixy_node_options.h"
@@ -65,30 +65,23 @@ class PixyNode {
   std::vector<std::string> status_lines() const;
 
  private:
+  // The reader thread's handlers, called with mutex_ held (BridgeRuntime).
   void on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns);
   void on_poll(std::uint64_t now_ns);
   void publish(const pixy::PixyFrame& frame, std::uint64_t end_ns);
   std::vector<std::string> status_lines_locked() const;
 
   PixyNodeOptions options_;
-  bridge::LogFunction log_;
-  std::unique_ptr<dds::Participant> participant_;
-  std::unique_ptr<dds::Writer<msg::LandmarkObservation>> writer_;
 
   // Reader-thread state; others read it under mutex_.
   mutable std::mutex mutex_;
   pixy::PixyBlockParser parser_;
   pixy::DetectionCounters detection_counters_;
   std::uint64_t frame_end_ns_ = 0;  // host time the open frame last advanced (opened or got a block)
-  std::chrono::steady_clock::time_point next_status_;
-  std::uint64_t published_ = 0;
-  std::uint64_t publish_failures_ = 0;
   std::uint64_t frames_timed_out_ = 0;
   std::uint64_t detections_dropped_ = 0;
-  bool started_ = false;
-  bool stopped_ = false;
 
-  std::unique_ptr<bridge::DeviceReader> reader_;  // last: its thread uses the members above
+  bridge::BridgeRuntime<msg::LandmarkObservation> runtime_;  // last: its thread uses the members above
 };
 
 }  // namespace pixyslam::pixy_node

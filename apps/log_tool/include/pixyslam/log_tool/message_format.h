@@ -1,0 +1,81 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ground_truth.h"
+#include "landmark_observation.h"
+#include "map_state.h"
+#include "odometry.h"
+
+namespace pixyslam::log_tool {
+
+// A message as a tree of named fields, in IDL order, for printing: structs,
+// sequences/arrays and scalars. Field names are the IDL names (units included,
+// e.g. `v_mps`). Plain value type, no DDS; thread-compatible.
+class Value {
+ public:
+  enum class Kind { kFloat, kInt, kUInt, kString, kStruct, kList };
+
+  static Value number(double v);
+  static Value integer(std::int64_t v);
+  static Value unsigned_integer(std::uint64_t v);
+  static Value string(std::string v);
+  static Value structure() { return Value(Kind::kStruct); }
+  static Value list() { return Value(Kind::kList); }
+
+  // Builders: add(name, value) on a struct, push(value) on a list. Return *this.
+  Value& add(std::string name, Value value);
+  Value& push(Value value);
+
+  Kind kind() const { return kind_; }
+  double float_value() const { return float_; }
+  std::int64_t int_value() const { return int_; }
+  std::uint64_t uint_value() const { return uint_; }
+  const std::string& string_value() const { return text_; }
+  const std::vector<std::pair<std::string, Value>>& fields() const { return fields_; }
+  const std::vector<Value>& items() const { return items_; }
+  // The field `name` of a struct (dotted path "header.seq" allowed); nullptr if absent.
+  const Value* find(const std::string& path) const;
+
+ private:
+  explicit Value(Kind kind) : kind_(kind) {}
+  Kind kind_;
+  double float_ = 0.0;
+  std::int64_t int_ = 0;
+  std::uint64_t uint_ = 0;
+  std::string text_;
+  std::vector<std::pair<std::string, Value>> fields_;
+  std::vector<Value> items_;
+};
+
+// Every field of a message (nested structs and sequences included).
+Value to_value(const msg::Odometry& m);
+Value to_value(const msg::LandmarkObservation& m);
+Value to_value(const msg::MapState& m);
+Value to_value(const msg::GroundTruth& m);
+
+// One YAML document: "---\n" then a block mapping; lists of scalars in flow
+// style ([1, 2]), lists of structs as block sequences, strings double-quoted
+// (JSON escapes), non-finite floats as .nan / .inf / -.inf.
+std::string to_yaml_document(const Value& value);
+// One line of JSON (no trailing newline); non-finite floats as null.
+std::string to_json_line(const Value& value);
+// Shortest text that reads back as exactly `v` ("0.1", "1e-09", "3").
+std::string format_double(double v);
+
+// Inter-arrival statistics of a stream (pixyslam_spy hz), times in seconds.
+struct GapStats {
+  std::size_t messages = 0;
+  double rate_hz = 0.0;  // 1 / mean gap (0 with fewer than two messages)
+  double mean_s = 0.0;
+  double min_s = 0.0;
+  double max_s = 0.0;
+  double std_s = 0.0;    // population standard deviation of the gaps (jitter)
+};
+// `arrivals_s` in arrival order (non-decreasing).
+GapStats gap_stats(const std::vector<double>& arrivals_s);
+
+}  // namespace pixyslam::log_tool

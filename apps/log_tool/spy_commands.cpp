@@ -1,0 +1,391 @@
+#include "spy_commands.h"
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+
+#include "pixyslam/app/stop_signal.h"
+#include "pixyslam/dds/endpoints.h"
+#include "pixyslam/log_tool/message_format.h"
+
+namespace pixyslam::log_tool {
+
+namespace fdds = eprosima::fastdds::dds;
+namespace rtps = eprosima::fastrtps::rtps;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Sleeps until `seconds` passed (0: forever) or a stop signal; `done` may end it earlier.
+template <class Done>
+void wait(double seconds, Done done) {
+  const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  while (!done() && (seconds <= 0.0 || Clock::now() < end)) {
+    if (app::StopSignal::wait_for(std::chrono::milliseconds(20))) return;
+  }
+}
+
+std::string text(const std::ostringstream& os) { return os.str(); }
+
+template <class T>
+std::string to_text(const T& value) {
+  std::ostringstream os;
+  os << value;
+  return text(os);
+}
+
+const char* reliability_name(fdds::ReliabilityQosPolicyKind k) {
+  return k == fdds::RELIABLE_RELIABILITY_QOS ? "reliable" : "best_effort";
+}
+
+const char* durability_name(fdds::DurabilityQosPolicyKind k) {
+  switch (k) {
+    case fdds::VOLATILE_DURABILITY_QOS: return "volatile";
+    case fdds::TRANSIENT_LOCAL_DURABILITY_QOS: return "transient_local";
+    case fdds::TRANSIENT_DURABILITY_QOS: return "transient";
+    case fdds::PERSISTENT_DURABILITY_QOS: return "persistent";
+  }
+  return "?";
+}
+
+std::string history_name(const fdds::HistoryQosPolicy& h) {
+  return h.kind == fdds::KEEP_ALL_HISTORY_QOS ? "keep_all" : "keep_last " + std::to_string(h.depth);
+}
+
+// What discovery told about one remote participant.
+struct ParticipantEntry {
+  std::string name;
+  std::string guid_prefix;
+  std::map<std::string, std::string> properties;
+  bool alive = true;
+};
+
+// One remote writer or reader.
+struct EndpointEntry {
+  bool writer = true;
+  std::string topic;
+  std::string type;
+  std::string participant_prefix;
+  std::string reliability;
+  std::string durability;
+  bool type_information = false;
+  bool alive = true;
+};
+
+// Collects discovery events (called on Fast DDS threads) under one lock.
+class DiscoveryListener : public fdds::DomainParticipantListener {
+ public:
+  void on_participant_discovery(fdds::DomainParticipant*, rtps::ParticipantDiscoveryInfo&& info) override {
+    const std::string prefix = to_text(info.info.m_guid.guidPrefix);
+    std::lock_guard<std::mutex> lock(mutex_);
+    ParticipantEntry& e = participants_[prefix];
+    e.guid_prefix = prefix;
+    switch (info.status) {
+      case rtps::ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT:
+      case rtps::ParticipantDiscoveryInfo::CHANGED_QOS_PARTICIPANT:
+        e.alive = true;
+        e.name = info.info.m_participantName.to_string();
+        for (const auto& p : info.info.m_properties) e.properties[p.first()] = p.second();
+        break;
+      default:
+        e.alive = false;
+    }
+  }
+
+  void on_publisher_discovery(fdds::DomainParticipant*, rtps::WriterDiscoveryInfo&& info) override {
+    const bool alive = info.status == rtps::WriterDiscoveryInfo::DISCOVERED_WRITER ||
+                       info.status == rtps::WriterDiscoveryInfo::CHANGED_QOS_WRITER;
+    EndpointEntry e;
+    e.writer = true;
+    e.topic = info.info.topicName().to_string();
+    e.type = info.info.typeName().to_string();
+    e.participant_prefix = to_text(info.info.guid().guidPrefix);
+    e.reliability = reliability_name(info.info.m_qos.m_reliability.kind);
+    e.durability = durability_name(info.info.m_qos.m_durability.kind);
+    e.type_information = info.info.has_type_information();
+    e.alive = alive;
+    store(to_text(info.info.guid()), std::move(e));
+  }
+
+  void on_subscriber_discovery(fdds::DomainParticipant*, rtps::ReaderDiscoveryInfo&& info) override {
+    const bool alive = info.status == rtps::ReaderDiscoveryInfo::DISCOVERED_READER ||
+                       info.status == rtps::ReaderDiscoveryInfo::CHANGED_QOS_READER;
+    EndpointEntry e;
+    e.writer = false;
+    e.topic = info.info.topicName().to_string();
+    e.type = info.info.typeName().to_string();
+    e.participant_prefix = to_text(info.info.guid().guidPrefix);
+    e.reliability = reliability_name(info.info.m_qos.m_reliability.kind);
+    e.durability = durability_name(info.info.m_qos.m_durability.kind);
+    e.type_information = info.info.has_type_information();
+    e.alive = alive;
+    store(to_text(info.info.guid()), std::move(e));
+  }
+
+  std::map<std::string, ParticipantEntry> participants() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return participants_;
+  }
+  std::map<std::string, EndpointEntry> endpoints() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return endpoints_;
+  }
+
+ private:
+  void store(const std::string& guid, EndpointEntry e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    endpoints_[guid] = std::move(e);
+  }
+
+  mutable std::mutex mutex_;
+  std::map<std::string, ParticipantEntry> participants_;  // by GUID prefix
+  std::map<std::string, EndpointEntry> endpoints_;        // by GUID
+};
+
+// A bare participant with the discovery listener attached from creation (a
+// listener set afterwards would miss the first announcements), from the same
+// XML profile as every pixyslam process.
+class DiscoveryParticipant {
+ public:
+  DiscoveryParticipant(const dds::DdsOptions& options, DiscoveryListener& listener) {
+    // Like dds::Participant: the project's TypeObjects before any discovery.
+    dds::MessageTraits<msg::Odometry>::register_type_object();
+    dds::MessageTraits<msg::LandmarkObservation>::register_type_object();
+    dds::MessageTraits<msg::MapState>::register_type_object();
+    dds::MessageTraits<msg::GroundTruth>::register_type_object();
+    auto* factory = fdds::DomainParticipantFactory::get_instance();
+    if (!options.profiles_file.empty() &&
+        factory->load_XML_profiles_file(options.profiles_file) != ReturnCode_t::RETCODE_OK) {
+      throw std::runtime_error("cannot load Fast DDS profiles file '" + options.profiles_file + "'");
+    }
+    fdds::DomainParticipantQos qos;
+    if (factory->get_participant_qos_from_profile(options.participant_profile, qos) != ReturnCode_t::RETCODE_OK) {
+      throw std::runtime_error("no participant profile '" + options.participant_profile + "' in '" +
+                               options.profiles_file + "'");
+    }
+    qos.name("pixyslam_spy");
+    participant_ = factory->create_participant(options.domain_id, qos, &listener, fdds::StatusMask::none());
+    if (participant_ == nullptr) {
+      throw std::runtime_error("cannot create DDS participant on domain " + std::to_string(options.domain_id));
+    }
+    publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+    subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+  }
+  ~DiscoveryParticipant() {
+    participant_->set_listener(nullptr);
+    participant_->delete_contained_entities();
+    fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+  DiscoveryParticipant(const DiscoveryParticipant&) = delete;
+  DiscoveryParticipant& operator=(const DiscoveryParticipant&) = delete;
+
+  // History of the local XML profile named like the topic ("" if none).
+  std::string profile_history(const std::string& topic, bool writer) const {
+    if (writer) {
+      fdds::DataWriterQos qos;
+      if (publisher_ == nullptr || publisher_->get_datawriter_qos_from_profile(topic, qos) != ReturnCode_t::RETCODE_OK) return "";
+      return history_name(qos.history());
+    }
+    fdds::DataReaderQos qos;
+    if (subscriber_ == nullptr || subscriber_->get_datareader_qos_from_profile(topic, qos) != ReturnCode_t::RETCODE_OK) return "";
+    return history_name(qos.history());
+  }
+
+ private:
+  fdds::DomainParticipant* participant_ = nullptr;
+  fdds::Publisher* publisher_ = nullptr;
+  fdds::Subscriber* subscriber_ = nullptr;
+};
+
+// Rows of cells printed as columns two spaces apart (the last one unpadded).
+void print_table(const std::vector<std::vector<std::string>>& rows, const std::string& indent, std::ostream& out) {
+  std::vector<std::size_t> widths;
+  for (const auto& row : rows) {
+    widths.resize(std::max(widths.size(), row.size()), 0);
+    for (std::size_t i = 0; i < row.size(); ++i) widths[i] = std::max(widths[i], row[i].size());
+  }
+  for (const auto& row : rows) {
+    std::string line = indent;
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      line += row[i];
+      if (i + 1 < row.size()) line.append(widths[i] - row[i].size() + 2, ' ');
+    }
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    out << line << "\n";
+  }
+}
+
+std::string property(const ParticipantEntry& p, const std::string& key) {
+  const auto it = p.properties.find(key);
+  return it == p.properties.end() || it->second.empty() ? "-" : it->second;
+}
+
+std::string participant_label(const std::map<std::string, ParticipantEntry>& participants, const std::string& prefix) {
+  const auto it = participants.find(prefix);
+  if (it == participants.end()) return "(unknown participant " + prefix + ")";
+  std::string label = it->second.name.empty() ? "(unnamed)" : it->second.name;
+  const std::string pid = property(it->second, "pixyslam.pid");
+  if (pid != "-") label += " (pid " + pid + ")";
+  return label;
+}
+
+// Dispatches on the topic name to the project's message type.
+template <class Function>
+int with_topic_type(const std::string& topic, Function f) {
+  if (topic == dds::kOdometryTopic) return f(msg::Odometry{});
+  if (topic == dds::kLandmarkObservationTopic) return f(msg::LandmarkObservation{});
+  if (topic == dds::kMapStateTopic) return f(msg::MapState{});
+  if (topic == dds::kGroundTruthTopic) return f(msg::GroundTruth{});
+  std::fprintf(stderr, "pixyslam_spy: unknown topic '%s'; known: %s, %s, %s, %s\n", topic.c_str(),
+               std::string(dds::kOdometryTopic).c_str(), std::string(dds::kLandmarkObservationTopic).c_str(),
+               std::string(dds::kMapStateTopic).c_str(), std::string(dds::kGroundTruthTopic).c_str());
+  return 2;
+}
+
+}  // namespace
+
+int run_participants(const dds::DdsOptions& dds, double seconds, std::ostream& out) {
+  DiscoveryListener listener;
+  DiscoveryParticipant participant(dds, listener);
+  wait(seconds, [] { return false; });
+  const auto participants = listener.participants();
+  std::size_t alive = 0;
+  for (const auto& [prefix, p] : participants) alive += p.alive ? 1 : 0;
+  out << "participants on domain " << dds.domain_id << ": " << alive << " (discovery for " << seconds << " s)\n";
+  std::vector<std::vector<std::string>> rows{{"name", "guid prefix", "host", "pid", "process"}};
+  for (const auto& [prefix, p] : participants) {
+    if (!p.alive) continue;
+    rows.push_back({p.name.empty() ? "(unnamed)" : p.name, prefix, property(p, "pixyslam.host"),
+                    property(p, "pixyslam.pid"), property(p, "pixyslam.process")});
+  }
+  print_table(rows, "", out);
+  return 0;
+}
+
+int run_topics(const dds::DdsOptions& dds, double seconds, std::ostream& out) {
+  DiscoveryListener listener;
+  DiscoveryParticipant participant(dds, listener);
+  wait(seconds, [] { return false; });
+  const auto participants = listener.participants();
+  // topic -> type -> endpoints (sorted writers first, then by participant)
+  std::map<std::string, std::map<std::string, std::vector<EndpointEntry>>> topics;
+  for (const auto& [guid, e] : listener.endpoints()) {
+    if (e.alive) topics[e.topic][e.type].push_back(e);
+  }
+  out << "topics on domain " << dds.domain_id << ": " << topics.size() << " (discovery for " << seconds << " s)\n";
+  for (auto& [topic, types] : topics) {
+    for (auto& [type, endpoints] : types) {
+      std::stable_sort(endpoints.begin(), endpoints.end(), [&](const EndpointEntry& a, const EndpointEntry& b) {
+        if (a.writer != b.writer) return a.writer;
+        return participant_label(participants, a.participant_prefix) <
+               participant_label(participants, b.participant_prefix);
+      });
+      std::size_t writers = 0;
+      for (const EndpointEntry& e : endpoints) writers += e.writer ? 1 : 0;
+      out << topic << "  [" << type << "]  " << writers << " writer(s), " << endpoints.size() - writers
+          << " reader(s)\n";
+      std::vector<std::vector<std::string>> rows;
+      for (const EndpointEntry& e : endpoints) {
+        const std::string history = participant.profile_history(topic, e.writer);
+        rows.push_back({e.writer ? "writer" : "reader", participant_label(participants, e.participant_prefix),
+                        e.reliability, e.durability,
+                        "history " + (history.empty() ? std::string("? (not announced)") : history + " (local profile)"),
+                        e.type_information ? "type_information" : ""});
+      }
+      print_table(rows, "  ", out);
+    }
+  }
+  return 0;
+}
+
+int run_echo(const dds::DdsOptions& options, const EchoRequest& request, std::ostream& out) {
+  return with_topic_type(request.topic, [&](auto tag) {
+    using Message = decltype(tag);
+    std::mutex mutex;
+    std::condition_variable cv;
+    std::deque<std::string> pending;
+    dds::Participant participant(options, "pixyslam_spy");
+    dds::Reader<Message> reader(participant, [&](const Message& m) {
+      const Value value = to_value(m);
+      std::string text = request.json ? to_json_line(value) + "\n" : to_yaml_document(value);
+      std::lock_guard<std::mutex> lock(mutex);
+      pending.push_back(std::move(text));
+      cv.notify_all();
+    });
+    std::size_t printed = 0;
+    const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(request.seconds));
+    while (!app::StopSignal::requested() && (request.count == 0 || printed < request.count) &&
+           (request.seconds <= 0.0 || Clock::now() < end)) {
+      std::unique_lock<std::mutex> lock(mutex);
+      cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return !pending.empty(); });
+      while (!pending.empty() && (request.count == 0 || printed < request.count)) {
+        out << pending.front();
+        pending.pop_front();
+        ++printed;
+      }
+      out.flush();
+    }
+    if (request.count > 0 && printed < request.count) {
+      std::fprintf(stderr, "pixyslam_spy: echo %s: %zu of %zu samples received\n", request.topic.c_str(), printed,
+                   request.count);
+      return 1;
+    }
+    return 0;
+  });
+}
+
+int run_hz(const dds::DdsOptions& options, const std::string& topic, double seconds, std::ostream& out) {
+  return with_topic_type(topic, [&](auto tag) {
+    using Message = decltype(tag);
+    std::mutex mutex;
+    std::vector<double> arrivals_s;
+    std::vector<double> stamps_s;
+    const auto start = Clock::now();
+    dds::Participant participant(options, "pixyslam_spy");
+    dds::Reader<Message> reader(participant, [&](const Message& m) {
+      const double t = std::chrono::duration<double>(Clock::now() - start).count();
+      std::lock_guard<std::mutex> lock(mutex);
+      arrivals_s.push_back(t);
+      stamps_s.push_back(static_cast<double>(m.header().stamp_ns()) * 1e-9);
+    });
+    wait(seconds, [] { return false; });
+    const double listened_s = std::chrono::duration<double>(Clock::now() - start).count();
+    std::lock_guard<std::mutex> lock(mutex);
+    const GapStats arrival = gap_stats(arrivals_s);
+    const GapStats stamp = gap_stats(stamps_s);  // not sorted: a reordering shows as a negative min
+    char line[256];
+    out << topic << ": " << arrival.messages << " messages in " << format_double(std::round(listened_s * 100) / 100)
+        << " s\n";
+    if (arrival.messages < 2) {
+      out << "  fewer than two messages: no rate\n";
+      return 0;
+    }
+    std::snprintf(line, sizeof(line), "  rate %.3f Hz\n", arrival.rate_hz);
+    out << line;
+    std::snprintf(line, sizeof(line), "  arrival gap  mean %.3f ms  min %.3f ms  max %.3f ms  std %.3f ms\n",
+                  arrival.mean_s * 1e3, arrival.min_s * 1e3, arrival.max_s * 1e3, arrival.std_s * 1e3);
+    out << line;
+    std::snprintf(line, sizeof(line), "  stamp gap    mean %.3f ms  min %.3f ms  max %.3f ms  std %.3f ms\n",
+                  stamp.mean_s * 1e3, stamp.min_s * 1e3, stamp.max_s * 1e3, stamp.std_s * 1e3);
+    out << line;
+    return 0;
+  });
+}
+
+}  // namespace pixyslam::log_tool

@@ -1,0 +1,187 @@
+// pixyslam_spy: one inspection tool for the live system and its recordings,
+// decoding with the project's own types (no XTypes needed).
+//   pixyslam_spy participants | topics                     [DDS options] [--seconds N]
+//   pixyslam_spy echo TOPIC [--json] [--count N] [--seconds N] [DDS options]
+//   pixyslam_spy hz TOPIC [--seconds N]                    [DDS options]
+//   pixyslam_spy info FILE.mcap
+//   pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]
+// DDS options: --dds-config FILE (a YAML with a `dds:` mapping, e.g.
+// config/slam_estimator.yaml; default: config/dds/loopback.xml on domain 0),
+// --domain N. The same program is also built as pixyslam_log (info/check).
+// Exit status: 0 ok, 1 check failed / too few samples / file unreadable,
+// 2 command-line or config error.
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "log_commands.h"
+#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/stop_signal.h"
+#include "pixyslam/config/yaml_reader.h"
+#include "spy_commands.h"
+
+#ifndef PIXYSLAM_DEFAULT_PROFILES_FILE
+#define PIXYSLAM_DEFAULT_PROFILES_FILE ""
+#endif
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: pixyslam_spy participants [--seconds N] [DDS options]\n"
+    "       pixyslam_spy topics [--seconds N] [DDS options]\n"
+    "       pixyslam_spy echo TOPIC [--json] [--count N] [--seconds N] [DDS options]\n"
+    "       pixyslam_spy hz TOPIC [--seconds N] [DDS options]\n"
+    "       pixyslam_spy info FILE.mcap\n"
+    "       pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]\n"
+    "DDS options: --dds-config FILE (YAML with a dds: mapping; default " PIXYSLAM_DEFAULT_PROFILES_FILE
+    ", domain 0)\n"
+    "             --domain N (overrides the file's domain_id)\n"
+    "TOPIC: pixyslam/odometry, pixyslam/landmark_observation, pixyslam/map_state, pixyslam/ground_truth\n";
+
+// TOPIC=N, N a non-negative integer.
+void add_expectation(const std::string& text, pixyslam::log_tool::CheckRequest& request) {
+  const auto eq = text.rfind('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) {
+    throw std::invalid_argument("--expect needs TOPIC=N, got '" + text + "'");
+  }
+  const std::string count = text.substr(eq + 1);
+  if (count.find_first_not_of("0123456789") != std::string::npos || count.size() > 18) {
+    throw std::invalid_argument("--expect " + text + ": N must be a non-negative integer");
+  }
+  if (!request.expected.emplace(text.substr(0, eq), std::stoull(count)).second) {
+    throw std::invalid_argument("--expect given twice for '" + text.substr(0, eq) + "'");
+  }
+}
+
+double non_negative_number(const std::string& flag, const std::string& text) {
+  std::size_t used = 0;
+  double v = -1.0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || !(v >= 0.0)) throw std::invalid_argument(flag + " needs a number >= 0, got '" + text + "'");
+  return v;
+}
+
+// Everything after the subcommand.
+struct Arguments {
+  std::vector<std::string> positional;
+  std::string dds_config;
+  int domain = -1;
+  double seconds = -1.0;  // -1: the command's default
+  std::size_t count = 0;
+  bool json = false;
+  pixyslam::log_tool::CheckRequest check;
+};
+
+Arguments parse(const std::string& command, const std::vector<std::string>& args) {
+  const bool live = command == "participants" || command == "topics" || command == "echo" || command == "hz";
+  Arguments a;
+  for (std::size_t i = 1; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw std::invalid_argument(arg + " needs a value");
+      return args[++i];
+    };
+    if (live && arg == "--dds-config") {
+      a.dds_config = value();
+    } else if (live && arg == "--domain") {
+      const double d = non_negative_number(arg, value());
+      if (d > 232 || d != static_cast<int>(d)) throw std::invalid_argument("--domain must be an integer 0..232");
+      a.domain = static_cast<int>(d);
+    } else if (live && arg == "--seconds") {
+      a.seconds = non_negative_number(arg, value());
+    } else if (command == "echo" && arg == "--count") {
+      const double c = non_negative_number(arg, value());
+      if (c != static_cast<double>(static_cast<std::size_t>(c))) throw std::invalid_argument("--count must be an integer");
+      a.count = static_cast<std::size_t>(c);
+    } else if (command == "echo" && arg == "--json") {
+      a.json = true;
+    } else if (command == "check" && arg == "--expect") {
+      add_expectation(value(), a.check);
+    } else if (command == "check" && arg.rfind("--expect=", 0) == 0) {
+      add_expectation(arg.substr(9), a.check);
+    } else if (command == "check" && arg == "--allow-recovered") {
+      a.check.allow_recovered = true;
+    } else if (arg.rfind("-", 0) == 0) {
+      throw std::invalid_argument("unknown option '" + arg + "' for " + command);
+    } else {
+      a.positional.push_back(arg);
+    }
+  }
+  const std::size_t wanted = (command == "participants" || command == "topics") ? 0 : 1;
+  if (a.positional.size() != wanted) {
+    const char* what = command == "info" || command == "check" ? "an MCAP file" : "a TOPIC";
+    if (wanted == 0) throw std::invalid_argument(command + " takes no positional argument");
+    throw std::invalid_argument(command + " needs exactly " + what);
+  }
+  return a;
+}
+
+pixyslam::dds::DdsOptions dds_options(const Arguments& a) {
+  using namespace pixyslam;
+  dds::DdsOptions o;
+  if (a.dds_config.empty()) {
+    o.profiles_file = PIXYSLAM_DEFAULT_PROFILES_FILE;
+  } else {
+    config::YamlReader root = config::YamlReader::from_file(a.dds_config);
+    config::YamlReader dds_yaml = root.child("dds");
+    o = dds::read_dds_options(dds_yaml, app::folder_of(a.dds_config));
+  }
+  if (a.domain >= 0) o.domain_id = a.domain;
+  return o;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace pixyslam;
+  app::StopSignal::install();
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
+    std::fputs(kUsage, args.empty() ? stderr : stdout);
+    return args.empty() ? 2 : 0;
+  }
+  const std::string& command = args[0];
+  Arguments a;
+  try {
+    if (command != "participants" && command != "topics" && command != "echo" && command != "hz" &&
+        command != "info" && command != "check") {
+      throw std::invalid_argument("unknown command '" + command + "'");
+    }
+    a = parse(command, args);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "pixyslam_spy: %s\n%s", e.what(), kUsage);
+    return 2;
+  }
+
+  try {
+    if (command == "info") return log_tool::run_info(a.positional[0], std::cout);
+    if (command == "check") {
+      a.check.path = a.positional[0];
+      return log_tool::run_check(a.check, std::cout);
+    }
+    const dds::DdsOptions options = dds_options(a);
+    if (command == "participants") return log_tool::run_participants(options, a.seconds < 0 ? 2.0 : a.seconds, std::cout);
+    if (command == "topics") return log_tool::run_topics(options, a.seconds < 0 ? 2.0 : a.seconds, std::cout);
+    if (command == "hz") return log_tool::run_hz(options, a.positional[0], a.seconds < 0 ? 5.0 : a.seconds, std::cout);
+    log_tool::EchoRequest request;
+    request.topic = a.positional[0];
+    request.json = a.json;
+    request.count = a.count;
+    request.seconds = a.seconds < 0 ? 0.0 : a.seconds;
+    return log_tool::run_echo(options, request, std::cout);
+  } catch (const config::ConfigError& e) {
+    std::fprintf(stderr, "pixyslam_spy: config error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pixyslam_spy: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,343 @@
+#include "pixyslam/log_tool/message_format.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace pixyslam::log_tool {
+
+Value Value::number(double v) {
+  Value r(Kind::kFloat);
+  r.float_ = v;
+  return r;
+}
+Value Value::integer(std::int64_t v) {
+  Value r(Kind::kInt);
+  r.int_ = v;
+  return r;
+}
+Value Value::unsigned_integer(std::uint64_t v) {
+  Value r(Kind::kUInt);
+  r.uint_ = v;
+  return r;
+}
+Value Value::string(std::string v) {
+  Value r(Kind::kString);
+  r.text_ = std::move(v);
+  return r;
+}
+
+Value& Value::add(std::string name, Value value) {
+  if (kind_ != Kind::kStruct) throw std::logic_error("Value::add on a non-struct");
+  fields_.emplace_back(std::move(name), std::move(value));
+  return *this;
+}
+
+Value& Value::push(Value value) {
+  if (kind_ != Kind::kList) throw std::logic_error("Value::push on a non-list");
+  items_.push_back(std::move(value));
+  return *this;
+}
+
+const Value* Value::find(const std::string& path) const {
+  const auto dot = path.find('.');
+  const std::string head = path.substr(0, dot);
+  for (const auto& [name, value] : fields_) {
+    if (name != head) continue;
+    return dot == std::string::npos ? &value : value.find(path.substr(dot + 1));
+  }
+  return nullptr;
+}
+
+namespace {
+
+Value header_value(const msg::MessageHeader& h) {
+  Value v = Value::structure();
+  v.add("stamp_ns", Value::unsigned_integer(h.stamp_ns()))
+      .add("seq", Value::unsigned_integer(h.seq()))
+      .add("robot_id", Value::string(h.robot_id()))
+      .add("frame_id", Value::string(h.frame_id()));
+  return v;
+}
+
+Value pose_value(const msg::Pose2D& p) {
+  Value v = Value::structure();
+  v.add("x_m", Value::number(p.x_m())).add("y_m", Value::number(p.y_m())).add("theta_rad", Value::number(p.theta_rad()));
+  return v;
+}
+
+template <class Container, class Convert>
+Value list_of(const Container& items, Convert convert) {
+  Value v = Value::list();
+  for (const auto& item : items) v.push(convert(item));
+  return v;
+}
+
+Value block_value(const msg::PixyBlock& b) {
+  Value v = Value::structure();
+  v.add("signature", Value::unsigned_integer(b.signature()))
+      .add("x_px", Value::unsigned_integer(b.x_px()))
+      .add("y_px", Value::unsigned_integer(b.y_px()))
+      .add("width_px", Value::unsigned_integer(b.width_px()))
+      .add("height_px", Value::unsigned_integer(b.height_px()))
+      .add("angle_deg", Value::integer(b.angle_deg()));
+  return v;
+}
+
+Value detection_value(const msg::LandmarkDetection& d) {
+  Value v = Value::structure();
+  v.add("landmark_id", Value::integer(d.landmark_id()))
+      .add("range_m", Value::number(d.range_m()))
+      .add("bearing_rad", Value::number(d.bearing_rad()))
+      .add("range_sigma_m", Value::number(d.range_sigma_m()))
+      .add("bearing_sigma_rad", Value::number(d.bearing_sigma_rad()))
+      .add("block", block_value(d.block()));
+  return v;
+}
+
+Value landmark_estimate_value(const msg::LandmarkEstimate& l) {
+  Value v = Value::structure();
+  v.add("landmark_id", Value::integer(l.landmark_id()))
+      .add("x_m", Value::number(l.x_m()))
+      .add("y_m", Value::number(l.y_m()))
+      .add("cov_xx_m2", Value::number(l.cov_xx_m2()))
+      .add("cov_xy_m2", Value::number(l.cov_xy_m2()))
+      .add("cov_yy_m2", Value::number(l.cov_yy_m2()))
+      .add("times_observed", Value::unsigned_integer(l.times_observed()));
+  return v;
+}
+
+Value true_landmark_value(const msg::TrueLandmark& l) {
+  Value v = Value::structure();
+  v.add("landmark_id", Value::integer(l.landmark_id()))
+      .add("x_m", Value::number(l.x_m()))
+      .add("y_m", Value::number(l.y_m()));
+  return v;
+}
+
+bool is_scalar(const Value& v) { return v.kind() != Value::Kind::kStruct && v.kind() != Value::Kind::kList; }
+
+// JSON string literal (also a valid YAML double-quoted scalar).
+std::string quoted(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof(buf), "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string scalar_text(const Value& v, bool json) {
+  switch (v.kind()) {
+    case Value::Kind::kFloat: {
+      const double d = v.float_value();
+      if (std::isnan(d)) return json ? "null" : ".nan";
+      if (std::isinf(d)) return json ? "null" : (d > 0 ? ".inf" : "-.inf");
+      return format_double(d);
+    }
+    case Value::Kind::kInt: return std::to_string(v.int_value());
+    case Value::Kind::kUInt: return std::to_string(v.uint_value());
+    case Value::Kind::kString: return quoted(v.string_value());
+    default: return "";
+  }
+}
+
+void write_json(const Value& v, std::string& out) {
+  if (v.kind() == Value::Kind::kStruct) {
+    out += '{';
+    bool first = true;
+    for (const auto& [name, field] : v.fields()) {
+      if (!first) out += ',';
+      first = false;
+      out += quoted(name);
+      out += ':';
+      write_json(field, out);
+    }
+    out += '}';
+  } else if (v.kind() == Value::Kind::kList) {
+    out += '[';
+    for (std::size_t i = 0; i < v.items().size(); ++i) {
+      if (i > 0) out += ',';
+      write_json(v.items()[i], out);
+    }
+    out += ']';
+  } else {
+    out += scalar_text(v, true);
+  }
+}
+
+// Flow-style list of scalars: [1, 2, 3].
+std::string flow_list(const Value& v) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < v.items().size(); ++i) {
+    if (i > 0) out += ", ";
+    out += scalar_text(v.items()[i], false);
+  }
+  return out + "]";
+}
+
+bool all_scalars(const Value& list) {
+  return std::all_of(list.items().begin(), list.items().end(), [](const Value& i) { return is_scalar(i); });
+}
+
+void write_yaml_mapping(const Value& v, int indent, bool first_line_prefixed, std::string& out);
+
+// "name: value" lines for one field at `indent`.
+void write_yaml_field(const std::string& name, const Value& field, int indent, std::string& out) {
+  out += name;
+  out += ':';
+  if (is_scalar(field)) {
+    out += ' ' + scalar_text(field, false) + '\n';
+  } else if (field.kind() == Value::Kind::kStruct) {
+    if (field.fields().empty()) {
+      out += " {}\n";
+      return;
+    }
+    out += '\n';
+    write_yaml_mapping(field, indent + 2, false, out);
+  } else if (field.items().empty() || all_scalars(field)) {
+    out += ' ' + flow_list(field) + '\n';
+  } else {
+    out += '\n';
+    for (const Value& item : field.items()) {
+      out.append(static_cast<std::size_t>(indent + 2), ' ');
+      out += "- ";
+      if (item.kind() == Value::Kind::kStruct && !item.fields().empty()) {
+        write_yaml_mapping(item, indent + 4, true, out);
+      } else if (item.kind() == Value::Kind::kList) {
+        out += flow_list(item) + '\n';  // no nested lists of structs in the IDL
+      } else {
+        out += (item.kind() == Value::Kind::kStruct ? std::string("{}") : scalar_text(item, false)) + '\n';
+      }
+    }
+  }
+}
+
+// The fields of a struct, one per line at `indent`; the first without its
+// indentation when the caller already wrote "- ".
+void write_yaml_mapping(const Value& v, int indent, bool first_line_prefixed, std::string& out) {
+  bool first = true;
+  for (const auto& [name, field] : v.fields()) {
+    if (!(first && first_line_prefixed)) out.append(static_cast<std::size_t>(indent), ' ');
+    first = false;
+    write_yaml_field(name, field, indent, out);
+  }
+}
+
+}  // namespace
+
+Value to_value(const msg::Odometry& m) {
+  Value v = Value::structure();
+  v.add("header", header_value(m.header()))
+      .add("v_mps", Value::number(m.v_mps()))
+      .add("w_radps", Value::number(m.w_radps()))
+      .add("period_s", Value::number(m.period_s()))
+      .add("distance_m", Value::number(m.distance_m()))
+      .add("rotation_rad", Value::number(m.rotation_rad()))
+      .add("encoder_samples", Value::unsigned_integer(m.encoder_samples()));
+  return v;
+}
+
+Value to_value(const msg::LandmarkObservation& m) {
+  Value v = Value::structure();
+  v.add("header", header_value(m.header()))
+      .add("camera_frame", Value::unsigned_integer(m.camera_frame()))
+      .add("blocks_in_frame", Value::unsigned_integer(m.blocks_in_frame()))
+      .add("blocks_rejected", Value::unsigned_integer(m.blocks_rejected()))
+      .add("detections", list_of(m.detections(), detection_value));
+  return v;
+}
+
+Value to_value(const msg::MapState& m) {
+  Value v = Value::structure();
+  v.add("header", header_value(m.header()))
+      .add("mean_pose", pose_value(m.mean_pose()))
+      .add("pose_covariance", list_of(m.pose_covariance(), Value::number))
+      .add("best_pose", pose_value(m.best_pose()))
+      .add("effective_sample_size", Value::number(m.effective_sample_size()))
+      .add("particle_count", Value::unsigned_integer(m.particle_count()))
+      .add("particle_poses", list_of(m.particle_poses(), pose_value))
+      .add("landmarks", list_of(m.landmarks(), landmark_estimate_value))
+      .add("update_time_s", Value::number(m.update_time_s()))
+      .add("odometry_sequence", Value::unsigned_integer(m.odometry_sequence()))
+      .add("observation_sequence", Value::unsigned_integer(m.observation_sequence()))
+      .add("observations_used", Value::unsigned_integer(m.observations_used()))
+      .add("observations_gated", Value::unsigned_integer(m.observations_gated()))
+      .add("observations_new_landmark", Value::unsigned_integer(m.observations_new_landmark()))
+      .add("samples_late", Value::unsigned_integer(m.samples_late()));
+  return v;
+}
+
+Value to_value(const msg::GroundTruth& m) {
+  Value v = Value::structure();
+  v.add("header", header_value(m.header()))
+      .add("pose", pose_value(m.pose()))
+      .add("v_mps", Value::number(m.v_mps()))
+      .add("w_radps", Value::number(m.w_radps()))
+      .add("landmarks", list_of(m.landmarks(), true_landmark_value));
+  return v;
+}
+
+std::string format_double(double v) {
+  char buf[64];
+  const auto result = std::to_chars(buf, buf + sizeof(buf), v);
+  return std::string(buf, result.ptr);
+}
+
+std::string to_yaml_document(const Value& value) {
+  std::string out = "---\n";
+  if (value.kind() == Value::Kind::kStruct) {
+    write_yaml_mapping(value, 0, false, out);
+  } else {
+    write_yaml_field("value", value, 0, out);
+  }
+  return out;
+}
+
+std::string to_json_line(const Value& value) {
+  std::string out;
+  write_json(value, out);
+  return out;
+}
+
+GapStats gap_stats(const std::vector<double>& arrivals_s) {
+  GapStats s;
+  s.messages = arrivals_s.size();
+  if (arrivals_s.size() < 2) return s;
+  const std::size_t n = arrivals_s.size() - 1;
+  double sum = 0.0;
+  s.min_s = arrivals_s[1] - arrivals_s[0];
+  s.max_s = s.min_s;
+  for (std::size_t i = 1; i < arrivals_s.size(); ++i) {
+    const double gap = arrivals_s[i] - arrivals_s[i - 1];
+    sum += gap;
+    s.min_s = std::min(s.min_s, gap);
+    s.max_s = std::max(s.max_s, gap);
+  }
+  s.mean_s = sum / static_cast<double>(n);
+  double squares = 0.0;
+  for (std::size_t i = 1; i < arrivals_s.size(); ++i) {
+    const double d = arrivals_s[i] - arrivals_s[i - 1] - s.mean_s;
+    squares += d * d;
+  }
+  s.std_s = std::sqrt(squares / static_cast<double>(n));
+  s.rate_hz = s.mean_s > 0.0 ? 1.0 / s.mean_s : 0.0;
+  return s;
+}
+
+}  // namespace pixyslam::log_tool

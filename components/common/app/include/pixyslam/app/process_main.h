@@ -1,0 +1,62 @@
+#pragma once
+
+#include <cstdio>
+#include <exception>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+#include "pixyslam/app/command_line.h"
+#include "pixyslam/config/yaml_reader.h"
+
+namespace pixyslam::app {
+
+// Runs a process's `body` (which returns the exit status) and turns an
+// exception escaping it into an exit status and one line on stderr:
+//   config::ConfigError -> 2, "<name>: config error: <what>"
+//   std::exception      -> 1, "<name>: <what>"
+template <class Body>
+int run_main(const char* name, const Body& body) {
+  try {
+    return body();
+  } catch (const config::ConfigError& e) {
+    std::fprintf(stderr, "%s: config error: %s\n", name, e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", name, e.what());
+    return 1;
+  }
+}
+
+// The set-up of a process that runs until it is stopped: parses `argv` for
+// `--flag value` pairs of `flags`, then calls `configure(args)` to read the
+// configuration. Returns the exit status when the process is to end here:
+// 0 after --help (`usage` printed to stdout); 2 for a config::ConfigError
+// ("<name>: config error: <what>") or a std::invalid_argument, which is a
+// command-line error ("<name>: <what>", then `usage`, on stderr). Returns
+// nothing when the process is to go on; other exceptions pass through.
+template <class Configure>
+std::optional<int> set_up(const char* name, const char* usage, int argc, char** argv,
+                          const std::set<std::string>& flags, const Configure& configure) {
+  try {
+    const CommandLine args(argc, argv, flags);
+    if (args.help()) {
+      std::puts(usage);
+      return 0;
+    }
+    configure(args);
+  } catch (const config::ConfigError& e) {
+    std::fprintf(stderr, "%s: config error: %s\n", name, e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "%s: %s\n%s\n", name, e.what(), usage);
+    return 2;
+  }
+  return std::nullopt;
+}
+
+// Prints "# <name>: effective configuration" and `yaml` to stdout, flushed.
+void print_effective_configuration(const char* name, const std::string& yaml);
+
+}  // namespace pixyslam::app

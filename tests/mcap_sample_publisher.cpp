@@ -1,0 +1,193 @@
+// Test publisher for the logger's integration tests: N rounds, each one message
+// of every topic (or of Odometry only), at a fixed rate, seq 1..N per topic.
+//   mcap_sample_publisher --profiles config/dds/loopback.xml --domain D --count N
+//                         [--rate HZ] [--topics all|odometry] [--wait-readers S]
+// Waits for one matched reader per topic, then publishes; prints
+// "progress N" (rounds published) every 10 rounds, line-buffered, so that a
+// test knows how far it got; then waits for the readers' acknowledgments and
+// prints "published TOPIC N" per topic. Exit status: 0 when everything was
+// published and acknowledged, 3 when not (e.g. the reader was killed), 1 on
+// DDS errors, 2 on usage errors. SIGINT/SIGTERM end the run early.
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <stdexcept>
+#include <thread>
+
+#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/stop_signal.h"
+#include "pixyslam/dds/endpoints.h"
+
+namespace pixyslam {
+namespace {
+
+msg::Odometry odometry(std::uint64_t i) {
+  msg::Odometry m;
+  m.header().stamp_ns(dds::now_ns());
+  m.header().frame_id("base_link");
+  m.v_mps(0.001 * static_cast<double>(i % 300));
+  m.w_radps(-0.0005 * static_cast<double>(i % 100));
+  m.period_s(0.1);
+  m.distance_m(0.0001 * static_cast<double>(i));
+  m.encoder_samples(static_cast<std::uint32_t>(i % 7));
+  return m;
+}
+
+msg::LandmarkObservation observation(std::uint64_t i) {
+  msg::LandmarkObservation m;
+  m.header().stamp_ns(dds::now_ns());
+  m.header().frame_id("camera");
+  m.camera_frame(static_cast<std::uint32_t>(i));
+  m.blocks_in_frame(static_cast<std::uint32_t>(i % 3));
+  for (std::uint64_t k = 0; k < i % 3; ++k) {
+    msg::LandmarkDetection d;
+    d.landmark_id(static_cast<std::int32_t>(10 + k));
+    d.range_m(1.0 + 0.01 * static_cast<double>(k));
+    d.bearing_rad(0.1 * static_cast<double>(k));
+    d.range_sigma_m(0.07);
+    d.bearing_sigma_rad(0.027);
+    m.detections().push_back(d);
+  }
+  return m;
+}
+
+msg::MapState map_state(std::uint64_t i) {
+  msg::MapState m;
+  m.header().stamp_ns(dds::now_ns());
+  m.header().frame_id("map");
+  msg::Pose2D pose;
+  pose.x_m(0.01 * static_cast<double>(i));
+  m.mean_pose(pose);
+  m.best_pose(pose);
+  m.particle_count(100);
+  for (int k = 0; k < 3; ++k) m.particle_poses().push_back(pose);
+  msg::LandmarkEstimate l;
+  l.landmark_id(10);
+  l.x_m(1.0);
+  l.cov_xx_m2(0.01);
+  l.cov_yy_m2(0.01);
+  m.landmarks().push_back(l);
+  m.odometry_sequence(i);
+  return m;
+}
+
+msg::GroundTruth ground_truth(std::uint64_t i) {
+  msg::GroundTruth m;
+  m.header().stamp_ns(dds::now_ns());
+  m.header().frame_id("map");
+  msg::Pose2D pose;
+  pose.x_m(0.01 * static_cast<double>(i));
+  m.pose(pose);
+  m.v_mps(0.2);
+  msg::TrueLandmark l;
+  l.landmark_id(10);
+  l.x_m(1.0);
+  m.landmarks().push_back(l);
+  return m;
+}
+
+int run(int argc, char** argv) {
+  constexpr const char* kUsage =
+      "usage: mcap_sample_publisher --profiles FILE --domain D --count N [--rate HZ] [--topics all|odometry] "
+      "[--wait-readers S]";
+  dds::DdsOptions options;
+  std::uint64_t count = 0;
+  double rate_hz = 500.0;
+  bool all_topics = true;
+  double wait_s = 20.0;
+  try {
+    const app::CommandLine args(argc, argv, {"profiles", "domain", "count", "rate", "topics", "wait-readers"});
+    if (args.help()) {
+      std::puts(kUsage);
+      return 0;
+    }
+    options.profiles_file = args.get("profiles");
+    options.domain_id = static_cast<int>(args.number("domain", 0));
+    options.robot_id = "sample_publisher";
+    count = static_cast<std::uint64_t>(args.number("count", 0));
+    rate_hz = args.number("rate", rate_hz);
+    const std::string topics = args.get("topics", "all");
+    if (topics != "all" && topics != "odometry") throw std::invalid_argument("--topics: all or odometry");
+    all_topics = topics == "all";
+    wait_s = args.number("wait-readers", wait_s);
+    if (count == 0 || rate_hz <= 0.0) throw std::invalid_argument("--count and --rate must be positive");
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "mcap_sample_publisher: %s\n%s\n", e.what(), kUsage);
+    return 2;
+  }
+
+  dds::Participant participant(options, "mcap_sample_publisher");
+  dds::Writer<msg::Odometry> odometry_writer(participant);
+  std::unique_ptr<dds::Writer<msg::LandmarkObservation>> observation_writer;
+  std::unique_ptr<dds::Writer<msg::MapState>> map_writer;
+  std::unique_ptr<dds::Writer<msg::GroundTruth>> truth_writer;
+  if (all_topics) {
+    observation_writer = std::make_unique<dds::Writer<msg::LandmarkObservation>>(participant);
+    map_writer = std::make_unique<dds::Writer<msg::MapState>>(participant);
+    truth_writer = std::make_unique<dds::Writer<msg::GroundTruth>>(participant);
+  }
+  const auto wait = std::chrono::milliseconds(static_cast<long>(wait_s * 1000.0));
+  bool matched = odometry_writer.wait_for_readers(1, wait);
+  if (all_topics) {
+    matched = matched && observation_writer->wait_for_readers(1, wait) && map_writer->wait_for_readers(1, wait) &&
+              truth_writer->wait_for_readers(1, wait);
+  }
+  if (!matched) {
+    std::fprintf(stderr, "mcap_sample_publisher: no reader on domain %d after %.0f s\n", options.domain_id, wait_s);
+    return 1;
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // every reader fully matched
+
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const auto period = std::chrono::duration<double>(1.0 / rate_hz);
+  bool ok = true;
+  std::uint64_t round = 0;
+  for (std::uint64_t i = 1; i <= count && !app::StopSignal::requested(); ++i) {
+    std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(period * static_cast<double>(i - 1)));
+    msg::Odometry o = odometry(i);
+    ok = odometry_writer.publish(o) && ok;
+    if (all_topics) {
+      msg::LandmarkObservation l = observation(i);
+      msg::MapState s = map_state(i);
+      msg::GroundTruth g = ground_truth(i);
+      ok = observation_writer->publish(l) && ok;
+      ok = map_writer->publish(s) && ok;
+      ok = truth_writer->publish(g) && ok;
+    }
+    round = i;
+    if (i % 10 == 0 || i == count) std::printf("progress %llu\n", static_cast<unsigned long long>(i));
+  }
+  // Stopped early: the reader may be gone, nothing to wait for.
+  const auto ack = app::StopSignal::requested() ? std::chrono::seconds(0) : std::chrono::seconds(10);
+  ok = odometry_writer.wait_for_acknowledgments(ack) && ok;
+  if (all_topics) {
+    ok = observation_writer->wait_for_acknowledgments(ack) && ok;
+    ok = map_writer->wait_for_acknowledgments(ack) && ok;
+    ok = truth_writer->wait_for_acknowledgments(ack) && ok;
+  }
+  std::printf("published %s %llu\n", dds::kOdometryTopic.data(), static_cast<unsigned long long>(odometry_writer.published()));
+  if (all_topics) {
+    std::printf("published %s %llu\n", dds::kLandmarkObservationTopic.data(),
+                static_cast<unsigned long long>(observation_writer->published()));
+    std::printf("published %s %llu\n", dds::kMapStateTopic.data(), static_cast<unsigned long long>(map_writer->published()));
+    std::printf("published %s %llu\n", dds::kGroundTruthTopic.data(),
+                static_cast<unsigned long long>(truth_writer->published()));
+  }
+  return ok && round == count ? 0 : 3;
+}
+
+}  // namespace
+}  // namespace pixyslam
+
+int main(int argc, char** argv) {
+  pixyslam::app::StopSignal::install();
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  try {
+    return pixyslam::run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mcap_sample_publisher: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# Integration test of pixyslam_spy on loopback, on a DDS domain of its own:
+# spy_test_publisher publishes Odometry whose values follow from header.seq;
+# `echo --json --count 3` must print exactly those values (every field),
+# `echo` (YAML) one document, `participants` the publisher with its pid and
+# host, `topics` its writer with the QoS of the profile, `hz` a rate.
+#   spy_echo_test.sh SPY PUBLISHER CONFIG_DIR
+set -euo pipefail
+spy=$1 publisher=$2 config=$3
+work=$(mktemp -d /tmp/pixyslam_spy_test.XXXXXX)
+pub_pid=""
+cleanup() {
+  if [[ -n "$pub_pid" ]] && kill -0 "$pub_pid" 2>/dev/null; then
+    kill -TERM "$pub_pid" 2>/dev/null || true
+    wait "$pub_pid" 2>/dev/null || true
+  fi
+  rm -rf "$work"
+}
+trap cleanup EXIT
+cp -r "$config" "$work/config"
+domain=$((20 + $$ % 100))
+sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/config/*.yaml
+cfg="$work/config/encoder_bridge.yaml"
+fail() { echo "FAIL: $*"; exit 1; }
+
+"$publisher" --dds-config "$cfg" --rate-hz 20 > "$work/publisher.log" 2>&1 &
+pub_pid=$!
+for _ in $(seq 100); do  # its participant and writer exist once it says so
+  grep -q "publishing on domain" "$work/publisher.log" && break
+  kill -0 "$pub_pid" 2>/dev/null || break
+  sleep 0.1
+done
+grep -q "publishing on domain" "$work/publisher.log" || { cat "$work/publisher.log"; fail "publisher did not start"; }
+
+echo "== participants"
+"$spy" participants --dds-config "$cfg" --seconds 4 | tee "$work/participants.txt"
+grep -Eq "^spy_test_publisher +[0-9a-f.]+ +$(hostname | cut -c1-15)[^ ]* +$pub_pid +spy_test_publis" \
+  "$work/participants.txt" || fail "participants does not show spy_test_publisher with pid $pub_pid"
+
+echo "== echo --json --count 3"
+"$spy" echo pixyslam/odometry --dds-config "$cfg" --json --count 3 --seconds 20 | tee "$work/echo.json"
+[[ $(wc -l < "$work/echo.json") -eq 3 ]] || fail "expected 3 JSON lines"
+previous=0
+while IFS= read -r line; do
+  seq=$(grep -oE '"seq":[0-9]+' <<< "$line" | cut -d: -f2)
+  [[ -n "$seq" && "$seq" -gt "$previous" ]] || fail "no increasing seq in: $line"
+  previous=$seq
+  expected="{\"header\":{\"stamp_ns\":$((1000000000000000000 + seq)),\"seq\":$seq,\"robot_id\":\"robot1\",\"frame_id\":\"base_link\"},\"v_mps\":$seq.5,\"w_radps\":-$seq.25,\"period_s\":0.1,\"distance_m\":$((2 * seq)),\"rotation_rad\":1e-09,\"encoder_samples\":$((seq + 3))}"
+  [[ "$line" == "$expected" ]] || fail "echo printed
+  $line
+expected
+  $expected"
+done < "$work/echo.json"
+
+echo "== echo (YAML) --count 1"
+"$spy" echo pixyslam/odometry --domain "$domain" --count 1 --seconds 20 | tee "$work/echo.yaml"
+seq=$(grep -oE '^  seq: [0-9]+' "$work/echo.yaml" | grep -oE '[0-9]+')
+[[ -n "$seq" ]] || fail "no header.seq in the YAML document"
+grep -qx -- "---" "$work/echo.yaml" || fail "no YAML document start"
+grep -qx "v_mps: $seq.5" "$work/echo.yaml" || fail "v_mps of seq $seq"
+grep -qx "encoder_samples: $((seq + 3))" "$work/echo.yaml" || fail "encoder_samples of seq $seq"
+
+echo "== topics"
+"$spy" topics --dds-config "$cfg" --seconds 4 | tee "$work/topics.txt"
+grep -q "^pixyslam/odometry  \[pixyslam::msg::Odometry\]" "$work/topics.txt" || fail "topics: no odometry topic"
+grep -Eq "^  writer +spy_test_publisher \(pid $pub_pid\) +reliable +volatile +history keep_all" "$work/topics.txt" \
+  || fail "topics: no writer line of the publisher"
+
+echo "== hz"
+"$spy" hz pixyslam/odometry --dds-config "$cfg" --seconds 2 | tee "$work/hz.txt"
+rate=$(grep -oE 'rate [0-9.]+' "$work/hz.txt" | grep -oE '[0-9.]+' || true)
+[[ -n "$rate" ]] || fail "hz printed no rate"
+awk -v r="$rate" 'BEGIN { exit !(r > 5 && r < 40) }' || fail "hz rate $rate Hz not near 20 Hz"
+
+echo "== unknown topic"
+status=0
+"$spy" echo pixyslam/nothing --dds-config "$cfg" --count 1 --seconds 1 2>/dev/null || status=$?
+[[ $status -eq 2 ]] || fail "unknown topic gave exit status $status, expected 2"
+echo "PASS"

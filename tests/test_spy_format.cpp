@@ -1,0 +1,172 @@
+// The printers of pixyslam_spy echo: every field, nested structs and
+// sequences, in IDL order, as YAML documents and JSON lines; and hz's gap statistics.
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "pixyslam/log_tool/message_format.h"
+
+namespace pixyslam::log_tool {
+namespace {
+
+msg::Odometry odometry() {
+  msg::Odometry m;
+  m.header().stamp_ns(1700000000123456789ull);
+  m.header().seq(7);
+  m.header().robot_id("robot1");
+  m.header().frame_id("base_link");
+  m.v_mps(0.1);
+  m.w_radps(-0.25);
+  m.period_s(0.1);
+  m.distance_m(0.01);
+  m.rotation_rad(-0.025);
+  m.encoder_samples(5);
+  return m;
+}
+
+msg::LandmarkObservation observation() {
+  msg::LandmarkObservation m;
+  m.header().seq(3);
+  m.header().frame_id("camera");
+  m.camera_frame(42);
+  m.blocks_in_frame(2);
+  m.blocks_rejected(1);
+  msg::LandmarkDetection d;
+  d.landmark_id(12);
+  d.range_m(1.5);
+  d.bearing_rad(-0.125);
+  d.range_sigma_m(0.07);
+  d.bearing_sigma_rad(0.027);
+  d.block().signature(10);
+  d.block().x_px(160);
+  d.block().y_px(100);
+  d.block().width_px(20);
+  d.block().height_px(40);
+  d.block().angle_deg(-3);
+  m.detections().push_back(d);
+  return m;
+}
+
+TEST(SpyFormat, OdometryAsJsonLineHasEveryFieldInIdlOrder) {
+  EXPECT_EQ(to_json_line(to_value(odometry())),
+            "{\"header\":{\"stamp_ns\":1700000000123456789,\"seq\":7,\"robot_id\":\"robot1\","
+            "\"frame_id\":\"base_link\"},\"v_mps\":0.1,\"w_radps\":-0.25,\"period_s\":0.1,"
+            "\"distance_m\":0.01,\"rotation_rad\":-0.025,\"encoder_samples\":5}");
+}
+
+TEST(SpyFormat, OdometryAsYamlDocument) {
+  EXPECT_EQ(to_yaml_document(to_value(odometry())),
+            "---\n"
+            "header:\n"
+            "  stamp_ns: 1700000000123456789\n"
+            "  seq: 7\n"
+            "  robot_id: \"robot1\"\n"
+            "  frame_id: \"base_link\"\n"
+            "v_mps: 0.1\n"
+            "w_radps: -0.25\n"
+            "period_s: 0.1\n"
+            "distance_m: 0.01\n"
+            "rotation_rad: -0.025\n"
+            "encoder_samples: 5\n");
+}
+
+TEST(SpyFormat, NestedSequenceOfStructsInYaml) {
+  EXPECT_EQ(to_yaml_document(to_value(observation())),
+            "---\n"
+            "header:\n"
+            "  stamp_ns: 0\n"
+            "  seq: 3\n"
+            "  robot_id: \"\"\n"
+            "  frame_id: \"camera\"\n"
+            "camera_frame: 42\n"
+            "blocks_in_frame: 2\n"
+            "blocks_rejected: 1\n"
+            "detections:\n"
+            "  - landmark_id: 12\n"
+            "    range_m: 1.5\n"
+            "    bearing_rad: -0.125\n"
+            "    range_sigma_m: 0.07\n"
+            "    bearing_sigma_rad: 0.027\n"
+            "    block:\n"
+            "      signature: 10\n"
+            "      x_px: 160\n"
+            "      y_px: 100\n"
+            "      width_px: 20\n"
+            "      height_px: 40\n"
+            "      angle_deg: -3\n");
+}
+
+TEST(SpyFormat, NestedSequenceOfStructsInJson) {
+  EXPECT_EQ(to_json_line(to_value(observation())),
+            "{\"header\":{\"stamp_ns\":0,\"seq\":3,\"robot_id\":\"\",\"frame_id\":\"camera\"},"
+            "\"camera_frame\":42,\"blocks_in_frame\":2,\"blocks_rejected\":1,\"detections\":[{\"landmark_id\":12,"
+            "\"range_m\":1.5,\"bearing_rad\":-0.125,\"range_sigma_m\":0.07,\"bearing_sigma_rad\":0.027,"
+            "\"block\":{\"signature\":10,\"x_px\":160,\"y_px\":100,\"width_px\":20,\"height_px\":40,"
+            "\"angle_deg\":-3}}]}");
+}
+
+TEST(SpyFormat, EmptySequenceAndFixedArrayInMapState) {
+  msg::MapState m;
+  m.pose_covariance()[0] = 0.5;
+  m.pose_covariance()[8] = 1e-9;
+  msg::LandmarkEstimate l;
+  l.landmark_id(3);
+  l.times_observed(9);
+  m.landmarks().push_back(l);
+  const std::string yaml = to_yaml_document(to_value(m));
+  EXPECT_NE(yaml.find("\npose_covariance: [0.5, 0, 0, 0, 0, 0, 0, 0, 1e-09]\n"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("\nparticle_poses: []\n"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("\nlandmarks:\n  - landmark_id: 3\n    x_m: 0\n"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("\n    times_observed: 9\nupdate_time_s: 0\n"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("\nsamples_late: 0\n"), std::string::npos) << yaml;
+  const std::string json = to_json_line(to_value(m));
+  EXPECT_NE(json.find("\"pose_covariance\":[0.5,0,0,0,0,0,0,0,1e-09],\"best_pose\":{\"x_m\":0,"), std::string::npos)
+      << json;
+  EXPECT_NE(json.find("\"particle_poses\":[],\"landmarks\":[{\"landmark_id\":3,"), std::string::npos) << json;
+}
+
+TEST(SpyFormat, GroundTruthFieldsCanBeFoundByPath) {
+  msg::GroundTruth m;
+  m.pose().theta_rad(1.25);
+  m.landmarks().resize(2);
+  const Value v = to_value(m);
+  ASSERT_NE(v.find("pose.theta_rad"), nullptr);
+  EXPECT_EQ(v.find("pose.theta_rad")->float_value(), 1.25);
+  ASSERT_NE(v.find("landmarks"), nullptr);
+  EXPECT_EQ(v.find("landmarks")->items().size(), 2u);
+  EXPECT_EQ(v.find("pose.nothing"), nullptr);
+}
+
+TEST(SpyFormat, StringsAreEscapedAndNonFiniteNumbersStayValid) {
+  Value v = Value::structure();
+  v.add("text", Value::string("a\"b\\c\nd\x01"))
+      .add("nan", Value::number(std::numeric_limits<double>::quiet_NaN()))
+      .add("inf", Value::number(-std::numeric_limits<double>::infinity()));
+  EXPECT_EQ(to_json_line(v), "{\"text\":\"a\\\"b\\\\c\\nd\\u0001\",\"nan\":null,\"inf\":null}");
+  EXPECT_EQ(to_yaml_document(v), "---\ntext: \"a\\\"b\\\\c\\nd\\u0001\"\nnan: .nan\ninf: -.inf\n");
+}
+
+TEST(SpyFormat, DoublesReadBackExactly) {
+  for (const double d : {0.1, 1.0 / 3.0, -2.5e-300, 6.02214076e23, 0.0, 17.5}) {
+    EXPECT_EQ(std::stod(format_double(d)), d) << format_double(d);
+  }
+  EXPECT_EQ(format_double(0.1), "0.1");
+  EXPECT_EQ(format_double(3.0), "3");
+}
+
+TEST(SpyFormat, GapStatistics) {
+  const GapStats s = gap_stats({0.0, 0.1, 0.3, 0.4});  // gaps 0.1, 0.2, 0.1
+  EXPECT_EQ(s.messages, 4u);
+  EXPECT_NEAR(s.mean_s, 0.4 / 3.0, 1e-12);
+  EXPECT_NEAR(s.rate_hz, 7.5, 1e-9);
+  EXPECT_NEAR(s.min_s, 0.1, 1e-12);
+  EXPECT_NEAR(s.max_s, 0.2, 1e-12);
+  EXPECT_NEAR(s.std_s, std::sqrt(2.0) / 30.0, 1e-12);  // population std of {0.1, 0.2, 0.1}
+  EXPECT_EQ(gap_stats({1.0}).rate_hz, 0.0);
+  EXPECT_EQ(gap_stats({}).messages, 0u);
+}
+
+}  // namespace
+}  // namespace pixyslam::log_tool
