@@ -168,8 +168,8 @@ int main(int argc, char** argv) {
       return log_tool::run_check(a.check, std::cout);
     }
     const dds::DdsOptions options = dds_options(a);
-    if (command == "participants") return log_tool::run_participants(options, a.seconds < 0 ? 2.0 : a.seconds, std::cout);
-    if (command == "topics") return log_tool::run_topics(options, a.seconds < 0 ? 2.0 : a.seconds, std::cout);
+    if (command == "participants") return log_tool::run_participants(options, a.seconds < 0 ? 4.0 : a.seconds, std::cout);
+    if (command == "topics") return log_tool::run_topics(options, a.seconds < 0 ? 4.0 : a.seconds, std::cout);
     if (command == "hz") return log_tool::run_hz(options, a.positional[0], a.seconds < 0 ? 5.0 : a.seconds, std::cout);
     log_tool::EchoRequest request;
     request.topic = a.positional[0];
