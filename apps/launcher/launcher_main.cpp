@@ -1,7 +1,8 @@
 // pixyslam_launch: starts the processes of a launch file, forwards their output
 // with a prefix, stops them all on Ctrl-C, after duration_s or when a process
 // marked ends_run finishes, then runs the after_run commands (evaluation).
-//   pixyslam_launch config/launch_sim.yaml [--run-dir DIR] [--duration S]
+//   pixyslam_launch config/launch_sim.yaml [--run-dir DIR] [--duration S] [--input FILE]
+// --input defines ${input} for the launch file (e.g. the log launch_replay.yaml plays).
 // Exit code 0 only if every process ended cleanly.
 #include <unistd.h>
 
@@ -9,6 +10,7 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -62,10 +64,12 @@ int run(const std::string& launch_file, const app::CommandLine& args) {
   const std::string run_dir = args.get("run-dir", default_run_dir());
   std::filesystem::create_directories(run_dir);
   const std::string bin_dir = own_folder();
-  launcher::LaunchPlan plan = launcher::read_launch_plan(
-      launch_file, {{"config_dir", std::filesystem::absolute(app::folder_of(launch_file)).string()},
-                    {"bin_dir", bin_dir},
-                    {"run_dir", std::filesystem::absolute(run_dir).string()}});
+  std::map<std::string, std::string> variables{
+      {"config_dir", std::filesystem::absolute(app::folder_of(launch_file)).string()},
+      {"bin_dir", bin_dir},
+      {"run_dir", std::filesystem::absolute(run_dir).string()}};
+  if (args.has("input")) variables["input"] = std::filesystem::absolute(args.get("input")).string();
+  launcher::LaunchPlan plan = launcher::read_launch_plan(launch_file, variables);
   plan.duration_s = args.number("duration", plan.duration_s);
   std::printf("[launch] %zu processes from %s, run folder %s%s\n", plan.processes.size(),
               launch_file.c_str(), run_dir.c_str(),
@@ -129,13 +133,13 @@ int main(int argc, char** argv) {
   app::StopSignal::install();
   try {
     if (argc < 2 || argv[1][0] == '-') {
-      std::fprintf(stderr, "usage: pixyslam_launch LAUNCH.yaml [--run-dir DIR] [--duration S]\n");
+      std::fprintf(stderr, "usage: pixyslam_launch LAUNCH.yaml [--run-dir DIR] [--duration S] [--input FILE]\n");
       return argc < 2 ? 2 : 0;
     }
     // The launch file is positional; the rest are flags.
     std::vector<char*> flags{argv[0]};
     for (int i = 2; i < argc; ++i) flags.push_back(argv[i]);
-    const app::CommandLine args(static_cast<int>(flags.size()), flags.data(), {"run-dir", "duration"});
+    const app::CommandLine args(static_cast<int>(flags.size()), flags.data(), {"run-dir", "duration", "input"});
     return run(argv[1], args);
   } catch (const config::ConfigError& e) {
     std::fprintf(stderr, "pixyslam_launch: config error: %s\n", e.what());

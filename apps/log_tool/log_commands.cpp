@@ -8,6 +8,8 @@
 #include <sstream>
 #include <vector>
 
+#include "pixyslam/dds/topics.h"
+#include "pixyslam/log_tool/message_format.h"
 #include "pixyslam/log_tool/sequence_check.h"
 #include "pixyslam/logger/mcap_reader.h"
 #include "pixyslam/logger_node/cdr_payload.h"
@@ -206,6 +208,127 @@ int run_check(const CheckRequest& request, std::ostream& out) {
   }
   out << (ok ? "check passed" : "check FAILED") << "\n";
   return ok ? 0 : 1;
+}
+
+namespace {
+
+template <class Message>
+bool decode_as(const std::vector<std::uint8_t>& bytes, Value& value, std::string& error) {
+  Message message;
+  if (!logger_node::from_cdr(bytes, message, error)) return false;
+  value = to_value(message);
+  return true;
+}
+
+// A recorded payload of `topic` as a field tree; false with `error` if undecodable.
+bool decode_value(const std::string& topic, const std::vector<std::uint8_t>& bytes, Value& value, std::string& error) {
+  if (topic == dds::kOdometryTopic) return decode_as<msg::Odometry>(bytes, value, error);
+  if (topic == dds::kLandmarkObservationTopic) return decode_as<msg::LandmarkObservation>(bytes, value, error);
+  if (topic == dds::kMapStateTopic) return decode_as<msg::MapState>(bytes, value, error);
+  if (topic == dds::kGroundTruthTopic) return decode_as<msg::GroundTruth>(bytes, value, error);
+  error = "not a topic of this project";
+  return false;
+}
+
+// Every message of `topic` in `path`, decoded, in file order. Throws naming
+// the file and message index of an undecodable payload.
+std::vector<Value> decoded_messages(const std::string& path, const std::string& topic) {
+  const logger::McapReader reader(path);
+  const logger::McapChannel* channel = reader.find_channel(topic);
+  if (channel == nullptr) throw std::runtime_error(path + ": no channel '" + topic + "'");
+  std::vector<Value> values;
+  std::size_t index = 0;
+  for (const logger::McapMessage& m : reader.messages()) {
+    if (m.channel_id != channel->id) continue;
+    Value value = Value::structure();
+    std::string error;
+    if (!decode_value(topic, m.data, value, error)) {
+      throw std::runtime_error(path + ": " + topic + " message " + std::to_string(index) + ": " + error);
+    }
+    values.push_back(std::move(value));
+    ++index;
+  }
+  return values;
+}
+
+}  // namespace
+
+int run_print(const PrintRequest& request, std::ostream& out) {
+  const logger::McapReader reader(request.path);
+  if (!request.topic.empty() && reader.find_channel(request.topic) == nullptr) {
+    throw std::runtime_error(request.path + ": no channel '" + request.topic + "'");
+  }
+  int status = 0;
+  for (const logger::McapMessage& m : reader.messages()) {
+    const logger::McapChannel* channel = reader.find_channel(m.channel_id);
+    if (channel == nullptr || (!request.topic.empty() && channel->topic != request.topic)) continue;
+    Value value = Value::structure();
+    std::string error;
+    if (!decode_value(channel->topic, m.data, value, error)) {
+      out << "# " << channel->topic << " log time " << m.log_time_ns << ": cannot decode: " << error << "\n";
+      status = 1;
+      continue;
+    }
+    Value record = Value::structure();
+    record.add("topic", Value::string(channel->topic));
+    record.add("log_time_ns", Value::unsigned_integer(m.log_time_ns));
+    record.add("message", std::move(value));
+    out << (request.json ? to_json_line(record) + "\n" : to_yaml_document(record));
+  }
+  return status;
+}
+
+int run_compare(const CompareRequest& request, std::ostream& out) {
+  const std::vector<Value> first = decoded_messages(request.first_path, request.topic);
+  const std::vector<Value> second = decoded_messages(request.second_path, request.topic);
+  out << request.topic << ": " << first.size() << " messages in " << request.first_path << ", " << second.size()
+      << " in " << request.second_path << "\n";
+  bool same = first.size() == second.size();
+
+  const std::size_t n = std::min(first.size(), second.size());
+  std::int64_t min_offset = std::numeric_limits<std::int64_t>::max();
+  std::int64_t max_offset = std::numeric_limits<std::int64_t>::min();
+  std::size_t differing = 0;
+  std::size_t lines = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Value* a = first[i].find("header.stamp_ns");
+    const Value* b = second[i].find("header.stamp_ns");
+    if (a != nullptr && b != nullptr) {
+      const auto offset = static_cast<std::int64_t>(b->uint_value() - a->uint_value());
+      min_offset = std::min(min_offset, offset);
+      max_offset = std::max(max_offset, offset);
+    }
+    const std::vector<std::string> differences = compare_values(
+        first[i], second[i], request.ignored, request.tolerance, std::max<std::size_t>(1, request.max_lines));
+    if (differences.empty()) continue;
+    ++differing;
+    for (const std::string& d : differences) {
+      if (lines >= request.max_lines) break;
+      out << "  message " << i << ": " << d << "\n";
+      ++lines;
+    }
+  }
+  if (n > 0 && min_offset <= max_offset) {
+    out << "header stamps: second - first = ";
+    if (min_offset == max_offset) {
+      out << "constant " << min_offset << " ns\n";
+    } else {
+      out << "varies from " << min_offset << " to " << max_offset << " ns\n";
+    }
+  }
+  std::string ignored;
+  for (const std::string& f : request.ignored) ignored += (ignored.empty() ? "" : ", ") + f;
+  if (differing == 0) {
+    out << n << " messages compared: identical in every field"
+        << (ignored.empty() ? "" : " except the ignored " + ignored)
+        << (request.tolerance > 0 ? " (relative tolerance " + format_double(request.tolerance) + ")" : "") << "\n";
+  } else {
+    out << differing << " of " << n << " messages differ\n";
+    same = false;
+  }
+  if (first.size() != second.size()) out << "message counts differ\n";
+  out << (same ? "SAME" : "DIFFERENT") << "\n";
+  return same ? 0 : 1;
 }
 
 }  // namespace pixyslam::log_tool

@@ -4,6 +4,7 @@
 #include <map>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace pixyslam::log_tool {
 
@@ -22,5 +23,33 @@ struct CheckRequest {
 // MCAP sequence and publish time agree with the header, and the expected
 // counts. One line per topic. Returns 0 only if everything checks, else 1.
 int run_check(const CheckRequest& request, std::ostream& out);
+
+struct PrintRequest {
+  std::string path;
+  std::string topic;  // "" = every topic
+  bool json = false;  // JSON lines instead of YAML documents
+};
+
+// `pixyslam_log print FILE.mcap [--topic T] [--json]`: every message decoded
+// with the project's types, in file order, with its topic and log time (the
+// same printers as `echo`). Returns 0, or 1 if a payload cannot be decoded.
+int run_print(const PrintRequest& request, std::ostream& out);
+
+struct CompareRequest {
+  std::string first_path;
+  std::string second_path;
+  std::string topic;
+  std::vector<std::string> ignored;  // field paths, e.g. header.stamp_ns, landmarks.times_observed
+  double tolerance = 0.0;            // relative; 0: bit-for-bit
+  std::size_t max_lines = 20;
+};
+
+// `pixyslam_log compare A.mcap B.mcap --topic T`: decodes the topic's messages
+// of both files in order and compares them field by field (e.g. a recorded
+// MapState against the one a replay through the estimator produced). Reports
+// the count of each, the constant or varying offset of the header stamps, and
+// the first differences. Returns 0 only if both have the same number of
+// messages and every compared field agrees, else 1.
+int run_compare(const CompareRequest& request, std::ostream& out);
 
 }  // namespace pixyslam::log_tool

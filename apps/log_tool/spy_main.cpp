@@ -5,11 +5,14 @@
 //   pixyslam_spy hz TOPIC [--seconds N]                    [DDS options]
 //   pixyslam_spy info FILE.mcap
 //   pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]
+//   pixyslam_spy print FILE.mcap [--topic T] [--json]
+//   pixyslam_spy compare A.mcap B.mcap --topic T [--ignore F,...] [--tolerance X]
 // DDS options: --dds-config FILE (a YAML with a `dds:` mapping, e.g.
 // config/slam_estimator.yaml; default: config/dds/loopback.xml on domain 0),
 // --domain N. The same program is also built as pixyslam_log (info/check).
 // Exit status: 0 ok, 1 check failed / too few samples / file unreadable,
 // 2 command-line or config error.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -37,6 +40,8 @@ constexpr const char* kUsage =
     "       pixyslam_spy hz TOPIC [--seconds N] [DDS options]\n"
     "       pixyslam_spy info FILE.mcap\n"
     "       pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]\n"
+    "       pixyslam_spy print FILE.mcap [--topic TOPIC] [--json]\n"
+    "       pixyslam_spy compare A.mcap B.mcap --topic TOPIC [--ignore FIELD,...] [--tolerance X]\n"
     "DDS options: --dds-config FILE (YAML with a dds: mapping; default " PIXYSLAM_DEFAULT_PROFILES_FILE
     ", domain 0)\n"
     "             --domain N (overrides the file's domain_id)\n"
@@ -77,7 +82,9 @@ struct Arguments {
   double seconds = -1.0;  // -1: the command's default
   std::size_t count = 0;
   bool json = false;
+  std::string topic;  // print --topic
   pixyslam::log_tool::CheckRequest check;
+  pixyslam::log_tool::CompareRequest compare;
 };
 
 Arguments parse(const std::string& command, const std::vector<std::string>& args) {
@@ -101,7 +108,7 @@ Arguments parse(const std::string& command, const std::vector<std::string>& args
       const double c = non_negative_number(arg, value());
       if (c != static_cast<double>(static_cast<std::size_t>(c))) throw std::invalid_argument("--count must be an integer");
       a.count = static_cast<std::size_t>(c);
-    } else if (command == "echo" && arg == "--json") {
+    } else if ((command == "echo" || command == "print") && arg == "--json") {
       a.json = true;
     } else if (command == "check" && arg == "--expect") {
       add_expectation(value(), a.check);
@@ -109,15 +116,32 @@ Arguments parse(const std::string& command, const std::vector<std::string>& args
       add_expectation(arg.substr(9), a.check);
     } else if (command == "check" && arg == "--allow-recovered") {
       a.check.allow_recovered = true;
+    } else if (command == "print" && arg == "--topic") {
+      a.topic = value();
+    } else if (command == "compare" && arg == "--topic") {
+      a.compare.topic = value();
+    } else if (command == "compare" && arg == "--ignore") {
+      const std::string& list = value();
+      for (std::size_t begin = 0, end = 0; begin <= list.size(); begin = end + 1) {
+        end = std::min(list.find(',', begin), list.size());
+        if (end > begin) a.compare.ignored.push_back(list.substr(begin, end - begin));
+      }
+    } else if (command == "compare" && arg == "--tolerance") {
+      a.compare.tolerance = non_negative_number(arg, value());
     } else if (arg.rfind("-", 0) == 0) {
       throw std::invalid_argument("unknown option '" + arg + "' for " + command);
     } else {
       a.positional.push_back(arg);
     }
   }
+  if (command == "compare") {
+    if (a.positional.size() != 2) throw std::invalid_argument("compare needs exactly two MCAP files");
+    if (a.compare.topic.empty()) throw std::invalid_argument("compare needs --topic");
+    return a;
+  }
   const std::size_t wanted = (command == "participants" || command == "topics") ? 0 : 1;
   if (a.positional.size() != wanted) {
-    const char* what = command == "info" || command == "check" ? "an MCAP file" : "a TOPIC";
+    const char* what = command == "info" || command == "check" || command == "print" ? "an MCAP file" : "a TOPIC";
     if (wanted == 0) throw std::invalid_argument(command + " takes no positional argument");
     throw std::invalid_argument(command + " needs exactly " + what);
   }
@@ -152,7 +176,8 @@ int main(int argc, char** argv) {
   Arguments a;
   try {
     if (command != "participants" && command != "topics" && command != "echo" && command != "hz" &&
-        command != "info" && command != "check") {
+        command != "info" && command != "check" && command != "compare" &&
+        command != "print") {
       throw std::invalid_argument("unknown command '" + command + "'");
     }
     a = parse(command, args);
@@ -163,6 +188,12 @@ int main(int argc, char** argv) {
 
   try {
     if (command == "info") return log_tool::run_info(a.positional[0], std::cout);
+    if (command == "print") return log_tool::run_print({a.positional[0], a.topic, a.json}, std::cout);
+    if (command == "compare") {
+      a.compare.first_path = a.positional[0];
+      a.compare.second_path = a.positional[1];
+      return log_tool::run_compare(a.compare, std::cout);
+    }
     if (command == "check") {
       a.check.path = a.positional[0];
       return log_tool::run_check(a.check, std::cout);

@@ -315,6 +315,86 @@ std::string to_json_line(const Value& value) {
   return out;
 }
 
+namespace {
+
+std::string without_indices(const std::string& path) {
+  std::string out;
+  bool in_index = false;
+  for (char c : path) {
+    if (c == '[') in_index = true;
+    if (!in_index) out += c;
+    if (c == ']') in_index = false;
+  }
+  return out;
+}
+
+bool same_scalar(const Value& a, const Value& b, double tolerance) {
+  if (a.kind() != b.kind()) return false;
+  switch (a.kind()) {
+    case Value::Kind::kFloat: {
+      const double x = a.float_value();
+      const double y = b.float_value();
+      if (std::isnan(x) || std::isnan(y)) return std::isnan(x) && std::isnan(y);
+      if (tolerance == 0.0) return x == y;
+      return std::abs(x - y) <= tolerance * std::max({1.0, std::abs(x), std::abs(y)});
+    }
+    case Value::Kind::kInt:
+      return a.int_value() == b.int_value();
+    case Value::Kind::kUInt:
+      return a.uint_value() == b.uint_value();
+    default:
+      return a.string_value() == b.string_value();
+  }
+}
+
+struct Comparison {
+  const std::vector<std::string>& ignored;
+  double tolerance;
+  std::size_t max_lines;
+  std::vector<std::string> lines;
+
+  bool skipped(const std::string& path) const {
+    return std::find(ignored.begin(), ignored.end(), path) != ignored.end() ||
+           std::find(ignored.begin(), ignored.end(), without_indices(path)) != ignored.end();
+  }
+  void differ(const std::string& path, const std::string& what) {
+    if (lines.size() < max_lines) lines.push_back(path + ": " + what);
+  }
+  void compare(const Value& a, const Value& b, const std::string& path) {
+    if (lines.size() >= max_lines || (!path.empty() && skipped(path))) return;
+    if (a.kind() != b.kind()) return differ(path, "different kinds of value");
+    if (a.kind() == Value::Kind::kStruct) {
+      for (const auto& [name, field] : a.fields()) {
+        const std::string child = path.empty() ? name : path + "." + name;
+        const Value* other = b.find(name);
+        if (other == nullptr) {
+          if (!skipped(child)) differ(child, "missing in the second");
+          continue;
+        }
+        compare(field, *other, child);
+      }
+    } else if (a.kind() == Value::Kind::kList) {
+      if (a.items().size() != b.items().size()) {
+        return differ(path, std::to_string(a.items().size()) + " items != " + std::to_string(b.items().size()));
+      }
+      for (std::size_t i = 0; i < a.items().size(); ++i) {
+        compare(a.items()[i], b.items()[i], path + "[" + std::to_string(i) + "]");
+      }
+    } else if (!same_scalar(a, b, tolerance)) {
+      differ(path, scalar_text(a, false) + " != " + scalar_text(b, false));
+    }
+  }
+};
+
+}  // namespace
+
+std::vector<std::string> compare_values(const Value& a, const Value& b, const std::vector<std::string>& ignored,
+                                        double tolerance, std::size_t max_lines) {
+  Comparison comparison{ignored, tolerance, max_lines, {}};
+  comparison.compare(a, b, "");
+  return comparison.lines;
+}
+
 GapStats gap_stats(const std::vector<double>& arrivals_s) {
   GapStats s;
   s.messages = arrivals_s.size();

@@ -101,8 +101,9 @@ void EstimatorNode::filter_loop() {
       for (const Inbox& item : batch) {
         const std::uint64_t stamp = std::visit([](const auto& m) { return m.header().stamp_ns(); }, item);
         if (!has_epoch_) {
-          // Whole seconds keep the epoch readable; times stay small doubles.
-          epoch_ns_ = stamp - stamp % 1000000000ull;
+          // Times are seconds since the first stamp (small doubles); a replay
+          // with every stamp shifted by one constant computes exactly the same.
+          epoch_ns_ = stamp;
           has_epoch_ = true;
         }
         if (const auto* odometry = std::get_if<msg::Odometry>(&item)) {

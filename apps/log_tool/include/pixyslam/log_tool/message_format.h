@@ -66,6 +66,15 @@ std::string to_json_line(const Value& value);
 // Shortest text that reads back as exactly `v` ("0.1", "1e-09", "3").
 std::string format_double(double v);
 
+// Field-by-field differences between two messages of one type, as lines
+// "path: a != b" (paths like "landmarks[3].x_m"), at most `max_lines`.
+// A path is skipped when it, or it with the list indices removed
+// ("landmarks.x_m"), is in `ignored`. Floats differ when
+// |a - b| > tolerance * max(1, |a|, |b|) (0: bit-for-bit, NaN equals NaN);
+// lists of different lengths differ by their length. Pure.
+std::vector<std::string> compare_values(const Value& a, const Value& b, const std::vector<std::string>& ignored,
+                                        double tolerance, std::size_t max_lines);
+
 // Inter-arrival statistics of a stream (pixyslam_spy hz), times in seconds.
 struct GapStats {
   std::size_t messages = 0;

@@ -1,0 +1,156 @@
+// pixyslam_play: replays MCAP logs written by the logger onto DDS.
+//   pixyslam_play LOG.mcap [LOG_001.mcap ...] [--rate R] [--start S] [--duration S]
+//                 [--loop] [--topics LIST] [--restamp] [--wait-readers N]
+//                 [--wait-timeout S] [--dds-config FILE] [--domain N] [--quiet]
+// Exit status: 0 played, 1 a file could not be read / nothing to play,
+// 2 command-line or config error.
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "log_player.h"
+#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/stop_signal.h"
+#include "pixyslam/config/yaml_reader.h"
+
+#ifndef PIXYSLAM_DEFAULT_PROFILES_FILE
+#define PIXYSLAM_DEFAULT_PROFILES_FILE ""
+#endif
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: pixyslam_play LOG.mcap [MORE.mcap ...] [options]\n"
+    "  --rate R          playback speed factor (default 1: the recorded timing)\n"
+    "  --start S         skip the first S seconds of the log\n"
+    "  --duration S      play S seconds of log time (default: to the end)\n"
+    "  --loop            start over at the end until Ctrl-C\n"
+    "  --topics LIST     comma-separated names, globs, !exclusions (default: every topic)\n"
+    "  --restamp         shift header stamps onto the current clock (for a live estimator)\n"
+    "  --wait-readers N  wait for N readers per topic before playing (default 1; 0: do not wait)\n"
+    "  --wait-timeout S  then play anyway (default 10)\n"
+    "  --dds-config FILE YAML with a dds: mapping (default " PIXYSLAM_DEFAULT_PROFILES_FILE ", domain 0)\n"
+    "  --domain N        overrides the domain id\n"
+    "  --quiet           no progress lines\n";
+
+double number(const std::string& flag, const std::string& text) {
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size()) throw std::invalid_argument(flag + " needs a number, got '" + text + "'");
+  return v;
+}
+
+int integer(const std::string& flag, const std::string& text, int min, int max) {
+  const double v = number(flag, text);
+  if (v != static_cast<int>(v) || v < min || v > max) {
+    throw std::invalid_argument(flag + " must be an integer " + std::to_string(min) + ".." + std::to_string(max) +
+                                ", got '" + text + "'");
+  }
+  return static_cast<int>(v);
+}
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> items;
+  std::size_t begin = 0;
+  while (begin <= text.size()) {
+    const std::size_t end = std::min(text.find(',', begin), text.size());
+    if (end > begin) items.push_back(text.substr(begin, end - begin));
+    begin = end + 1;
+  }
+  return items;
+}
+
+pixyslam::player::PlayerOptions parse(const std::vector<std::string>& args) {
+  using namespace pixyslam;
+  player::PlayerOptions o;
+  std::string dds_config;
+  int domain = -1;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw std::invalid_argument(arg + " needs a value");
+      return args[++i];
+    };
+    if (arg == "--rate") {
+      o.playback.rate = number(arg, value());
+    } else if (arg == "--start") {
+      o.playback.start_offset_s = number(arg, value());
+    } else if (arg == "--duration") {
+      o.playback.duration_s = number(arg, value());
+    } else if (arg == "--loop") {
+      o.playback.loop = true;
+    } else if (arg == "--topics") {
+      o.topics = split_list(value());
+      if (o.topics.empty()) throw std::invalid_argument("--topics needs at least one topic");
+    } else if (arg == "--restamp") {
+      o.restamp = true;
+    } else if (arg == "--wait-readers") {
+      o.wait_readers = integer(arg, value(), 0, 1000);
+    } else if (arg == "--wait-timeout") {
+      o.wait_timeout_s = number(arg, value());
+      if (!(o.wait_timeout_s >= 0)) throw std::invalid_argument("--wait-timeout must be >= 0");
+    } else if (arg == "--dds-config") {
+      dds_config = value();
+    } else if (arg == "--domain") {
+      domain = integer(arg, value(), 0, 232);
+    } else if (arg == "--quiet") {
+      o.progress_period_s = 0.0;
+    } else if (arg.rfind("-", 0) == 0) {
+      throw std::invalid_argument("unknown option '" + arg + "'");
+    } else {
+      o.files.push_back(arg);
+    }
+  }
+  if (o.files.empty()) throw std::invalid_argument("no MCAP file given");
+  player::validate(o.playback);
+  if (dds_config.empty()) {
+    o.dds.profiles_file = PIXYSLAM_DEFAULT_PROFILES_FILE;
+  } else {
+    config::YamlReader root = config::YamlReader::from_file(dds_config);
+    config::YamlReader dds_yaml = root.child("dds");
+    o.dds = dds::read_dds_options(dds_yaml, app::folder_of(dds_config));
+  }
+  if (domain >= 0) o.dds.domain_id = domain;
+  return o;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace pixyslam;
+  app::StopSignal::install();
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
+    std::fputs(kUsage, args.empty() ? stderr : stdout);
+    return args.empty() ? 2 : 0;
+  }
+  player::PlayerOptions options;
+  try {
+    options = parse(args);
+  } catch (const config::ConfigError& e) {
+    std::fprintf(stderr, "pixyslam_play: config error: %s\n", e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "pixyslam_play: %s\n%s", e.what(), kUsage);
+    return 2;
+  }
+  try {
+    player::LogPlayer player(options, std::cerr);
+    player.play();
+    return 0;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "pixyslam_play: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pixyslam_play: %s\n", e.what());
+    return 1;
+  }
+}
