@@ -9,6 +9,7 @@ PACKAGES=(
   libgtest-dev libbenchmark-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools default-jre-headless
   libzstd-dev liblz4-dev
+  libopencv-dev
 )
 
 missing=()

@@ -5,9 +5,10 @@
 # cleanly, the evaluator's ATE is under MAX_ATE (so MapState arrived and the
 # map is near the truth), and the log holds every message each publisher sent
 # (seq 1..N per topic, N = the publisher's own count).
-#   run_system_test.sh BIN_DIR CONFIG_DIR SIM_DURATION_S MAX_ATE_M
+# The log is kept as KEEP_LOG when given (for the replay test).
+#   run_system_test.sh BIN_DIR CONFIG_DIR SIM_DURATION_S MAX_ATE_M [KEEP_LOG]
 set -euo pipefail
-bin=$1 config=$2 duration=$3 max_ate=$4
+bin=$1 config=$2 duration=$3 max_ate=$4 keep_log=${5:-}
 work=$(mktemp -d /tmp/pixyslam_system_test.XXXXXX)
 trap 'rm -rf "$work"' EXIT
 cp -r "$config" "$work/config"
@@ -17,7 +18,20 @@ sed -i "s/^  duration_s: [0-9.]* /  duration_s: $duration /" "$work/config/robot
 sed -i "s/--max-ate, '0.10'/--max-ate, '$max_ate'/" "$work/config/launch_sim.yaml"
 
 status=0
-"$bin/pixyslam_launch" "$work/config/launch_sim.yaml" --run-dir "$work/run" > "$work/out.log" 2>&1 || status=$?
+"$bin/pixyslam_launch" "$work/config/launch_sim.yaml" --run-dir "$work/run" > "$work/out.log" 2>&1 &
+launcher=$!
+trap 'kill "$launcher" 2>/dev/null || true; rm -rf "$work"' EXIT
+# pixyslam_spy echo of every topic while the system runs: 20 samples each.
+topics=(odometry landmark_observation map_state ground_truth)
+sleep 8
+echoes=()
+for t in "${topics[@]}"; do
+  "$bin/pixyslam_spy" echo "pixyslam/$t" --json --count 20 --seconds 20 \
+    --dds-config "$work/config/slam_estimator.yaml" > "$work/echo_$t.jsonl" 2> "$work/echo_$t.err" &
+  echoes+=($!)
+done
+for pid in "${echoes[@]}"; do wait "$pid" || { echo "FAIL: pixyslam_spy echo failed"; cat "$work"/echo_*.err; exit 1; }; done
+wait "$launcher" || status=$?
 grep -v "robot_sim: t \|status: " "$work/out.log"
 if [[ $status -ne 0 ]]; then
   echo "FAIL: pixyslam_launch exited with $status"
@@ -37,4 +51,17 @@ done
 "$bin/pixyslam_log" check "$work/run/run.mcap" \
   --expect "pixyslam/odometry=$odometry" --expect "pixyslam/landmark_observation=$observations" \
   --expect "pixyslam/map_state=$maps" --expect "pixyslam/ground_truth=$truth"
+# Every echoed sample is, field for field, a message the publisher sent (the
+# log holds exactly what each publisher sent: checked above).
+for t in "${topics[@]}"; do
+  "$bin/pixyslam_log" print "$work/run/run.mcap" --topic "pixyslam/$t" --json > "$work/log_$t.jsonl"
+  lines=$(wc -l < "$work/echo_$t.jsonl")
+  if [[ $lines -ne 20 ]]; then echo "FAIL: echo pixyslam/$t printed $lines samples, wanted 20"; exit 1; fi
+  while IFS= read -r line; do
+    grep -qF "\"message\":$line}" "$work/log_$t.jsonl" ||
+      { echo "FAIL: echo pixyslam/$t printed a sample no publisher sent: $line"; exit 1; }
+  done < "$work/echo_$t.jsonl"
+  echo "echo pixyslam/$t: 20 samples, each equal to a published one (e.g. $(head -c 100 "$work/echo_$t.jsonl")...)"
+done
+if [[ -n "$keep_log" ]]; then cp "$work/run/run.mcap" "$keep_log"; fi
 echo "PASS"

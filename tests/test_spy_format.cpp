@@ -168,5 +168,55 @@ TEST(SpyFormat, GapStatistics) {
   EXPECT_EQ(gap_stats({}).messages, 0u);
 }
 
+// pixyslam_log compare: field-by-field differences of two messages.
+TEST(CompareValues, IdenticalMessagesHaveNoDifferences) {
+  EXPECT_TRUE(compare_values(to_value(observation()), to_value(observation()), {}, 0.0, 10).empty());
+}
+
+TEST(CompareValues, NamesEveryDifferingFieldByPath) {
+  msg::LandmarkObservation changed = observation();
+  changed.header().stamp_ns(5);
+  changed.detections()[0].range_m(1.5000001);
+  changed.detections()[0].block().x_px(161);
+  const auto lines = compare_values(to_value(observation()), to_value(changed), {}, 0.0, 10);
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0].rfind("header.stamp_ns: ", 0), 0u) << lines[0];
+  EXPECT_EQ(lines[1].rfind("detections[0].range_m: 1.5 != 1.5000001", 0), 0u) << lines[1];
+  EXPECT_EQ(lines[2].rfind("detections[0].block.x_px: 160 != 161", 0), 0u) << lines[2];
+  // At most max_lines.
+  EXPECT_EQ(compare_values(to_value(observation()), to_value(changed), {}, 0.0, 2).size(), 2u);
+}
+
+TEST(CompareValues, IgnoredPathsWithOrWithoutIndicesAndTolerance) {
+  msg::LandmarkObservation changed = observation();
+  changed.header().stamp_ns(5);
+  changed.detections()[0].range_m(1.5 * (1 + 1e-12));
+  EXPECT_EQ(compare_values(to_value(observation()), to_value(changed), {"header.stamp_ns"}, 0.0, 10).size(), 1u);
+  EXPECT_TRUE(
+      compare_values(to_value(observation()), to_value(changed), {"header.stamp_ns", "detections.range_m"}, 0.0, 10)
+          .empty());
+  EXPECT_TRUE(
+      compare_values(to_value(observation()), to_value(changed), {"header.stamp_ns", "detections[0].range_m"}, 0.0, 10)
+          .empty());
+  EXPECT_TRUE(compare_values(to_value(observation()), to_value(changed), {"header"}, 1e-9, 10).empty());
+  // A tolerance does not hide a real difference.
+  changed.detections()[0].range_m(1.6);
+  EXPECT_EQ(compare_values(to_value(observation()), to_value(changed), {"header"}, 1e-9, 10).size(), 1u);
+}
+
+TEST(CompareValues, ListLengthsAndNaN) {
+  msg::LandmarkObservation more = observation();
+  more.detections().push_back(more.detections()[0]);
+  const auto lines = compare_values(to_value(observation()), to_value(more), {}, 0.0, 10);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0], "detections: 1 items != 2");
+  msg::Odometry a = odometry();
+  a.v_mps(std::numeric_limits<double>::quiet_NaN());
+  msg::Odometry b = a;
+  EXPECT_TRUE(compare_values(to_value(a), to_value(b), {}, 0.0, 10).empty());
+  b.v_mps(0.0);
+  EXPECT_EQ(compare_values(to_value(a), to_value(b), {}, 0.0, 10).size(), 1u);
+}
+
 }  // namespace
 }  // namespace pixyslam::log_tool

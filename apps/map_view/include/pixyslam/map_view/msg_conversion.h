@@ -1,0 +1,49 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "map_state.h"
+#include "ground_truth.h"
+#include "pixyslam/map_view/map_view_state.h"
+
+namespace pixyslam::map_view {
+
+// Flat conversions from the DDS messages to the map view's plain structs.
+Pose2 to_pose(const msg::Pose2D& pose);
+LandmarkView to_landmark(const msg::LandmarkEstimate& landmark);
+std::vector<LandmarkView> to_landmarks(const msg::MapState& state);
+std::vector<TrueLandmarkView> to_true_landmarks(const msg::GroundTruth& truth);
+
+// Builds the MapViewState from a stream of MapState and GroundTruth messages:
+// the latest map, particles and poses, and the mean and true trajectories
+// accumulated so far (decimated by `trajectory_min_step_m`). A MapState
+// stamped before the last one taken (a late joiner's stale state) is ignored.
+// Caption times are relative to the first stamp of either kind.
+// Thread-compatible (the live view guards it with a mutex).
+class MapViewBuilder {
+ public:
+  explicit MapViewBuilder(double trajectory_min_step_m = 0.0) : min_step_m_(trajectory_min_step_m) {}
+
+  // False if the message was ignored (older than the last MapState).
+  bool add(const msg::MapState& state);
+  void add(const msg::GroundTruth& truth);
+
+  const MapViewState& state() const { return state_; }
+  std::size_t map_states() const { return map_states_; }
+  std::size_t ground_truths() const { return ground_truths_; }
+
+ private:
+  void note_stamp(std::uint64_t stamp_ns);
+
+  double min_step_m_;
+  MapViewState state_;
+  std::size_t map_states_ = 0;
+  std::size_t ground_truths_ = 0;
+  bool have_start_ = false;
+  std::uint64_t start_ns_ = 0;
+  std::uint64_t last_map_ns_ = 0;
+};
+
+}  // namespace pixyslam::map_view

@@ -1,0 +1,71 @@
+#include "pixyslam/map_view/msg_conversion.h"
+
+namespace pixyslam::map_view {
+
+Pose2 to_pose(const msg::Pose2D& pose) { return {pose.x_m(), pose.y_m(), pose.theta_rad()}; }
+
+LandmarkView to_landmark(const msg::LandmarkEstimate& l) {
+  LandmarkView v;
+  v.id = l.landmark_id();
+  v.x_m = l.x_m();
+  v.y_m = l.y_m();
+  v.cov_xx_m2 = l.cov_xx_m2();
+  v.cov_xy_m2 = l.cov_xy_m2();
+  v.cov_yy_m2 = l.cov_yy_m2();
+  v.times_observed = l.times_observed();
+  return v;
+}
+
+std::vector<LandmarkView> to_landmarks(const msg::MapState& state) {
+  std::vector<LandmarkView> out;
+  out.reserve(state.landmarks().size());
+  for (const msg::LandmarkEstimate& l : state.landmarks()) out.push_back(to_landmark(l));
+  return out;
+}
+
+std::vector<TrueLandmarkView> to_true_landmarks(const msg::GroundTruth& truth) {
+  std::vector<TrueLandmarkView> out;
+  out.reserve(truth.landmarks().size());
+  for (const msg::TrueLandmark& l : truth.landmarks()) out.push_back({l.landmark_id(), l.x_m(), l.y_m()});
+  return out;
+}
+
+void MapViewBuilder::note_stamp(std::uint64_t stamp_ns) {
+  if (!have_start_ || stamp_ns < start_ns_) {
+    start_ns_ = stamp_ns;
+    have_start_ = true;
+  }
+}
+
+bool MapViewBuilder::add(const msg::MapState& m) {
+  const std::uint64_t stamp = m.header().stamp_ns();
+  if (map_states_ > 0 && stamp < last_map_ns_) return false;
+  note_stamp(stamp);
+  last_map_ns_ = stamp;
+  ++map_states_;
+
+  state_.particles.clear();
+  for (const msg::Pose2D& p : m.particle_poses()) state_.particles.push_back(to_pose(p));
+  state_.current_pose = to_pose(m.mean_pose());
+  append_point(state_.mean_trajectory, {m.mean_pose().x_m(), m.mean_pose().y_m()}, min_step_m_);
+  state_.landmarks = to_landmarks(m);
+
+  CaptionInfo info;
+  info.time_s = static_cast<double>(stamp - start_ns_) * 1e-9;
+  info.particle_count = m.particle_count();
+  info.effective_sample_size = m.effective_sample_size();
+  info.landmark_count = m.landmarks().size();
+  info.robot_id = m.header().robot_id();
+  state_.caption = format_caption(info);
+  return true;
+}
+
+void MapViewBuilder::add(const msg::GroundTruth& g) {
+  note_stamp(g.header().stamp_ns());
+  ++ground_truths_;
+  state_.true_pose = to_pose(g.pose());
+  append_point(state_.true_trajectory, {g.pose().x_m(), g.pose().y_m()}, min_step_m_);
+  if (!g.landmarks().empty() || state_.true_landmarks.empty()) state_.true_landmarks = to_true_landmarks(g);
+}
+
+}  // namespace pixyslam::map_view

@@ -1,0 +1,25 @@
+# pixyslam_play rejects bad command lines and files with exit status 2 (usage,
+# options) or 1 (unreadable file), naming what was wrong, before any DDS traffic.
+#   cmake -DPLAYER=... -DLOG=... -P player_cli_test.cmake
+function(expect_failure code pattern)
+  execute_process(COMMAND ${PLAYER} ${ARGN} RESULT_VARIABLE result ERROR_VARIABLE err OUTPUT_VARIABLE out TIMEOUT 30)
+  if(NOT result EQUAL code)
+    message(FATAL_ERROR "pixyslam_play ${ARGN}: exit ${result}, expected ${code}\n${err}")
+  endif()
+  if(NOT err MATCHES "${pattern}")
+    message(FATAL_ERROR "pixyslam_play ${ARGN}: message does not match '${pattern}':\n${err}")
+  endif()
+endfunction()
+
+expect_failure(2 "usage: pixyslam_play")
+expect_failure(2 "no MCAP file given" --rate 2)
+expect_failure(2 "--rate must be a finite number > 0" ${LOG} --rate 0)
+expect_failure(2 "--rate needs a number, got 'fast'" ${LOG} --rate fast)
+expect_failure(2 "unknown option '--bogus'" ${LOG} --bogus)
+expect_failure(2 "--domain must be an integer 0..232" ${LOG} --domain 300)
+expect_failure(2 "--topics 'pixyslam/nothing'" ${LOG} --topics pixyslam/nothing --domain 231)
+expect_failure(2 "past the end of the log" ${LOG} --start 100000 --domain 231 --wait-readers 0)
+expect_failure(1 "no_such_file.mcap" ${LOG}.no_such_file.mcap --domain 231)
+file(WRITE ${LOG}.not_mcap.txt "hello")
+expect_failure(1 "not_mcap.txt" ${LOG}.not_mcap.txt --domain 231)
+file(REMOVE ${LOG}.not_mcap.txt)
