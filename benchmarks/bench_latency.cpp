@@ -46,10 +46,10 @@ int run(int argc, char** argv) {
   // The estimator as its own process, its output forwarded with a prefix.
   launcher::ProcessGroup estimator(own_folder(), stdout);
   std::vector<std::string> command{"slam_estimator", "--config", config};
-  estimator.start({"slam_estimator", command, 0.0, false});
+  estimator.start({"slam_estimator", command, 0.0, false, {}});
 
   dds::DdsOptions dds_options;
-  dds_options.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml";
+  dds_options.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/profiles.xml";
   dds::Participant participant(dds_options, "bench_latency");
   dds::Writer<msg::Odometry> odometry_writer(participant);
   dds::Writer<msg::LandmarkObservation> observation_writer(participant);

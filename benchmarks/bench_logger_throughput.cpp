@@ -77,7 +77,7 @@ int run(int argc, char** argv) {
   const double duration_s = args.number("duration", 10.0);
   const std::string compression = args.get("compression", "zstd");
   const int domain = static_cast<int>(args.number("domain", 150 + ::getpid() % 80));
-  const std::string profiles = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml";
+  const std::string profiles = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/profiles.xml";
 
   const std::filesystem::path work =
       std::filesystem::temp_directory_path() / ("pixyslam_bench_logger_" + std::to_string(::getpid()));
@@ -92,7 +92,7 @@ int run(int argc, char** argv) {
   }
 
   launcher::ProcessGroup logger(own_folder(), stdout);
-  logger.start({"logger", {"logger", "--config", config}, 0.0, false});
+  logger.start({"logger", {"logger", "--config", config}, 0.0, false, {}});
 
   dds::DdsOptions dds_options;
   dds_options.profiles_file = profiles;

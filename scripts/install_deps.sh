@@ -10,6 +10,7 @@ PACKAGES=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools default-jre-headless
   libzstd-dev liblz4-dev
   libopencv-dev
+  openssl iproute2 tcpdump
 )
 
 missing=()

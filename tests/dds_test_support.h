@@ -27,7 +27,7 @@ namespace pixyslam::test_support {
 // share ports nor see each other's messages.
 inline dds::DdsOptions loopback_options(int first_domain, int domains, const std::string& robot_id_prefix) {
   dds::DdsOptions o;
-  o.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml";
+  o.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/profiles.xml";
   o.domain_id = first_domain + static_cast<int>(::getpid() % domains);
   o.robot_id = robot_id_prefix + std::to_string(::getpid());
   return o;

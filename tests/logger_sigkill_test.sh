@@ -32,13 +32,13 @@ logger:
   flush_period_s: $flush_period_s
 dds:
   domain_id: $domain
-  profiles_file: $source_dir/config/dds/loopback.xml
+  profiles_file: $source_dir/config/dds/profiles.xml
   robot_id: sigkill_test
 YAML
 
 "$logger" --config "$work/logger.yaml" > "$work/logger.out" 2> "$work/logger.err" &
 logger_pid=$!
-"$publisher" --profiles "$source_dir/config/dds/loopback.xml" --domain "$domain" --topics odometry \
+"$publisher" --profiles "$source_dir/config/dds/profiles.xml" --domain "$domain" --topics odometry \
   --count $((rate * 60)) --rate "$rate" > "$work/publisher.out" 2> "$work/publisher.err" &
 publisher_pid=$!
 

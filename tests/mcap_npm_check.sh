@@ -98,12 +98,12 @@ logger:
   flush_period_s: 0.5
 dds:
   domain_id: $domain
-  profiles_file: $source_dir/config/dds/loopback.xml
+  profiles_file: $source_dir/config/dds/profiles.xml
   robot_id: npm_check
 YAML
   "$logger" --config "$dir/logger.yaml" > "$dir/logger.out" 2> "$dir/logger.err" &
   logger_pid=$!
-  if ! "$publisher" --profiles "$source_dir/config/dds/loopback.xml" --domain "$domain" --count "$count" \
+  if ! "$publisher" --profiles "$source_dir/config/dds/profiles.xml" --domain "$domain" --count "$count" \
       --rate 1000 > "$dir/publisher.out" 2> "$dir/publisher.err"; then
     echo "FAIL $name: publisher failed"; cat "$dir/publisher.err" "$dir/logger.err"; return 1
   fi

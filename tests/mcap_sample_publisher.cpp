@@ -1,6 +1,6 @@
 // Test publisher for the logger's integration tests: N rounds, each one message
 // of every topic (or of Odometry only), at a fixed rate, seq 1..N per topic.
-//   mcap_sample_publisher --profiles config/dds/loopback.xml --domain D --count N
+//   mcap_sample_publisher --profiles config/dds/profiles.xml --domain D --count N
 //                         [--rate HZ] [--topics all|odometry] [--wait-readers S]
 // Waits for one matched reader per topic, then publishes; prints
 // "progress N" (rounds published) every 10 rounds, line-buffered, so that a

@@ -16,7 +16,7 @@ namespace {
 
 DdsOptions loopback_options() {
   DdsOptions o;
-  o.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml";
+  o.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/profiles.xml";
   o.domain_id = 0;  // ctest runs one DDS test at a time (RESOURCE_LOCK dds)
   o.robot_id = "test_robot";
   return o;
@@ -101,11 +101,11 @@ TEST(DdsLoopback, UnknownParticipantProfileIsNamed) {
 
 TEST(DdsOptions, ReadsKeysAndResolvesTheProfilesPath) {
   auto reader = config::YamlReader::from_string(
-      "dds:\n  domain_id: 7\n  profiles_file: dds/loopback.xml\n  robot_id: r2\n", "test.yaml");
+      "dds:\n  domain_id: 7\n  profiles_file: dds/profiles.xml\n  robot_id: r2\n", "test.yaml");
   auto dds = reader.child("dds");
   const DdsOptions o = read_dds_options(dds, "/etc/pixyslam");
   EXPECT_EQ(o.domain_id, 7);
-  EXPECT_EQ(o.profiles_file, "/etc/pixyslam/dds/loopback.xml");
+  EXPECT_EQ(o.profiles_file, "/etc/pixyslam/dds/profiles.xml");
   EXPECT_EQ(o.robot_id, "r2");
 }
 

@@ -143,7 +143,7 @@ TEST(EncoderNodeOptions, ShippedConfigLoadsWithNodeAndDds) {
   EXPECT_EQ(o.encoder.serial_device, "/dev/ttyACM0");
   EXPECT_DOUBLE_EQ(o.process.reopen_period_s, 1.0);
   EXPECT_DOUBLE_EQ(o.clock_window_s, 1.0);
-  EXPECT_EQ(o.dds.profiles_file, std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml");
+  EXPECT_EQ(o.dds.profiles_file, std::string(PIXYSLAM_CONFIG_DIR) + "/dds/profiles.xml");
   // The core's file reader accepts the same file.
   EXPECT_EQ(encoder::read_encoder_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/encoder_bridge.yaml")
                 .serial_device,

@@ -112,7 +112,7 @@ TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
 TEST(EstimatorOptions, ShippedConfigIsValid) {
   const EstimatorOptions o = test_options();
   EXPECT_EQ(o.filter.particles, 100);
-  EXPECT_NE(o.dds.profiles_file.find("dds/loopback.xml"), std::string::npos);
+  EXPECT_NE(o.dds.profiles_file.find("dds/profiles.xml"), std::string::npos);
 }
 
 }  // namespace

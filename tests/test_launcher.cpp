@@ -92,8 +92,8 @@ TEST(ProcessGroup, ForwardsOutputWithPrefixAndReportsExitCodes) {
   std::FILE* out = std::tmpfile();
   {
     ProcessGroup group("", out);
-    group.start({"ok", {"/bin/sh", "-c", "echo hello; echo world >&2"}, 0.0, false});
-    group.start({"bad", {"/bin/sh", "-c", "exit 3"}, 0.0, false});
+    group.start({"ok", {"/bin/sh", "-c", "echo hello; echo world >&2"}, 0.0, false, {}});
+    group.start({"bad", {"/bin/sh", "-c", "exit 3"}, 0.0, false, {}});
     const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     while (group.any_running() && std::chrono::steady_clock::now() < end) {
       group.poll(std::chrono::milliseconds(50));
@@ -112,9 +112,9 @@ TEST(ProcessGroup, ForwardsOutputWithPrefixAndReportsExitCodes) {
 TEST(ProcessGroup, StopAllInterruptsAndEscalatesToKill) {
   std::FILE* out = std::tmpfile();
   ProcessGroup group("", out);
-  group.start({"sleeper", {"/bin/sleep", "30"}, 0.0, false});
+  group.start({"sleeper", {"/bin/sleep", "30"}, 0.0, false, {}});
   // Ignores SIGINT: must be killed after the timeout.
-  group.start({"stubborn", {"/bin/sh", "-c", "trap '' INT; sleep 30"}, 0.0, false});
+  group.start({"stubborn", {"/bin/sh", "-c", "trap '' INT; sleep 30"}, 0.0, false, {}});
   group.poll(std::chrono::milliseconds(200));
   const auto begin = std::chrono::steady_clock::now();
   group.stop_all(std::chrono::milliseconds(500));
@@ -128,7 +128,7 @@ TEST(ProcessGroup, StopAllInterruptsAndEscalatesToKill) {
 TEST(ProcessGroup, MissingProgramIsNamed) {
   ProcessGroup group("/nonexistent", stdout);
   try {
-    group.start({"x", {"no_such_program_pixyslam"}, 0.0, false});
+    group.start({"x", {"no_such_program_pixyslam"}, 0.0, false, {}});
     FAIL() << "expected an error";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("no_such_program_pixyslam"), std::string::npos);

@@ -237,7 +237,7 @@ TEST(LoggerOptions, ShippedConfigLoads) {
   EXPECT_EQ(o.compression, default_compression());
   EXPECT_DOUBLE_EQ(o.flush_period_s, 1.0);
   EXPECT_FALSE(o.fsync);
-  EXPECT_EQ(o.dds.profiles_file, std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml");
+  EXPECT_EQ(o.dds.profiles_file, std::string(PIXYSLAM_CONFIG_DIR) + "/dds/profiles.xml");
   EXPECT_TRUE(std::filesystem::exists(o.dds.profiles_file));
 }
 
@@ -253,13 +253,13 @@ TEST(LoggerOptions, DefaultsRecordEveryTopic) {
 TEST(LoggerOptions, SelectedTopicsAndCompression) {
   auto root = config::YamlReader::from_string(
       "logger:\n  topics: [pixyslam/map_state]\n  compression: none\n  fsync: true\n"
-      "dds:\n  profiles_file: dds/loopback.xml\n",
+      "dds:\n  profiles_file: dds/profiles.xml\n",
       "logger_test.yaml");
   const LoggerOptions o = read_logger_options(root, "/cfg");
   EXPECT_EQ(o.topics, std::vector<std::string>{"pixyslam/map_state"});
   EXPECT_EQ(o.compression, logger::McapCompression::kNone);
   EXPECT_TRUE(o.fsync);
-  EXPECT_EQ(o.dds.profiles_file, "/cfg/dds/loopback.xml");
+  EXPECT_EQ(o.dds.profiles_file, "/cfg/dds/profiles.xml");
 }
 
 TEST(LoggerOptions, TopicPatternsAndRotation) {
@@ -318,7 +318,7 @@ TEST(LoggerOptions, ErrorsNameTheFileAndTheKey) {
 // anything else on domain 0 of this machine would be recorded too.
 dds::DdsOptions loopback_options() {
   dds::DdsOptions o;
-  o.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml";
+  o.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/profiles.xml";
   o.domain_id = 100 + static_cast<int>(::getpid() % 100);
   o.robot_id = "test_robot";
   return o;

@@ -610,7 +610,7 @@ TEST(FrameSink, WritesPngSequenceAndMjpgVideo) {
 TEST(MapViewOptions, ReadsValidatesAndRejectsUnknownKeys) {
   config::YamlReader ok = config::YamlReader::from_string(
       "map_view:\n  width_px: 640\n  height_px: 500\n  sigma_scale: 3\n  ground_truth: false\n"
-      "  snapshot_period_s: 0.5\ndds:\n  domain_id: 7\n  profiles_file: dds/loopback.xml\n",
+      "  snapshot_period_s: 0.5\ndds:\n  domain_id: 7\n  profiles_file: dds/profiles.xml\n",
       "test.yaml");
   const MapViewOptions o = read_map_view_options(ok, "/cfg", "/default.xml");
   EXPECT_EQ(o.render.width_px, 640);
@@ -619,7 +619,7 @@ TEST(MapViewOptions, ReadsValidatesAndRejectsUnknownKeys) {
   EXPECT_FALSE(o.render.ground_truth);
   EXPECT_DOUBLE_EQ(o.snapshot_period_s, 0.5);
   EXPECT_EQ(o.dds.domain_id, 7);
-  EXPECT_EQ(o.dds.profiles_file, "/cfg/dds/loopback.xml");
+  EXPECT_EQ(o.dds.profiles_file, "/cfg/dds/profiles.xml");
 
   config::YamlReader empty = config::YamlReader::from_string("{}", "empty.yaml");
   EXPECT_EQ(read_map_view_options(empty, "/cfg", "/default.xml").dds.profiles_file, "/default.xml");
@@ -643,7 +643,7 @@ TEST(MapViewOptions, ReadsValidatesAndRejectsUnknownKeys) {
 TEST(MapViewOptions, ShippedConfigIsValid) {
   const MapViewOptions o = read_map_view_options_file(PIXYSLAM_CONFIG_DIR "/map_view.yaml", "");
   EXPECT_EQ(o.render.width_px, 800);
-  EXPECT_EQ(o.dds.profiles_file, PIXYSLAM_CONFIG_DIR "/dds/loopback.xml");
+  EXPECT_EQ(o.dds.profiles_file, PIXYSLAM_CONFIG_DIR "/dds/profiles.xml");
 }
 #endif
 

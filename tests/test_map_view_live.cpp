@@ -41,7 +41,7 @@ TEST(MapViewLive, DrawsReceivedMapStatesAndStopsOnSigint) {
 
   dds::DdsOptions options;
   options.domain_id = domain;
-  options.profiles_file = PIXYSLAM_CONFIG_DIR "/dds/loopback.xml";
+  options.profiles_file = PIXYSLAM_CONFIG_DIR "/dds/profiles.xml";
   {
     dds::Participant participant(options, "test_map_view_live");
     dds::Writer<msg::MapState> writer(participant);

@@ -138,7 +138,7 @@ TEST(PixyNodeOptions, ShippedConfigLoadsWithNodeAndDds) {
   EXPECT_EQ(o.baud, 19200);
   EXPECT_DOUBLE_EQ(o.camera_latency_s, 0.0);
   EXPECT_EQ(o.pixy.signatures.size(), 20u);
-  EXPECT_EQ(o.dds.profiles_file, std::string(PIXYSLAM_CONFIG_DIR) + "/dds/loopback.xml");
+  EXPECT_EQ(o.dds.profiles_file, std::string(PIXYSLAM_CONFIG_DIR) + "/dds/profiles.xml");
 }
 
 TEST(PixyNodeOptions, EffectiveConfigurationReadsBack) {

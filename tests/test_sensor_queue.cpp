@@ -111,5 +111,70 @@ TEST(SensorQueue, LateSampleIsReleasedAtOnceAndCounted) {
   EXPECT_EQ(queue.counters().late, 1u);
 }
 
+// A network outage: both streams' backlogs arrive at once, long after their
+// stamps, odometry first. While they keep arriving they hold each other back,
+// so the burst is merged in stamp order and nothing is late.
+TEST(SensorQueue, BacklogAfterAnOutageIsMergedInStampOrder) {
+  SensorQueue queue(SensorQueueOptions{});
+  std::vector<double> released;
+  auto drain = [&](double now) {
+    for (const SensorInput& input : queue.pop_ready(now)) released.push_back(stamp_of(input));
+  };
+  queue.push(odometry(0.0), 0.1);
+  queue.push(frame(0.05), 0.1);
+  drain(0.1);
+  double now = 5.0;  // the link is back: 5 s of data arrives within 50 ms
+  for (int i = 1; i < 50; ++i) {
+    queue.push(odometry(0.1 * i), now);
+    drain(now);
+    now += 0.0005;
+  }
+  for (int i = 1; i < 50; ++i) {
+    queue.push(frame(0.1 * i + 0.05), now);
+    drain(now);
+    now += 0.0005;
+  }
+  drain(now + 1.1);  // both silent again, recovery wait over: everything goes
+  EXPECT_EQ(released.size(), 100u);
+  EXPECT_TRUE(std::is_sorted(released.begin(), released.end()));
+  EXPECT_EQ(queue.counters().late, 0u);
+}
+
+// Without arrival times the same burst is released as it comes: late frames.
+TEST(SensorQueue, BacklogWithoutArrivalTimesGoesOutAsItComes) {
+  SensorQueue queue(SensorQueueOptions{});
+  queue.push(odometry(0.0));
+  for (int i = 1; i < 50; ++i) queue.push(odometry(0.1 * i));
+  EXPECT_EQ(queue.pop_ready(5.0).size(), 50u);
+  for (int i = 1; i < 50; ++i) queue.push(frame(0.1 * i + 0.05));
+  queue.pop_ready(5.0);
+  EXPECT_GT(queue.counters().late, 40u);
+}
+
+TEST(SensorQueue, AnArrivingStreamHoldsTheOtherUntilSilentForItsMaxDelay) {
+  SensorQueueOptions options;
+  options.odometry_max_delay_s = 0.3;
+  SensorQueue queue(options);
+  queue.push(odometry(1.0), 10.0);  // stamps lag the clock by 9 s, but it is arriving
+  queue.push(frame(1.5), 10.0);
+  EXPECT_EQ(queue.pop_ready(10.0).size(), 1u);  // the odometry; the frame waits for odometry up to 1.5
+  // The odometry came 8.9 s late: an outage; held through the recovery wait (1 s).
+  EXPECT_TRUE(queue.pop_ready(10.99).empty());
+  EXPECT_DOUBLE_EQ(queue.next_release_s(), 11.0);
+  EXPECT_EQ(queue.pop_ready(11.0).size(), 1u);
+}
+
+TEST(SensorQueue, WithoutAnOutageASilentStreamHoldsOnlyForItsMaxDelay) {
+  SensorQueueOptions options;
+  options.odometry_max_delay_s = 0.3;
+  SensorQueue queue(options);
+  queue.push(odometry(9.8), 9.95);  // on time (stamped at the start of its 0.1 s period)
+  queue.push(frame(10.0), 10.01);
+  EXPECT_EQ(queue.pop_ready(10.01).size(), 1u);
+  EXPECT_TRUE(queue.pop_ready(10.29).empty());
+  EXPECT_DOUBLE_EQ(queue.next_release_s(), 10.3);  // stamp 10.0 + 0.3
+  EXPECT_EQ(queue.pop_ready(10.3).size(), 1u);      // odometry silent for 0.3 s: it stops holding
+}
+
 }  // namespace
 }  // namespace pixyslam::slam

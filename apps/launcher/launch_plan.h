@@ -2,6 +2,7 @@
 
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pixyslam::launcher {
@@ -14,6 +15,7 @@ struct ProcessSpec {
   std::vector<std::string> command;
   double delay_s = 0.0;
   bool ends_run = false;
+  std::vector<std::pair<std::string, std::string>> environment;  // set in the child (deployment)
 };
 
 // A run as a launch file describes it (config/launch_*.yaml).

@@ -2,19 +2,27 @@
 // with a prefix, stops them all on Ctrl-C, after duration_s or when a process
 // marked ends_run finishes, then runs the after_run commands (evaluation).
 //   pixyslam_launch config/launch_sim.yaml [--run-dir DIR] [--duration S] [--input FILE]
+//                   [--deployment DEPLOY.yaml --host NAME]
 // --input defines ${input} for the launch file (e.g. the log launch_replay.yaml plays).
+// With a deployment, only the host's share of the processes runs, with the
+// deployment's DDS settings, and DDS liveliness of every process on the
+// domain is reported ([health] lines; docs/deployment.md).
 // Exit code 0 only if every process ended cleanly.
 #include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <map>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "deployment.h"
+#include "health_monitor.h"
 #include "launch_plan.h"
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/app/stop_signal.h"
@@ -41,8 +49,17 @@ std::string default_run_dir() {
 
 // Forwards output until `until` or a stop; returns false if the run must end
 // early (stop requested, or a process ended: `failed` tells whether badly).
+std::unique_ptr<launcher::HealthMonitor> health;
+
+void print_health() {
+  if (!health) return;
+  for (const std::string& event : health->take_events()) std::printf("[health] %s\n", event.c_str());
+  std::fflush(stdout);
+}
+
 bool supervise(launcher::ProcessGroup& group, Clock::time_point until, bool& failed, bool& finished) {
   while (Clock::now() < until) {
+    print_health();
     for (std::size_t i : group.poll(std::chrono::milliseconds(100))) {
       const launcher::ExitStatus& status = group.status(i);
       std::printf("[launch] %s ended: %s\n", group.spec(i).name.c_str(), status.describe().c_str());
@@ -70,6 +87,27 @@ int run(const std::string& launch_file, const app::CommandLine& args) {
       {"run_dir", std::filesystem::absolute(run_dir).string()}};
   if (args.has("input")) variables["input"] = std::filesystem::absolute(args.get("input")).string();
   launcher::LaunchPlan plan = launcher::read_launch_plan(launch_file, variables);
+  if (args.has("deployment") != args.has("host")) {
+    throw std::invalid_argument("--deployment and --host go together");
+  }
+  if (args.has("deployment")) {
+    const launcher::Deployment deployment = launcher::read_deployment(args.get("deployment"));
+    plan = launcher::plan_for_host(plan, deployment, args.get("host"));
+    // The launcher's own DDS participant (the health monitor) joins like its processes.
+    for (const auto& [name, value] : launcher::host_environment(deployment, args.get("host"))) {
+      setenv(name.c_str(), value.c_str(), 1);
+    }
+    dds::DdsOptions options;
+    const std::string profiles = variables["config_dir"] + "/dds/profiles.xml";
+    options.profiles_file = std::filesystem::exists(profiles) ? profiles : PIXYSLAM_DEFAULT_PROFILES_FILE;
+    try {
+      health = std::make_unique<launcher::HealthMonitor>(options);
+    } catch (const std::exception& e) {
+      std::printf("[launch] warning: no health monitor: %s\n", e.what());
+    }
+    std::printf("[launch] host '%s' of %s: %zu processes, %zu after the run\n", args.get("host").c_str(),
+                args.get("deployment").c_str(), plan.processes.size(), plan.after_run.size());
+  }
   plan.duration_s = args.number("duration", plan.duration_s);
   std::printf("[launch] %zu processes from %s, run folder %s%s\n", plan.processes.size(),
               launch_file.c_str(), run_dir.c_str(),
@@ -103,15 +141,19 @@ int run(const std::string& launch_file, const app::CommandLine& args) {
   std::fflush(stdout);
   group.stop_all(std::chrono::milliseconds(static_cast<long>(plan.stop_timeout_s * 1000)));
 
-  // Evaluation and the like, one after another, unless interrupted.
-  if (!app::StopSignal::requested()) {
-    for (const launcher::ProcessSpec& spec : plan.after_run) {
-      group.start(spec);
-      while (group.running(group.size() - 1) && !app::StopSignal::requested()) {
-        group.poll(std::chrono::milliseconds(100));
-      }
-      if (group.running(group.size() - 1)) group.stop_all(std::chrono::seconds(5));
-    }
+  // Evaluation and the like, one after another, also after a Ctrl-C (a run on
+  // a host without an ends_run process ends that way); a second one skips them.
+  const int signals_before = app::StopSignal::signal_count();
+  auto skipped = [&] { return signals_before > 1 || app::StopSignal::signal_count() > signals_before; };
+  if (signals_before == 1 && !plan.after_run.empty()) {
+    std::printf("[launch] after-run steps (Ctrl-C again to skip them)\n");
+    std::fflush(stdout);
+  }
+  for (const launcher::ProcessSpec& spec : plan.after_run) {
+    if (skipped()) break;
+    group.start(spec);
+    while (group.running(group.size() - 1) && !skipped()) group.poll(std::chrono::milliseconds(100));
+    if (group.running(group.size() - 1)) group.stop_all(std::chrono::seconds(5));
   }
 
   int bad = 0;
@@ -122,6 +164,9 @@ int run(const std::string& launch_file, const app::CommandLine& args) {
                 status.ok() ? "" : "  <- FAILED");
     if (!status.ok()) ++bad;
   }
+  print_health();
+  if (health) std::printf("[launch] health: %d process(es) lost on the domain during the run\n", health->lost());
+  health.reset();
   std::printf("[launch] run folder: %s\n", run_dir.c_str());
   std::fflush(stdout);
   return bad == 0 && !failed ? 0 : 1;
@@ -133,16 +178,21 @@ int main(int argc, char** argv) {
   app::StopSignal::install();
   try {
     if (argc < 2 || argv[1][0] == '-') {
-      std::fprintf(stderr, "usage: pixyslam_launch LAUNCH.yaml [--run-dir DIR] [--duration S] [--input FILE]\n");
+      std::fprintf(stderr,
+                   "usage: pixyslam_launch LAUNCH.yaml [--run-dir DIR] [--duration S] [--input FILE]\n"
+                   "                       [--deployment DEPLOY.yaml --host NAME]\n");
       return argc < 2 ? 2 : 0;
     }
     // The launch file is positional; the rest are flags.
     std::vector<char*> flags{argv[0]};
     for (int i = 2; i < argc; ++i) flags.push_back(argv[i]);
-    const app::CommandLine args(static_cast<int>(flags.size()), flags.data(), {"run-dir", "duration", "input"});
+    const app::CommandLine args(static_cast<int>(flags.size()), flags.data(), {"run-dir", "duration", "input", "deployment", "host"});
     return run(argv[1], args);
   } catch (const config::ConfigError& e) {
     std::fprintf(stderr, "pixyslam_launch: config error: %s\n", e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "pixyslam_launch: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pixyslam_launch: %s\n", e.what());

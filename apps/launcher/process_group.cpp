@@ -85,6 +85,7 @@ void ProcessGroup::start(const ProcessSpec& spec) {
     sigset_t none;
     sigemptyset(&none);
     sigprocmask(SIG_SETMASK, &none, nullptr);
+    for (const auto& [name, value] : spec.environment) setenv(name.c_str(), value.c_str(), 1);
     execv(program.c_str(), argv.data());
     std::fprintf(stderr, "cannot execute %s: %s\n", program.c_str(), std::strerror(errno));
     _exit(127);
@@ -162,22 +163,22 @@ std::vector<std::size_t> ProcessGroup::poll(std::chrono::milliseconds timeout) {
 }
 
 void ProcessGroup::stop_all(std::chrono::milliseconds timeout) {
+  // Newest first, one at a time: sources stop before the estimator, which
+  // publishes its last states before the logger (started first) stops.
   for (auto it = children_.rbegin(); it != children_.rend(); ++it) {
-    if ((*it)->running) {
-      (*it)->status.stopped_by_us = true;
-      kill(-(*it)->pid, SIGINT);
-    }
-  }
-  const auto end = std::chrono::steady_clock::now() + timeout;
-  while (any_running() && std::chrono::steady_clock::now() < end) poll(std::chrono::milliseconds(50));
-  for (auto& child : children_) {
-    if (child->running) {
-      std::fprintf(out_, "[launch] %s did not stop within %.1f s: SIGKILL\n", child->spec.name.c_str(),
+    Child& child = **it;
+    if (!child.running) continue;
+    child.status.stopped_by_us = true;
+    kill(-child.pid, SIGINT);
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    while (child.running && std::chrono::steady_clock::now() < end) poll(std::chrono::milliseconds(20));
+    if (child.running) {
+      std::fprintf(out_, "[launch] %s did not stop within %.1f s: SIGKILL\n", child.spec.name.c_str(),
                    static_cast<double>(timeout.count()) / 1000.0);
-      kill(-child->pid, SIGKILL);
+      kill(-child.pid, SIGKILL);
+      while (child.running) poll(std::chrono::milliseconds(20));
     }
   }
-  while (any_running()) poll(std::chrono::milliseconds(50));
 }
 
 bool ProcessGroup::running(std::size_t i) const { return children_.at(i)->running; }

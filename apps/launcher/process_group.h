@@ -38,7 +38,8 @@ class ProcessGroup {
   // Forwards output and reaps children for up to `timeout`; returns the indices
   // of children that ended during the call.
   std::vector<std::size_t> poll(std::chrono::milliseconds timeout);
-  // SIGINT to every running child (reverse start order), SIGKILL after timeout.
+  // Stops the running children one at a time, newest first: SIGINT, then
+  // SIGKILL if one has not exited within `timeout`.
   void stop_all(std::chrono::milliseconds timeout);
 
   std::size_t size() const { return children_.size(); }

@@ -1,6 +1,7 @@
 #include "spy_commands.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
@@ -164,26 +165,9 @@ class DiscoveryListener : public fdds::DomainParticipantListener {
 class DiscoveryParticipant {
  public:
   DiscoveryParticipant(const dds::DdsOptions& options, DiscoveryListener& listener) {
-    // Like dds::Participant: the project's TypeObjects before any discovery.
-    dds::MessageTraits<msg::Odometry>::register_type_object();
-    dds::MessageTraits<msg::LandmarkObservation>::register_type_object();
-    dds::MessageTraits<msg::MapState>::register_type_object();
-    dds::MessageTraits<msg::GroundTruth>::register_type_object();
-    auto* factory = fdds::DomainParticipantFactory::get_instance();
-    if (!options.profiles_file.empty() &&
-        factory->load_XML_profiles_file(options.profiles_file) != ReturnCode_t::RETCODE_OK) {
-      throw std::runtime_error("cannot load Fast DDS profiles file '" + options.profiles_file + "'");
-    }
-    fdds::DomainParticipantQos qos;
-    if (factory->get_participant_qos_from_profile(options.participant_profile, qos) != ReturnCode_t::RETCODE_OK) {
-      throw std::runtime_error("no participant profile '" + options.participant_profile + "' in '" +
-                               options.profiles_file + "'");
-    }
-    qos.name("pixyslam_spy");
-    participant_ = factory->create_participant(options.domain_id, qos, &listener, fdds::StatusMask::none());
-    if (participant_ == nullptr) {
-      throw std::runtime_error("cannot create DDS participant on domain " + std::to_string(options.domain_id));
-    }
+    dds::DdsOptions effective = options;
+    dds::apply_environment(effective, [](const char* n) { return std::getenv(n); });
+    participant_ = dds::create_participant(effective, "pixyslam_spy", &listener);
     publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
     subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
   }

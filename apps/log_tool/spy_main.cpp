@@ -8,7 +8,7 @@
 //   pixyslam_spy print FILE.mcap [--topic T] [--json]
 //   pixyslam_spy compare A.mcap B.mcap --topic T [--ignore F,...] [--tolerance X]
 // DDS options: --dds-config FILE (a YAML with a `dds:` mapping, e.g.
-// config/slam_estimator.yaml; default: config/dds/loopback.xml on domain 0),
+// config/slam_estimator.yaml; default: config/dds/profiles.xml on domain 0),
 // --domain N. The same program is also built as pixyslam_log (info/check).
 // Exit status: 0 ok, 1 check failed / too few samples / file unreadable,
 // 2 command-line or config error.

@@ -64,12 +64,7 @@ std::string to_yaml(const MapViewOptions& o) {
      << "  snapshot_period_s: " << o.snapshot_period_s << "\n"
      << "  snapshot_dir: '" << o.snapshot_dir << "'\n"
      << "  window: " << flag(o.window) << "\n"
-     << "dds:\n"
-     << "  domain_id: " << o.dds.domain_id << "\n"
-     << "  profiles_file: '" << o.dds.profiles_file << "'\n"
-     << "  participant_profile: " << o.dds.participant_profile << "\n"
-     << "  robot_id: " << o.dds.robot_id << "\n"
-     << "  type_information: " << flag(o.dds.type_information) << "\n";
+     << dds::to_yaml(o.dds);
   return os.str();
 }
 

@@ -16,12 +16,14 @@ std::mutex g_mutex;
 std::condition_variable g_cv;
 std::atomic<bool> g_requested{false};
 std::atomic<int> g_signal{0};
+std::atomic<int> g_count{0};
 
 void set_requested(int signal_number) {
   {
     std::lock_guard<std::mutex> lock(g_mutex);
     if (!g_requested) g_signal = signal_number;
     g_requested = true;
+    if (signal_number != 0) ++g_count;
   }
   g_cv.notify_all();
 }
@@ -55,5 +57,7 @@ bool StopSignal::wait_for(std::chrono::milliseconds timeout) {
 void StopSignal::request() { set_requested(0); }
 
 int StopSignal::signal_number() { return g_signal.load(); }
+
+int StopSignal::signal_count() { return g_count.load(); }
 
 }  // namespace pixyslam::app

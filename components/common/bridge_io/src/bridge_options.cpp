@@ -40,13 +40,4 @@ std::string to_yaml_lines(const BridgeProcessOptions& o) {
          "  status_period_s: " + yaml_number(o.status_period_s) + "\n";
 }
 
-std::string to_yaml(const dds::DdsOptions& o) {
-  return "dds:\n"
-         "  domain_id: " + std::to_string(o.domain_id) + "\n" +
-         "  profiles_file: " + yaml_quoted(o.profiles_file) + "\n" +
-         "  participant_profile: " + yaml_quoted(o.participant_profile) + "\n" +
-         "  robot_id: " + yaml_quoted(o.robot_id) + "\n" +
-         "  type_information: " + (o.type_information ? "true" : "false") + "\n";
-}
-
 }  // namespace pixyslam::bridge

@@ -2,37 +2,175 @@
 
 #include "pixyslam/dds/topics.h"
 
-#include <cerrno>
-#include <chrono>
-#include <mutex>
-#include <stdexcept>
-
+#include <arpa/inet.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <utility>
+
 #include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/log/Log.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/attributes/ServerAttributes.h>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
 
 namespace pixyslam::dds {
 
 namespace fdds = eprosima::fastdds::dds;
 
+namespace {
+
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> items;
+  std::size_t begin = 0;
+  while (begin <= text.size()) {
+    const std::size_t end = std::min(text.find(',', begin), text.size());
+    std::string item = text.substr(begin, end - begin);
+    item.erase(0, item.find_first_not_of(" \t"));
+    item.erase(item.find_last_not_of(" \t") + 1);
+    if (!item.empty()) items.push_back(item);
+    begin = end + 1;
+  }
+  return items;
+}
+
+// "ADDR:PORT" -> (ADDR, PORT); throws naming `what`.
+std::pair<std::string, std::uint16_t> split_server(const std::string& text, const std::string& what) {
+  const auto colon = text.rfind(':');
+  const std::string port_text = colon == std::string::npos ? "" : text.substr(colon + 1);
+  if (colon == std::string::npos || port_text.empty() || port_text.size() > 5 ||
+      port_text.find_first_not_of("0123456789") != std::string::npos || std::stoul(port_text) == 0 ||
+      std::stoul(port_text) > 65535) {
+    throw std::invalid_argument(what + ": '" + text + "' is not ADDR:PORT (e.g. 10.200.0.3:11811)");
+  }
+  check_ipv4(text.substr(0, colon), what);
+  return {text.substr(0, colon), static_cast<std::uint16_t>(std::stoul(port_text))};
+}
+
+std::string resolve(const std::string& path, const std::string& dir) {
+  if (path.empty() || path.front() == '/' || dir.empty()) return path;
+  return dir + "/" + path;
+}
+
+std::string yaml_list(const std::vector<std::string>& items) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + items[i];
+  return out + "]";
+}
+
+}  // namespace
+
+void check_ipv4(const std::string& text, const std::string& what) {
+  in_addr address{};
+  if (inet_pton(AF_INET, text.c_str(), &address) != 1) {
+    throw std::invalid_argument(what + ": '" + text + "' is not an IPv4 address");
+  }
+}
+
 DdsOptions read_dds_options(config::YamlReader& reader, const std::string& config_dir) {
   DdsOptions o;
   o.domain_id = static_cast<int>(reader.integer("domain_id", 0, 232, o.domain_id));
-  o.profiles_file = reader.text("profiles_file", o.profiles_file);
+  o.profiles_file = resolve(reader.text("profiles_file", o.profiles_file), config_dir);
   o.participant_profile = reader.text("participant_profile", o.participant_profile);
   o.robot_id = reader.text("robot_id", o.robot_id);
   if (o.robot_id.empty()) reader.fail("robot_id", "must not be empty");
   o.type_information = reader.boolean("type_information", o.type_information);
-  reader.finish();
-  if (!o.profiles_file.empty() && o.profiles_file.front() != '/' && !config_dir.empty()) {
-    o.profiles_file = config_dir + "/" + o.profiles_file;
+  auto addresses = [&](const char* key) {
+    std::vector<std::string> list = reader.has(key) ? reader.text_list(key) : std::vector<std::string>{};
+    for (const std::string& a : list) {
+      try {
+        check_ipv4(a, key);
+      } catch (const std::invalid_argument& e) {
+        reader.fail(key, e.what());
+      }
+    }
+    return list;
+  };
+  o.interfaces = addresses("interfaces");
+  o.initial_peers = addresses("initial_peers");
+  o.discovery_server = reader.text("discovery_server", o.discovery_server);
+  if (!o.discovery_server.empty()) {
+    try {
+      split_server(o.discovery_server, "discovery_server");
+    } catch (const std::invalid_argument& e) {
+      reader.fail("discovery_server", e.what());
+    }
   }
+  o.discovery_server_id = static_cast<int>(reader.integer("discovery_server_id", 0, 255, o.discovery_server_id));
+  o.security_dir = resolve(reader.text("security_dir", o.security_dir), config_dir);
+  reader.finish();
   return o;
+}
+
+void apply_environment(DdsOptions& o, const std::function<const char*(const char*)>& getenv) {
+  auto value = [&](const char* name) -> std::string {
+    const char* v = getenv(name);
+    return v == nullptr ? std::string() : std::string(v);
+  };
+  auto integer = [&](const char* name, int min, int max, int& out) {
+    const std::string v = value(name);
+    if (v.empty()) return;
+    if (v.size() > 3 || v.find_first_not_of("0123456789") != std::string::npos || std::stoi(v) < min ||
+        std::stoi(v) > max) {
+      throw std::invalid_argument(std::string(name) + "='" + v + "': must be an integer " + std::to_string(min) +
+                                  ".." + std::to_string(max));
+    }
+    out = std::stoi(v);
+  };
+  auto addresses = [&](const char* name, std::vector<std::string>& out) {
+    const std::string v = value(name);
+    if (v.empty()) return;
+    out = split_commas(v);
+    for (const std::string& a : out) check_ipv4(a, name);
+  };
+  integer("PIXYSLAM_DDS_DOMAIN", 0, 232, o.domain_id);
+  if (!value("PIXYSLAM_DDS_PROFILES_FILE").empty()) o.profiles_file = value("PIXYSLAM_DDS_PROFILES_FILE");
+  if (!value("PIXYSLAM_DDS_PROFILE").empty()) o.participant_profile = value("PIXYSLAM_DDS_PROFILE");
+  addresses("PIXYSLAM_DDS_INTERFACES", o.interfaces);
+  addresses("PIXYSLAM_DDS_PEERS", o.initial_peers);
+  if (!value("PIXYSLAM_DDS_SERVER").empty()) {
+    split_server(value("PIXYSLAM_DDS_SERVER"), "PIXYSLAM_DDS_SERVER");
+    o.discovery_server = value("PIXYSLAM_DDS_SERVER");
+  }
+  integer("PIXYSLAM_DDS_SERVER_ID", 0, 255, o.discovery_server_id);
+  if (!value("PIXYSLAM_DDS_SECURITY_DIR").empty()) o.security_dir = value("PIXYSLAM_DDS_SECURITY_DIR");
+  const std::string type_information = value("PIXYSLAM_DDS_TYPE_INFORMATION");
+  if (type_information == "true" || type_information == "1") {
+    o.type_information = true;
+  } else if (type_information == "false" || type_information == "0") {
+    o.type_information = false;
+  } else if (!type_information.empty()) {
+    throw std::invalid_argument("PIXYSLAM_DDS_TYPE_INFORMATION='" + type_information + "': must be true or false");
+  }
+}
+
+std::string to_yaml(const DdsOptions& o) {
+  auto quoted = [](const std::string& s) { return "'" + s + "'"; };
+  return "dds:\n"
+         "  domain_id: " + std::to_string(o.domain_id) + "\n" +
+         "  profiles_file: " + quoted(o.profiles_file) + "\n" +
+         "  participant_profile: " + quoted(o.participant_profile) + "\n" +
+         "  robot_id: " + quoted(o.robot_id) + "\n" +
+         "  type_information: " + (o.type_information ? "true" : "false") + "\n" +
+         "  interfaces: " + yaml_list(o.interfaces) + "\n" +
+         "  initial_peers: " + yaml_list(o.initial_peers) + "\n" +
+         "  discovery_server: " + quoted(o.discovery_server) + "\n" +
+         "  discovery_server_id: " + std::to_string(o.discovery_server_id) + "\n" +
+         "  security_dir: " + quoted(o.security_dir) + "\n";
 }
 
 namespace {
@@ -52,8 +190,82 @@ void register_all_type_objects() {
 
 }  // namespace
 
-Participant::Participant(const DdsOptions& options, const std::string& name) : options_(options) {
+namespace {
+
+eprosima::fastrtps::rtps::Locator_t udp_locator(const std::string& address, std::uint16_t port) {
+  eprosima::fastrtps::rtps::Locator_t locator;
+  locator.kind = LOCATOR_KIND_UDPv4;
+  eprosima::fastrtps::rtps::IPLocator::setIPv4(locator, address);
+  locator.port = port;
+  return locator;
+}
+
+// The deployment settings on top of the XML participant profile.
+void apply_deployment(const DdsOptions& o, const std::string& name, fdds::DomainParticipantQos& qos) {
+  if (!o.interfaces.empty()) {
+    // One UDPv4 transport limited to these addresses (replaces the profile's).
+    auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+    udp->interfaceWhiteList = o.interfaces;
+    udp->maxInitialPeersRange = 32;
+    qos.transport().use_builtin_transports = false;
+    qos.transport().user_transports = {udp};
+  }
+  auto& builtin = qos.wire_protocol().builtin;
+  for (const std::string& peer : o.initial_peers) builtin.initialPeersList.push_back(udp_locator(peer, 0));
+  if (!o.discovery_server.empty()) {
+    const auto [address, port] = split_server(o.discovery_server, "discovery_server");
+    eprosima::fastrtps::rtps::RemoteServerAttributes server;
+    if (!eprosima::fastrtps::rtps::get_server_client_default_guidPrefix(o.discovery_server_id, server.guidPrefix)) {
+      throw std::invalid_argument("discovery_server_id " + std::to_string(o.discovery_server_id) + " is not valid");
+    }
+    server.metatrafficUnicastLocatorList.push_back(udp_locator(address, port));
+    builtin.discovery_config.discoveryProtocol = eprosima::fastrtps::rtps::DiscoveryProtocol_t::CLIENT;
+    builtin.discovery_config.m_DiscoveryServers.push_back(server);
+  }
+  auto& properties = qos.properties().properties();
+  const bool secure_profile = std::any_of(properties.begin(), properties.end(), [](const auto& p) {
+    return p.name() == "dds.sec.auth.plugin";
+  });
+  if (secure_profile && o.security_dir.empty()) {
+    throw std::invalid_argument("participant profile '" + o.participant_profile +
+                                "' uses DDS Security: set dds.security_dir (or PIXYSLAM_DDS_SECURITY_DIR)");
+  }
+  if (!o.security_dir.empty()) {
+    const std::string dir = "file://" + std::filesystem::absolute(o.security_dir).string() + "/";
+    for (const std::string& file : std::vector<std::string>{"ca.cert.pem", "governance.p7s", "permissions.p7s",
+                                                            name + ".cert.pem",
+                                   name + ".key.pem"}) {
+      if (!std::ifstream(o.security_dir + "/" + file).good()) {
+        throw std::runtime_error("DDS security: cannot read '" + o.security_dir + "/" + file +
+                                 "' (make them with scripts/make_dds_security.sh)");
+      }
+    }
+    auto& p = properties;
+    if (!secure_profile) {
+      p.emplace_back("dds.sec.auth.plugin", "builtin.PKI-DH");
+      p.emplace_back("dds.sec.access.plugin", "builtin.Access-Permissions");
+      p.emplace_back("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
+    }
+    p.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_ca", dir + "ca.cert.pem");
+    p.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_certificate", dir + name + ".cert.pem");
+    p.emplace_back("dds.sec.auth.builtin.PKI-DH.private_key", dir + name + ".key.pem");
+    p.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions_ca", dir + "ca.cert.pem");
+    p.emplace_back("dds.sec.access.builtin.Access-Permissions.governance", dir + "governance.p7s");
+    p.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions", dir + "permissions.p7s");
+  }
+}
+
+}  // namespace
+
+fdds::DomainParticipant* create_participant(const DdsOptions& options, const std::string& name,
+                                            fdds::DomainParticipantListener* listener) {
   register_all_type_objects();
+  // Fast DDS's own log: errors by default; PIXYSLAM_DDS_LOG=warning|info for more.
+  if (const char* level = std::getenv("PIXYSLAM_DDS_LOG")) {
+    const std::string l = level;
+    if (l == "warning") fdds::Log::SetVerbosity(fdds::Log::Warning);
+    if (l == "info") fdds::Log::SetVerbosity(fdds::Log::Info);
+  }
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   if (!options.profiles_file.empty() &&
       factory->load_XML_profiles_file(options.profiles_file) != ReturnCode_t::RETCODE_OK) {
@@ -69,6 +281,7 @@ Participant::Participant(const DdsOptions& options, const std::string& name) : o
                              "'");
   }
   qos.name(name);
+  apply_deployment(options, name, qos);
   // Who this is, for inspection tools (pixyslam_spy participants): sent in discovery.
   char host[256] = {};
   if (gethostname(host, sizeof(host) - 1) != 0) host[0] = '\0';
@@ -76,16 +289,29 @@ Participant::Participant(const DdsOptions& options, const std::string& name) : o
   qos.properties().properties().emplace_back("pixyslam.host", host, true);
   qos.properties().properties().emplace_back("pixyslam.pid", std::to_string(getpid()), true);
   qos.properties().properties().emplace_back("pixyslam.process", process, true);
-  participant_ = factory->create_participant(options.domain_id, qos);
-  if (participant_ == nullptr) {
+  fdds::DomainParticipant* participant =
+      factory->create_participant(options.domain_id, qos, listener,
+                                  listener != nullptr ? fdds::StatusMask::none() : fdds::StatusMask::all());
+  if (participant == nullptr) {
     throw std::runtime_error("cannot create DDS participant '" + name + "' on domain " +
-                             std::to_string(options.domain_id));
+                             std::to_string(options.domain_id) + " with profile '" + options.participant_profile +
+                             "'" + (options.security_dir.empty() ? "" : " (check the DDS security files)"));
   }
+  return participant;
+}
+
+Participant::Participant(const DdsOptions& options, const std::string& name) : options_(options) {
+  apply_environment(options_, [](const char* n) { return std::getenv(n); });
+  if (to_yaml(options_) != to_yaml(options)) {
+    std::fprintf(stderr, "%s: DDS settings after the PIXYSLAM_DDS_* environment:\n%s", name.c_str(),
+                 to_yaml(options_).c_str());
+  }
+  participant_ = create_participant(options_, name, nullptr);
   publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
   if (publisher_ == nullptr || subscriber_ == nullptr) {
     participant_->delete_contained_entities();
-    factory->delete_participant(participant_);
+    fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
     throw std::runtime_error("cannot create DDS publisher/subscriber for '" + name + "'");
   }
 }

@@ -29,7 +29,7 @@ EncoderNodeOptions read_encoder_node_options_file(const std::string& path) {
 
 std::string to_yaml(const EncoderNodeOptions& o) {
   return encoder::to_yaml(o.encoder) + "node:\n" + bridge::to_yaml_lines(o.process) +
-         "  clock_window_s: " + bridge::yaml_number(o.clock_window_s) + "\n" + bridge::to_yaml(o.dds);
+         "  clock_window_s: " + bridge::yaml_number(o.clock_window_s) + "\n" + dds::to_yaml(o.dds);
 }
 
 }  // namespace pixyslam::encoder_node

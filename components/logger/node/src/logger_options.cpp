@@ -107,12 +107,7 @@ std::string to_yaml(const LoggerOptions& o) {
      << "  flush_period_s: " << o.flush_period_s << "\n"
      << "  fsync: " << (o.fsync ? "true" : "false") << "\n"
      << "  queue_max_bytes: " << o.queue_max_bytes << "\n"
-     << "dds:\n"
-     << "  domain_id: " << o.dds.domain_id << "\n"
-     << "  profiles_file: '" << o.dds.profiles_file << "'\n"
-     << "  participant_profile: " << o.dds.participant_profile << "\n"
-     << "  robot_id: " << o.dds.robot_id << "\n"
-     << "  type_information: " << (o.dds.type_information ? "true" : "false") << "\n";
+     << dds::to_yaml(o.dds);
   return os.str();
 }
 

@@ -77,7 +77,7 @@ std::string to_yaml(const PixyNodeOptions& o) {
   for (const auto& [signature, id] : o.pixy.signatures.entries()) {
     os << "    \"" << pixy::signature_tags(signature) << "\": " << id << "\n";
   }
-  os << bridge::to_yaml(o.dds);
+  os << dds::to_yaml(o.dds);
   return os.str();
 }
 

@@ -27,32 +27,56 @@ bool insert_sorted(std::deque<T>& queue, const T& item) {
 
 SensorQueue::SensorQueue(const SensorQueueOptions& options) : options_(options) {}
 
-void SensorQueue::push(const OdometryInput& odometry) {
+void SensorQueue::push(const OdometryInput& odometry, double arrival_s) {
   ++counters_.odometry_in;
+  odometry_arrival_s_ = std::max(odometry_arrival_s_, arrival_s);
   const double end = stamp(odometry) + std::max(0.0, odometry.period_s);
+  note_arrival(end, arrival_s, options_.odometry_max_delay_s);
   odometry_known_until_s_ = has_odometry_ ? std::max(odometry_known_until_s_, end) : end;
   has_odometry_ = true;
   if (is_late(stamp(odometry))) ++counters_.late;
   if (insert_sorted(odometry_, odometry)) ++counters_.reordered;
 }
 
-void SensorQueue::push(const ObservationInput& observation) {
+void SensorQueue::push(const ObservationInput& observation, double arrival_s) {
   ++counters_.observations_in;
+  observation_arrival_s_ = std::max(observation_arrival_s_, arrival_s);
   const double t = stamp(observation);
+  note_arrival(t, arrival_s, options_.observation_max_delay_s);
   observation_known_until_s_ = has_observation_ ? std::max(observation_known_until_s_, t) : t;
   has_observation_ = true;
   if (is_late(t)) ++counters_.late;
   if (insert_sorted(observations_, observation)) ++counters_.reordered;
 }
 
+namespace {
+
+// How far a stream is known: its stamps, and while it keeps arriving nothing
+// more; once silent for `max_delay_s` (stamps and arrivals), up to now - max delay.
+double horizon(bool has, double known_until_s, double arrival_s, double max_delay_s, double now_s,
+               bool recovering) {
+  const double waited = now_s - max_delay_s;
+  if (!has) return waited;
+  if (arrival_s >= waited || recovering) return known_until_s;
+  return std::max(known_until_s, waited);
+}
+
+}  // namespace
+
+void SensorQueue::note_arrival(double stamp_end_s, double arrival_s, double max_delay_s) {
+  if (arrival_s - stamp_end_s > max_delay_s) {
+    recovery_until_s_ = std::max(recovery_until_s_, arrival_s + options_.recovery_wait_s);
+  }
+}
+
 double SensorQueue::odometry_horizon_s(double now_s) const {
-  const double waited = now_s - options_.odometry_max_delay_s;
-  return has_odometry_ ? std::max(odometry_known_until_s_, waited) : waited;
+  return horizon(has_odometry_, odometry_known_until_s_, odometry_arrival_s_, options_.odometry_max_delay_s, now_s,
+                 now_s < recovery_until_s_);
 }
 
 double SensorQueue::observation_horizon_s(double now_s) const {
-  const double waited = now_s - options_.observation_max_delay_s;
-  return has_observation_ ? std::max(observation_known_until_s_, waited) : waited;
+  return horizon(has_observation_, observation_known_until_s_, observation_arrival_s_,
+                 options_.observation_max_delay_s, now_s, now_s < recovery_until_s_);
 }
 
 std::vector<SensorInput> SensorQueue::pop_ready(double now_s) {
@@ -88,11 +112,16 @@ std::vector<SensorInput> SensorQueue::pop_all() {
 
 double SensorQueue::next_release_s() const {
   double t = kNever;
+  // Held back by the other stream: until it has been silent for its max delay.
   if (!odometry_.empty()) {
-    t = std::min(t, stamp(odometry_.front()) + options_.observation_max_delay_s);
+    t = std::min(t, std::max(std::max(stamp(odometry_.front()), observation_arrival_s_) +
+                                 options_.observation_max_delay_s,
+                             recovery_until_s_));
   }
   if (!observations_.empty()) {
-    t = std::min(t, stamp(observations_.front()) + options_.odometry_max_delay_s);
+    t = std::min(t, std::max(std::max(stamp(observations_.front()), odometry_arrival_s_) +
+                                 options_.odometry_max_delay_s,
+                             recovery_until_s_));
   }
   return t;
 }

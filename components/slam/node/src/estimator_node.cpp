@@ -106,11 +106,14 @@ void EstimatorNode::filter_loop() {
           epoch_ns_ = stamp;
           has_epoch_ = true;
         }
+        const double arrival_s =
+            static_cast<double>(static_cast<std::int64_t>(dds::now_ns() - epoch_ns_)) * 1e-9;
         if (const auto* odometry = std::get_if<msg::Odometry>(&item)) {
-          queue_.push(to_odometry_input(*odometry, epoch_ns_));
+          queue_.push(to_odometry_input(*odometry, epoch_ns_), arrival_s);
         } else {
           queue_.push(to_observation_input(std::get<msg::LandmarkObservation>(item), epoch_ns_,
-                                           options_.use_detection_sigmas));
+                                           options_.use_detection_sigmas),
+                      arrival_s);
         }
       }
       batch.clear();

@@ -18,6 +18,8 @@ class StopSignal {
   static void request();
   // The signal that requested the stop (0 if none or request()).
   static int signal_number();
+  // How many SIGINT/SIGTERM arrived so far (a second one can mean "really stop").
+  static int signal_count();
 };
 
 }  // namespace pixyslam::app

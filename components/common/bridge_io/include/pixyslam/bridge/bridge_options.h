@@ -36,7 +36,5 @@ using config::yaml_quoted;
 
 // reopen_period_s and status_period_s as lines of a `node:` mapping (two-space indent).
 std::string to_yaml_lines(const BridgeProcessOptions& options);
-// The options as a `dds:` mapping, as read_dds_options() reads it.
-std::string to_yaml(const dds::DdsOptions& options);
 
 }  // namespace pixyslam::bridge

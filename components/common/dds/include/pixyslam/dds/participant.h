@@ -1,15 +1,18 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "pixyslam/config/yaml_reader.h"
 
 namespace eprosima::fastdds::dds {
 class DomainParticipant;
+class DomainParticipantListener;
 class Publisher;
 class Subscriber;
 class Topic;
@@ -18,21 +21,55 @@ class TypeSupport;
 
 namespace pixyslam::dds {
 
-// How a process joins the DDS system. QoS and transports come from a Fast DDS
-// XML profiles file; the shipped default (config/dds/loopback.xml) keeps all
-// traffic on 127.0.0.1.
+// How a process joins the DDS system. QoS per topic and the participant
+// profiles of each deployment (loopback, lan_multicast, lan_peers,
+// discovery_client, secure) live in one Fast DDS XML file (config/dds/profiles.xml);
+// the addresses of a deployment are settings applied on top of the profile
+// (docs/deployment.md). The default keeps all traffic on 127.0.0.1.
 struct DdsOptions {
   int domain_id = 0;
   std::string profiles_file;  // XML; relative paths are resolved against the YAML file's folder
-  std::string participant_profile = "pixyslam_participant";
+  std::string participant_profile = "loopback";
   std::string robot_id = "robot1";  // written into every message header
   bool type_information = true;     // announce XTypes type information (generic tools);
                                     // off for readers of other vendors (see README)
+  std::vector<std::string> interfaces;     // IPv4 addresses DDS may use on this host (whitelist);
+                                           // empty: the profile's choice
+  std::vector<std::string> initial_peers;  // IPv4 addresses of other hosts, for unicast discovery
+  std::string discovery_server;            // "ADDR:PORT" of a `fastdds discovery` server: be its client
+  int discovery_server_id = 0;             // that server's `-i`
+  std::string security_dir;  // DDS Security: ca.cert.pem, governance.p7s, permissions.p7s and
+                             // <participant name>.cert.pem / .key.pem (scripts/make_dds_security.sh)
 };
 
 // Reads a `dds:` mapping (all keys optional) and calls reader.finish().
-// `config_dir` resolves a relative profiles_file. Throws config::ConfigError.
+// `config_dir` resolves a relative profiles_file and security_dir. Throws config::ConfigError.
 DdsOptions read_dds_options(config::YamlReader& reader, const std::string& config_dir);
+
+// Deployment overrides from the environment, for every process of a host at
+// once (the per-host launcher and containers set them): PIXYSLAM_DDS_DOMAIN,
+// PIXYSLAM_DDS_PROFILES_FILE, PIXYSLAM_DDS_PROFILE, PIXYSLAM_DDS_INTERFACES and
+// PIXYSLAM_DDS_PEERS (comma-separated IPv4), PIXYSLAM_DDS_SERVER (ADDR:PORT),
+// PIXYSLAM_DDS_SERVER_ID, PIXYSLAM_DDS_SECURITY_DIR, PIXYSLAM_DDS_TYPE_INFORMATION
+// (true/false). Unset or empty variables
+// change nothing. Throws std::invalid_argument naming the variable and value.
+void apply_environment(DdsOptions& options, const std::function<const char*(const char*)>& getenv);
+
+// Throws std::invalid_argument naming `what` unless `text` is a dotted IPv4 address.
+void check_ipv4(const std::string& text, const std::string& what);
+
+// The options as a `dds:` YAML block (effective-configuration printouts).
+std::string to_yaml(const DdsOptions& options);
+
+
+// Creates a DomainParticipant named `name` from the options' XML participant
+// profile (loaded first), the environment overrides and the deployment
+// settings, announcing pixyslam.host/pid/process properties for inspection.
+// `listener` (may be null) is attached from creation, for discovery callbacks
+// only (a listener set afterwards misses the first announcements). Throws
+// std::runtime_error / std::invalid_argument naming the file, profile, setting.
+eprosima::fastdds::dds::DomainParticipant* create_participant(const DdsOptions& options, const std::string& name,
+                                                              eprosima::fastdds::dds::DomainParticipantListener* listener);
 
 // A DomainParticipant created from the options' XML profile, with one publisher
 // and one subscriber, and the topics created so far (one per name). The profile

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <variant>
 #include <vector>
 
@@ -30,6 +31,11 @@ using SensorInput = std::variant<OdometryInput, ObservationInput>;
 struct SensorQueueOptions {
   double odometry_max_delay_s = 0.3;
   double observation_max_delay_s = 0.05;
+  // After an outage (a sample arriving later than its stream's max delay after
+  // its stamp), a silent stream still holds the other back this long: the
+  // streams' backlogs come back at different times (reliable DDS resends on
+  // its heartbeat), and are merged in stamp order if both arrive within it.
+  double recovery_wait_s = 1.0;
 };
 
 struct SensorQueueCounters {
@@ -45,16 +51,20 @@ struct SensorQueueCounters {
 // the filter (cartographer's OrderedMultiQueue, for two live streams). A sample
 // stamped t is released once neither stream can still deliver something older:
 // the odometry stream is known up to (last stamp + period), the camera stream
-// up to its last stamp, and a stream silent for longer than its max delay no
-// longer holds the other back. At equal stamps odometry goes first (a frame at
-// t uses the control that starts at t). Times are seconds on the stamps' clock;
-// `now_s` is the wall clock on the same clock, passed in. Thread-compatible.
+// up to its last stamp. A stream holds the other back while it keeps arriving
+// (its last arrival within its max delay), however far its stamps lag, so a
+// backlog delivered after a network outage is merged in stamp order; a stream
+// silent for longer than its max delay, in stamps and in arrivals, no longer
+// holds the other back, except during the recovery wait after an outage. At equal stamps odometry goes first (a frame at t uses
+// the control that starts at t). Times are seconds on the stamps' clock; `now_s`
+// and `arrival_s` are the wall clock on the same clock, passed in (an unknown
+// arrival, -infinity, counts as long ago). Thread-compatible.
 class SensorQueue {
  public:
   explicit SensorQueue(const SensorQueueOptions& options);
 
-  void push(const OdometryInput& odometry);
-  void push(const ObservationInput& observation);
+  void push(const OdometryInput& odometry, double arrival_s = -std::numeric_limits<double>::infinity());
+  void push(const ObservationInput& observation, double arrival_s = -std::numeric_limits<double>::infinity());
 
   // Samples that may go to the filter now, oldest first.
   std::vector<SensorInput> pop_ready(double now_s);
@@ -70,6 +80,7 @@ class SensorQueue {
  private:
   double odometry_horizon_s(double now_s) const;
   double observation_horizon_s(double now_s) const;
+  void note_arrival(double stamp_end_s, double arrival_s, double max_delay_s);
   bool is_late(double t_s) const { return has_released_ && t_s < released_until_s_; }
 
   SensorQueueOptions options_;
@@ -77,8 +88,11 @@ class SensorQueue {
   std::deque<ObservationInput> observations_;  // sorted by stamp
   bool has_odometry_ = false;
   double odometry_known_until_s_ = 0.0;
+  double odometry_arrival_s_ = -std::numeric_limits<double>::infinity();
   bool has_observation_ = false;
   double observation_known_until_s_ = 0.0;
+  double observation_arrival_s_ = -std::numeric_limits<double>::infinity();
+  double recovery_until_s_ = -std::numeric_limits<double>::infinity();
   bool has_released_ = false;
   double released_until_s_ = 0.0;
   SensorQueueCounters counters_;
