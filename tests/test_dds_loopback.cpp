@@ -7,6 +7,10 @@
 #include <thread>
 #include <vector>
 
+#include <map>
+#include <utility>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "pixyslam/dds/endpoints.h"
@@ -117,6 +121,102 @@ TEST(DdsOptions, OutOfRangeDomainNamesTheKey) {
     FAIL() << "expected an error";
   } catch (const config::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("dds.domain_id"), std::string::npos) << e.what();
+  }
+}
+
+// Deployment settings: YAML keys, environment overrides, and their errors.
+TEST(DdsOptions, ReadsDeploymentKeys) {
+  auto reader = config::YamlReader::from_string(
+      "dds:\n  participant_profile: lan_peers\n  interfaces: [10.200.0.1]\n"
+      "  initial_peers: [10.200.0.1, 10.200.0.2]\n  discovery_server: 10.200.0.3:11811\n"
+      "  discovery_server_id: 2\n  security_dir: sec\n",
+      "test.yaml");
+  auto dds = reader.child("dds");
+  const DdsOptions o = read_dds_options(dds, "/etc/pixyslam");
+  EXPECT_EQ(o.participant_profile, "lan_peers");
+  EXPECT_EQ(o.interfaces, std::vector<std::string>{"10.200.0.1"});
+  EXPECT_EQ(o.initial_peers.size(), 2u);
+  EXPECT_EQ(o.discovery_server, "10.200.0.3:11811");
+  EXPECT_EQ(o.discovery_server_id, 2);
+  EXPECT_EQ(o.security_dir, "/etc/pixyslam/sec");
+}
+
+TEST(DdsOptions, BadAddressesNameTheKey) {
+  for (const char* text : {"dds:\n  interfaces: [10.200.0]\n", "dds:\n  initial_peers: [robot.local]\n",
+                           "dds:\n  discovery_server: 10.200.0.3\n", "dds:\n  discovery_server: 10.0.0.1:70000\n"}) {
+    auto reader = config::YamlReader::from_string(text, "test.yaml");
+    auto dds = reader.child("dds");
+    try {
+      read_dds_options(dds, "");
+      ADD_FAILURE() << "expected an error for " << text;
+    } catch (const config::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("test.yaml"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("dds."), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(DdsOptions, EnvironmentOverridesEachSetting) {
+  const std::map<std::string, std::string> env{{"PIXYSLAM_DDS_DOMAIN", "42"},
+                                               {"PIXYSLAM_DDS_PROFILE", "secure"},
+                                               {"PIXYSLAM_DDS_INTERFACES", "10.1.0.1"},
+                                               {"PIXYSLAM_DDS_PEERS", "10.1.0.1, 10.1.0.2"},
+                                               {"PIXYSLAM_DDS_SERVER", "10.1.0.3:11811"},
+                                               {"PIXYSLAM_DDS_SERVER_ID", "1"},
+                                               {"PIXYSLAM_DDS_SECURITY_DIR", "/sec"},
+                                               {"PIXYSLAM_DDS_TYPE_INFORMATION", "false"}};
+  auto lookup = [&](const char* name) -> const char* {
+    const auto it = env.find(name);
+    return it == env.end() ? nullptr : it->second.c_str();
+  };
+  DdsOptions o;
+  apply_environment(o, lookup);
+  EXPECT_EQ(o.domain_id, 42);
+  EXPECT_EQ(o.participant_profile, "secure");
+  EXPECT_EQ(o.interfaces, std::vector<std::string>{"10.1.0.1"});
+  EXPECT_EQ(o.initial_peers, (std::vector<std::string>{"10.1.0.1", "10.1.0.2"}));
+  EXPECT_EQ(o.discovery_server, "10.1.0.3:11811");
+  EXPECT_EQ(o.discovery_server_id, 1);
+  EXPECT_EQ(o.security_dir, "/sec");
+  EXPECT_FALSE(o.type_information);
+  // Nothing set: nothing changes.
+  DdsOptions unchanged;
+  apply_environment(unchanged, [](const char*) -> const char* { return nullptr; });
+  EXPECT_EQ(to_yaml(unchanged), to_yaml(DdsOptions{}));
+}
+
+TEST(DdsOptions, BadEnvironmentNamesTheVariable) {
+  for (const auto& [name, value] : std::vector<std::pair<std::string, std::string>>{
+           {"PIXYSLAM_DDS_DOMAIN", "300"},
+           {"PIXYSLAM_DDS_PEERS", "10.0.0.1,nope"},
+           {"PIXYSLAM_DDS_SERVER", "10.0.0.1"},
+           {"PIXYSLAM_DDS_TYPE_INFORMATION", "maybe"}}) {
+    DdsOptions o;
+    try {
+      apply_environment(o, [&](const char* n) { return n == name ? value.c_str() : nullptr; });
+      ADD_FAILURE() << "expected an error for " << name;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(DdsLoopback, SecureProfileWithoutSecurityFilesIsRefused) {
+  DdsOptions o = loopback_options();
+  o.participant_profile = "secure";
+  try {
+    Participant p(o, "test");
+    FAIL() << "expected an error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("security_dir"), std::string::npos) << e.what();
+  }
+  o.security_dir = "/nonexistent_pixyslam_security";
+  try {
+    Participant p(o, "test");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent_pixyslam_security/ca.cert.pem"), std::string::npos)
+        << e.what();
   }
 }
 

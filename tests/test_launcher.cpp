@@ -5,9 +5,12 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <vector>
+#include <utility>
 
 #include <gtest/gtest.h>
 
+#include "deployment.h"
 #include "launch_plan.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "process_group.h"
@@ -132,6 +135,107 @@ TEST(ProcessGroup, MissingProgramIsNamed) {
     FAIL() << "expected an error";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("no_such_program_pixyslam"), std::string::npos);
+  }
+}
+
+// Deployments: which host runs what, with which DDS settings.
+LaunchPlan three_process_plan() {
+  LaunchPlan plan;
+  plan.processes = {{"sim", {"robot_sim"}, 0.0, true, {}},
+                    {"estimator", {"slam_estimator"}, 0.0, false, {}},
+                    {"logger", {"logger"}, 0.0, false, {}}};
+  plan.after_run = {{"check", {"pixyslam_log", "check"}, 0.0, false, {}}};
+  return plan;
+}
+
+std::string env_of(const ProcessSpec& p, const std::string& name) {
+  for (const auto& [n, v] : p.environment) {
+    if (n == name) return v;
+  }
+  return "<unset>";
+}
+
+TEST(Deployment, EachHostGetsItsProcessesAndDdsSettings) {
+  const std::string path = write_temp(
+      "deployment:\n  profile: discovery_client\n  domain_id: 5\n"
+      "  discovery_server: {host: server, port: 11900, id: 3}\n"
+      "  hosts:\n"
+      "    robot: {address: 10.0.0.1, processes: [sim]}\n"
+      "    laptop: {address: 10.0.0.2, processes: [estimator, logger, check]}\n"
+      "    server: {address: 10.0.0.3, processes: []}\n");
+  const Deployment d = read_deployment(path);
+  std::remove(path.c_str());
+  const LaunchPlan robot = plan_for_host(three_process_plan(), d, "robot");
+  ASSERT_EQ(robot.processes.size(), 1u);
+  EXPECT_EQ(robot.processes[0].name, "sim");
+  EXPECT_TRUE(robot.after_run.empty());
+  EXPECT_EQ(env_of(robot.processes[0], "PIXYSLAM_DDS_INTERFACES"), "10.0.0.1");
+  EXPECT_EQ(env_of(robot.processes[0], "PIXYSLAM_DDS_PEERS"), "10.0.0.1,10.0.0.2,10.0.0.3");
+  EXPECT_EQ(env_of(robot.processes[0], "PIXYSLAM_DDS_SERVER"), "10.0.0.3:11900");
+  EXPECT_EQ(env_of(robot.processes[0], "PIXYSLAM_DDS_SERVER_ID"), "3");
+  EXPECT_EQ(env_of(robot.processes[0], "PIXYSLAM_DDS_DOMAIN"), "5");
+  EXPECT_EQ(env_of(robot.processes[0], "PIXYSLAM_DDS_PROFILE"), "discovery_client");
+  const LaunchPlan laptop = plan_for_host(three_process_plan(), d, "laptop");
+  ASSERT_EQ(laptop.processes.size(), 2u);
+  EXPECT_EQ(laptop.processes[1].name, "logger");
+  ASSERT_EQ(laptop.after_run.size(), 1u);
+  EXPECT_EQ(env_of(laptop.after_run[0], "PIXYSLAM_DDS_INTERFACES"), "10.0.0.2");
+  // The server host runs only the discovery server, on its own address.
+  const LaunchPlan server = plan_for_host(three_process_plan(), d, "server");
+  ASSERT_EQ(server.processes.size(), 1u);
+  EXPECT_EQ(server.processes[0].command,
+            (std::vector<std::string>{"fastdds", "discovery", "-i", "3", "-l", "10.0.0.3", "-p", "11900"}));
+  EXPECT_THROW(plan_for_host(three_process_plan(), d, "nas"), std::invalid_argument);
+}
+
+TEST(Deployment, UnassignedOrUnknownProcessesAreErrors) {
+  const std::string path = write_temp(
+      "deployment:\n  hosts:\n    robot: {address: 10.0.0.1, processes: [sim, ghost]}\n"
+      "    laptop: {address: 10.0.0.2, processes: [estimator]}\n");
+  const Deployment d = read_deployment(path);
+  std::remove(path.c_str());
+  try {
+    plan_for_host(three_process_plan(), d, "robot");
+    FAIL() << "expected an error";
+  } catch (const std::invalid_argument& e) {
+    // logger and check are on no host.
+    EXPECT_NE(std::string(e.what()).find("on no host"), std::string::npos) << e.what();
+  }
+  LaunchPlan two = three_process_plan();
+  two.processes.pop_back();
+  two.after_run.clear();
+  try {
+    plan_for_host(two, d, "robot");
+    FAIL() << "expected an error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'ghost'"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Deployment, BadFilesNameTheKey) {
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"deployment:\n  hosts:\n    robot: {address: 10.0.0, processes: []}\n", "address"},
+      {"deployment:\n  hosts:\n    a: {address: 10.0.0.1, processes: [x]}\n    b: {address: 10.0.0.2, processes: [x]}\n",
+       "two hosts"},
+      {"deployment:\n  hosts:\n    a: {address: 10.0.0.1, processes: []}\n    b: {address: 10.0.0.1, processes: []}\n",
+       "used by two hosts"},
+      {"deployment:\n  profile: discovery_client\n  hosts:\n    a: {address: 10.0.0.1, processes: []}\n",
+       "discovery_server"},
+      {"deployment:\n  profile: secure\n  hosts:\n    a: {address: 10.0.0.1, processes: []}\n", "security_dir"},
+      {"deployment:\n  profile: wifi\n  hosts:\n    a: {address: 10.0.0.1, processes: []}\n", "profile"},
+      {"deployment:\n  discovery_server: {host: nas}\n  hosts:\n    a: {address: 10.0.0.1, processes: []}\n",
+       "nas"},
+  };
+  for (const auto& [text, expected] : cases) {
+    const std::string path = write_temp(text);
+    try {
+      read_deployment(path);
+      ADD_FAILURE() << "expected an error for:\n" << text;
+    } catch (const config::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+    std::remove(path.c_str());
   }
 }
 

@@ -24,6 +24,9 @@ struct Deployment {
   int discovery_server_port = 11811;
   int discovery_server_id = 0;
   std::string security_dir;  // profile secure: scripts/make_dds_security.sh output
+  // Announce XTypes type information (generic tools); "auto": yes, except with
+  // discovery_client (the 2.9 server crashes on it). Off saves bandwidth.
+  std::string type_information = "auto";
   std::vector<HostSpec> hosts;
 };
 
