@@ -11,6 +11,7 @@ PACKAGES=(
   libzstd-dev liblz4-dev
   libopencv-dev
   openssl iproute2 tcpdump
+  podman runc debootstrap
 )
 
 missing=()

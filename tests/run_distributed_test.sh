@@ -11,10 +11,14 @@
 # 5 s of the link coming back, and a capture on the robot's link shows the
 # payload in the clear (plain profiles) or never (secure; where also a
 # participant without a valid certificate must receive nothing).
+# RUNNER=podman: the same with every host a container (images from
+# docker/build_images.sh) in its namespace: hosts robot, estimator, logger
+# and viewer, one per image, sharing one run folder.
 # Needs root (ip netns); exits 77 (skip) without it. Removes all it made.
-#   run_distributed_test.sh BIN_DIR CONFIG_DIR SCRIPTS_DIR PROFILE [MAX_ATE_M]
+#   [RUNNER=podman] run_distributed_test.sh BIN_DIR CONFIG_DIR SCRIPTS_DIR PROFILE [MAX_ATE_M]
 set -euo pipefail
 bin=$1 config=$2 scripts=$3 profile=$4 max_ate=${5:-0.15}
+runner=${RUNNER:-native}
 sim_s=30 cut_at_s=12 cut_s=5
 
 if [[ $(id -u) -ne 0 ]] || ! command -v ip >/dev/null || ! ip netns list >/dev/null 2>&1; then
@@ -26,13 +30,30 @@ if command -v tcpdump >/dev/null; then capture_tool=tcpdump; elif command -v tsh
 
 tag=pxs$$
 net=$((10 + $$ % 240))
-hosts=(robot laptop server)
+if [[ $runner == podman ]]; then
+  hosts=(robot estimator logger viewer)
+  stop_order=(estimator logger viewer)  # the logger after the estimator, the final map after the log
+  log_host=logger log_addr=10.200.$net.3
+  command -v podman >/dev/null || { echo "SKIP: podman is not installed"; exit 77; }
+  export CONTAINERS_CONF=${CONTAINERS_CONF:-$scripts/../docker/containers.conf}
+  for role in robot estimator logger viewer; do
+    podman image exists "localhost/pixyslam-$role:latest" ||
+      { echo "SKIP: image pixyslam-$role missing (docker/build_images.sh)"; exit 77; }
+  done
+else
+  hosts=(robot laptop server)
+  stop_order=(laptop server)
+  log_host=laptop log_addr=10.200.$net.2
+fi
 work=$(mktemp -d /tmp/pixyslam_distributed.XXXXXX)
 pids=()
 cleanup() {
   for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
   sleep 1
   for pid in "${pids[@]}"; do kill -KILL "$pid" 2>/dev/null || true; done
+  if [[ $runner == podman ]]; then
+    for h in "${hosts[@]}"; do podman rm -f "${tag}_$h" > /dev/null 2>&1 || true; done
+  fi
   for h in "${hosts[@]}" sw; do ip netns pids "${tag}_$h" 2>/dev/null | xargs -r kill -KILL 2>/dev/null || true; done
   for h in "${hosts[@]}" sw; do ip netns del "${tag}_$h" 2>/dev/null || true; done
   rm -rf "$work"
@@ -54,7 +75,7 @@ for h in "${hosts[@]}"; do
   ip -n "${tag}_$h" link set eth0 up
   ip -n "${tag}_$h" route add 224.0.0.0/4 dev eth0
 done
-echo "namespaces ${tag}_{robot,laptop,server,sw}, network 10.200.$net.0/24, profile $profile"
+echo "namespaces ${tag}_{${hosts[*]}, sw}, network 10.200.$net.0/24, profile $profile, runner $runner"
 
 cp -r "$config" "$work/config"
 sed -i "s/^  duration_s: [0-9.]* /  duration_s: $sim_s /" "$work/config/robot_sim.yaml"
@@ -66,21 +87,39 @@ if [[ $profile == secure ]]; then
   "$scripts/make_dds_security.sh" "$work/intruder" pixyslam_spy > /dev/null  # another CA
   extra="  security_dir: $work/security"
 fi
+if [[ $runner == podman ]]; then
+  assignment="    robot:     {address: 10.200.$net.1, processes: [encoder_bridge, pixy_bridge, robot_sim]}
+    estimator: {address: 10.200.$net.2, processes: [slam_estimator]}
+    logger:    {address: 10.200.$net.3, processes: [logger, evaluator, log_check]}
+    viewer:    {address: 10.200.$net.4, processes: [map_view, final_map]}"
+else
+  assignment="    robot:  {address: 10.200.$net.1, processes: [encoder_bridge, pixy_bridge, robot_sim]}
+    laptop: {address: 10.200.$net.2, processes: [logger, slam_estimator, evaluator, map_view, log_check, final_map]}
+    server: {address: 10.200.$net.3, processes: []}"
+fi
 cat > "$work/deploy.yaml" <<EOF
 deployment:
   profile: $profile
   domain_id: 0
 $extra
   hosts:
-    robot:  {address: 10.200.$net.1, processes: [encoder_bridge, pixy_bridge, robot_sim]}
-    laptop: {address: 10.200.$net.2, processes: [logger, slam_estimator, evaluator, map_view, log_check, final_map]}
-    server: {address: 10.200.$net.3, processes: []}
+$assignment
 EOF
 
+declare -A launcher_of
 launch() {  # launch HOST: that host's share, in its namespace, in the background
-  ip netns exec "${tag}_$1" "$bin/pixyslam_launch" "$work/config/launch_sim.yaml" --deployment "$work/deploy.yaml" \
-    --host "$1" --run-dir "$work/$1" > "$work/$1.log" 2>&1 &
+  if [[ $runner == podman ]]; then
+    # One run folder for all (the viewer renders the logger's file); the
+    # container's programs are its own (/usr/local/bin).
+    podman run --rm --name "${tag}_$1" --network "ns:/run/netns/${tag}_$1" -v "$work:$work" \
+      "localhost/pixyslam-$1:latest" "$work/config/launch_sim.yaml" --deployment "$work/deploy.yaml" \
+      --host "$1" --run-dir "$work/run" > "$work/$1.log" 2>&1 &
+  else
+    ip netns exec "${tag}_$1" "$bin/pixyslam_launch" "$work/config/launch_sim.yaml" \
+      --deployment "$work/deploy.yaml" --host "$1" --run-dir "$work/$1" > "$work/$1.log" 2>&1 &
+  fi
   pids+=($!)
+  launcher_of[$1]=$!
 }
 if [[ -n $capture_tool ]]; then
   if [[ $capture_tool == tcpdump ]]; then
@@ -91,24 +130,21 @@ if [[ -n $capture_tool ]]; then
   capture=$!
   pids+=($capture)
 fi
-launch server
-server_launcher=${pids[-1]}
-launch laptop
-laptop_launcher=${pids[-1]}
+for h in "${stop_order[@]}"; do launch "$h"; done
 sleep 2
 launch robot
-robot_launcher=${pids[-1]}
+robot_launcher=${launcher_of[robot]}
 start=$(date +%s)
 
 if [[ $profile == secure ]]; then
   # Intruders on the laptop: no security at all, and certificates of another CA.
   sleep 4
-  ip netns exec "${tag}_laptop" env PIXYSLAM_DDS_PROFILE=lan_peers PIXYSLAM_DDS_INTERFACES=10.200.$net.2 \
-    PIXYSLAM_DDS_PEERS=10.200.$net.1,10.200.$net.2 \
+  ip netns exec "${tag}_$log_host" env PIXYSLAM_DDS_PROFILE=lan_peers PIXYSLAM_DDS_INTERFACES=$log_addr \
+    PIXYSLAM_DDS_PEERS=10.200.$net.1,$log_addr \
     "$bin/pixyslam_spy" echo pixyslam/odometry --count 1 --seconds 5 > "$work/intruder_plain.txt" 2>&1 &
   plain=$!
-  ip netns exec "${tag}_laptop" env PIXYSLAM_DDS_PROFILE=secure PIXYSLAM_DDS_SECURITY_DIR="$work/intruder" \
-    PIXYSLAM_DDS_INTERFACES=10.200.$net.2 PIXYSLAM_DDS_PEERS=10.200.$net.1,10.200.$net.2 \
+  ip netns exec "${tag}_$log_host" env PIXYSLAM_DDS_PROFILE=secure PIXYSLAM_DDS_SECURITY_DIR="$work/intruder" \
+    PIXYSLAM_DDS_INTERFACES=$log_addr PIXYSLAM_DDS_PEERS=10.200.$net.1,$log_addr \
     "$bin/pixyslam_spy" echo pixyslam/odometry --count 1 --seconds 5 > "$work/intruder_ca.txt" 2>&1 &
   other_ca=$!
   plain_status=0; wait "$plain" || plain_status=$?
@@ -125,19 +161,23 @@ cut_end_ns=$(date +%s%N)
 echo "link cut for $(( (cut_end_ns - cut_begin_ns) / 1000000 )) ms"
 
 robot_status=0; wait "$robot_launcher" || robot_status=$?
-sleep 4  # the last samples reach the laptop
-for pid in "${pids[@]}"; do
-  [[ $pid == "${capture:-}" || $pid == "$robot_launcher" ]] && continue
-  kill -INT "$pid" 2>/dev/null || true
+sleep 4  # the last samples reach the other hosts
+declare -A status_of
+for h in "${stop_order[@]}"; do
+  kill -INT "${launcher_of[$h]}" 2>/dev/null || true
+  status_of[$h]=0
+  wait "${launcher_of[$h]}" || status_of[$h]=$?
 done
-laptop_status=0; wait "$laptop_launcher" || laptop_status=$?
-wait "$server_launcher" || true
 if [[ -n ${capture:-} ]]; then kill -INT "$capture" 2>/dev/null || true; wait "$capture" || true; fi
 
-for h in robot laptop server; do grep -v "robot_sim: t \|status: \|^\[map_view\]   " "$work/$h.log" | sed "s/^/$h| /"; done
-fail() { echo "FAIL ($profile): $*"; exit 1; }
+for h in "${hosts[@]}"; do grep -v "robot_sim: t \|status: \|^\[map_view\]   " "$work/$h.log" | sed "s/^/$h| /"; done
+fail() { echo "FAIL ($profile, $runner): $*"; exit 1; }
 [[ $robot_status -eq 0 ]] || fail "robot launcher exited with $robot_status"
-[[ $laptop_status -eq 0 ]] || fail "laptop launcher exited with $laptop_status"
+for h in "${stop_order[@]}"; do
+  # `fastdds discovery` (2.9) may crash when stopped: the server host may fail, no other.
+  [[ ${status_of[$h]} -eq 0 || $h == server ]] || fail "$h launcher exited with ${status_of[$h]}"
+done
+if [[ $runner == podman ]]; then log="$work/run/run.mcap"; else log="$log"; fi
 
 # Every message each robot-side publisher sent is in the laptop's log (seq 1..N).
 count() { grep -oE "$1" "$work/robot.log" | tail -1 | grep -oE '[0-9]+' | head -1; }
@@ -145,12 +185,12 @@ odometry=$(count 'odometry published [0-9]+')
 observations=$(count 'observations published [0-9]+')
 truth=$(count '[0-9]+ ground truth messages')
 for n in "$odometry" "$observations" "$truth"; do [[ -n $n && $n -gt 0 ]] || fail "a publisher count is missing"; done
-"$bin/pixyslam_log" check "$work/laptop/run.mcap" --expect "pixyslam/odometry=$odometry" \
+"$bin/pixyslam_log" check "$log" --expect "pixyslam/odometry=$odometry" \
   --expect "pixyslam/landmark_observation=$observations" --expect "pixyslam/ground_truth=$truth" ||
   fail "the laptop's log does not hold every message the robot sent"
 
 # MapState after the link came back.
-first_after=$("$bin/pixyslam_log" print "$work/laptop/run.mcap" --topic pixyslam/map_state --json |
+first_after=$("$bin/pixyslam_log" print "$log" --topic pixyslam/map_state --json |
   grep -oE '"log_time_ns":[0-9]+' | grep -oE '[0-9]+' | awk -v t="$cut_end_ns" '$1 > t && !found { print $1; found = 1 }')
 [[ -n $first_after ]] || fail "no MapState after the link came back"
 resume_ms=$(( (first_after - cut_end_ns) / 1000000 ))
@@ -176,4 +216,4 @@ if [[ $profile == secure ]]; then
   [[ $plain_status -ne 0 && $ca_status -ne 0 ]] || fail "an intruder's echo did not fail"
   echo "intruders (no security; another CA): 0 samples each"
 fi
-echo "PASS ($profile)"
+echo "PASS ($profile, $runner)"
