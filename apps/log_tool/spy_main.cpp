@@ -150,14 +150,7 @@ Arguments parse(const std::string& command, const std::vector<std::string>& args
 
 pixyslam::dds::DdsOptions dds_options(const Arguments& a) {
   using namespace pixyslam;
-  dds::DdsOptions o;
-  if (a.dds_config.empty()) {
-    o.profiles_file = PIXYSLAM_DEFAULT_PROFILES_FILE;
-  } else {
-    config::YamlReader root = config::YamlReader::from_file(a.dds_config);
-    config::YamlReader dds_yaml = root.child("dds");
-    o = dds::read_dds_options(dds_yaml, app::folder_of(a.dds_config));
-  }
+  dds::DdsOptions o = dds::read_dds_options_file(a.dds_config, PIXYSLAM_DEFAULT_PROFILES_FILE);
   if (a.domain >= 0) o.domain_id = a.domain;
   return o;
 }

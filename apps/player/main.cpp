@@ -111,13 +111,7 @@ pixyslam::player::PlayerOptions parse(const std::vector<std::string>& args) {
   }
   if (o.files.empty()) throw std::invalid_argument("no MCAP file given");
   player::validate(o.playback);
-  if (dds_config.empty()) {
-    o.dds.profiles_file = PIXYSLAM_DEFAULT_PROFILES_FILE;
-  } else {
-    config::YamlReader root = config::YamlReader::from_file(dds_config);
-    config::YamlReader dds_yaml = root.child("dds");
-    o.dds = dds::read_dds_options(dds_yaml, app::folder_of(dds_config));
-  }
+  o.dds = dds::read_dds_options_file(dds_config, PIXYSLAM_DEFAULT_PROFILES_FILE);
   if (domain >= 0) o.dds.domain_id = domain;
   return o;
 }

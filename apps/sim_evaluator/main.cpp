@@ -45,10 +45,7 @@ void print_topic(const dds::Reader<Message>& reader) {
 }
 
 int run(const app::CommandLine& args) {
-  const std::string dds_config = args.get("dds-config");
-  config::YamlReader root = config::YamlReader::from_file(dds_config);
-  config::YamlReader dds_yaml = root.child("dds");
-  const dds::DdsOptions dds_options = dds::read_dds_options(dds_yaml, app::folder_of(dds_config));
+  const dds::DdsOptions dds_options = dds::read_dds_options_file(args.get("dds-config"), "");
 
   Received r;
   dds::Participant participant(dds_options, "sim_evaluator");

@@ -116,6 +116,17 @@ DdsOptions read_dds_options(config::YamlReader& reader, const std::string& confi
   return o;
 }
 
+DdsOptions read_dds_options_file(const std::string& yaml_path, const std::string& default_profiles_file) {
+  if (yaml_path.empty()) {
+    DdsOptions o;
+    o.profiles_file = default_profiles_file;
+    return o;
+  }
+  config::YamlReader root = config::YamlReader::from_file(yaml_path);
+  config::YamlReader dds = root.child("dds");
+  return read_dds_options(dds, std::filesystem::path(yaml_path).parent_path().string());
+}
+
 void apply_environment(DdsOptions& o, const std::function<const char*(const char*)>& getenv) {
   auto value = [&](const char* name) -> std::string {
     const char* v = getenv(name);

@@ -46,6 +46,11 @@ struct DdsOptions {
 // `config_dir` resolves a relative profiles_file and security_dir. Throws config::ConfigError.
 DdsOptions read_dds_options(config::YamlReader& reader, const std::string& config_dir);
 
+// The `dds:` mapping of a YAML file (a tool's --dds-config, e.g.
+// config/slam_estimator.yaml); an empty path gives the defaults with
+// `default_profiles_file`. Throws config::ConfigError naming the file and key.
+DdsOptions read_dds_options_file(const std::string& yaml_path, const std::string& default_profiles_file);
+
 // Deployment overrides from the environment, for every process of a host at
 // once (the per-host launcher and containers set them): PIXYSLAM_DDS_DOMAIN,
 // PIXYSLAM_DDS_PROFILES_FILE, PIXYSLAM_DDS_PROFILE, PIXYSLAM_DDS_INTERFACES and
