@@ -109,9 +109,10 @@ int run(const std::string& launch_file, const app::CommandLine& args) {
                 args.get("deployment").c_str(), plan.processes.size(), plan.after_run.size());
   }
   plan.duration_s = args.number("duration", plan.duration_s);
-  std::printf("[launch] %zu processes from %s, run folder %s%s\n", plan.processes.size(),
-              launch_file.c_str(), run_dir.c_str(),
-              plan.duration_s > 0 ? (", for " + std::to_string(plan.duration_s) + " s").c_str() : "");
+  char duration[48] = "";
+  if (plan.duration_s > 0) std::snprintf(duration, sizeof(duration), ", for %.1f s", plan.duration_s);
+  std::printf("[launch] %zu processes from %s, run folder %s%s\n", plan.processes.size(), launch_file.c_str(),
+              run_dir.c_str(), duration);
   std::fflush(stdout);
 
   launcher::ProcessGroup group(bin_dir, stdout);

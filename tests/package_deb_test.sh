@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# The Debian package (cpack -G DEB from this build): its control data (runtime
+# dependencies found by dpkg-shlibdeps, conffiles), its files (programs,
+# /etc/pixyslam, systemd units whose ExecStart exists in the package), and the
+# unpacked robot side running: the packaged launcher starts the packaged
+# bridges from the packaged launch_robot.yaml (no serial devices here: they
+# wait for them) and stops them cleanly. Nothing is installed on the machine.
+#   package_deb_test.sh BUILD_DIR
+set -euo pipefail
+build=$1
+command -v dpkg-deb >/dev/null || { echo "SKIP: no dpkg-deb"; exit 77; }
+work=$(mktemp -d /tmp/pixyslam_deb_test.XXXXXX)
+trap 'rm -rf "$work"' EXIT
+cpack --config "$build/CPackConfig.cmake" -G DEB -B "$work/out" > "$work/cpack.log" 2>&1 || { cat "$work/cpack.log"; exit 1; }
+deb=$(ls "$work"/out/pixyslam_*.deb)
+fail() { echo "FAIL: $*"; exit 1; }
+info=$(dpkg-deb -I "$deb")
+echo "$info" | grep -E "^ (Package|Version|Depends|Installed-Size):"
+for dep in libfastrtps2.9 libyaml-cpp0.7 libzstd1; do
+  echo "$info" | grep -q "Depends:.*$dep" || fail "Depends lacks $dep"
+done
+dpkg-deb -x "$deb" "$work/root"
+dpkg-deb -e "$deb" "$work/control"
+for f in usr/bin/slam_estimator usr/bin/encoder_bridge usr/bin/pixy_bridge usr/bin/logger usr/bin/pixyslam_launch \
+         etc/pixyslam/dds/profiles.xml etc/pixyslam/launch_robot.yaml etc/default/pixyslam \
+         usr/lib/systemd/system/pixyslam-robot.service usr/lib/systemd/system/pixyslam-station.service; do
+  [[ -e $work/root/$f ]] || fail "$f is not in the package"
+done
+grep -qx "/etc/pixyslam/slam_estimator.yaml" "$work/control/conffiles" || fail "config files are not conffiles"
+for unit in "$work"/root/usr/lib/systemd/system/*.service; do
+  exe=$(sed -n 's/^ExecStart=\([^ ]*\).*/\1/p' "$unit")
+  [[ -x $work/root$exe ]] || fail "$(basename "$unit"): ExecStart $exe is not in the package"
+  config=$(sed -n 's/^ExecStart=[^ ]* \([^ ]*\).*/\1/p' "$unit")
+  [[ -f $work/root$config ]] || fail "$(basename "$unit"): $config is not in the package"
+done
+# The robot side from the unpacked files, on a private DDS domain, for 3 s.
+domain=$((40 + $$ % 100))
+sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/root/etc/pixyslam/*.yaml
+status=0
+"$work/root/usr/bin/pixyslam_launch" "$work/root/etc/pixyslam/launch_robot.yaml" --run-dir "$work/run" \
+  --duration 3 > "$work/run.log" 2>&1 || status=$?
+grep "\[launch\]" "$work/run.log"
+[[ $status -eq 0 ]] || fail "the packaged robot side exited with $status"
+grep -q "started encoder_bridge (pid [0-9]*): $work/root/usr/bin/encoder_bridge" "$work/run.log" ||
+  fail "the launcher did not start the packaged encoder_bridge"
+echo "PASS: $(basename "$deb"), $(stat -c %s "$deb") bytes"
