@@ -43,6 +43,8 @@ if [[ ! -f $sysroot/.pixyslam_sysroot ]]; then
     > "$sysroot.log" 2>&1 || { tail -20 "$sysroot.log"; exit 1; }
   # --foreign unpacks only the base; unpack the rest (no maintainer scripts run).
   for deb in "$sysroot"/var/cache/apt/archives/*.deb; do $SUDO dpkg-deb -x "$deb" "$sysroot"; done
+  # No device nodes: qemu -L would open the sysroot's /dev/ptmx instead of the real one.
+  $SUDO rm -rf "$sysroot"/dev/* "$sysroot"/var/cache/apt/archives/*.deb
   # Debian's CMake package files name /usr/... absolutely: point them into the sysroot.
   grep -rlE '"/usr/(lib|include)|_IMPORT_PREFIX "/usr"' "$sysroot"/usr/lib/arm-linux-gnueabihf/cmake \
     "$sysroot"/usr/share/*/cmake "$sysroot"/usr/lib/cmake 2>/dev/null | while read -r f; do

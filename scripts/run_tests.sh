@@ -1,9 +1,14 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs every test (ctest). Extra arguments
-# go to ctest, e.g. scripts/run_tests.sh -L unit.
+# Installs what is missing, builds (native, and the armhf cross build whose
+# unit tests and estimator the `armhf` tests run under qemu; PIXYSLAM_ARMHF=0
+# skips it), and runs every test (ctest). Extra arguments go to ctest, e.g.
+# scripts/run_tests.sh -L unit.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/install_deps.sh"
 "$root/scripts/build.sh"
+if [[ ${PIXYSLAM_ARMHF:-1} != 0 ]]; then
+  "$root/scripts/cross_build_armhf.sh" --no-tests --build-dir "$root/build-armhf"
+fi
 build_dir=${BUILD_DIR:-$root/build}
 ctest --test-dir "$build_dir" --output-on-failure --parallel "$(nproc)" --timeout 600 "$@"

@@ -29,6 +29,7 @@ cleanup() {
   if [[ -n ${KEEP_WORK:-} ]]; then echo "kept $work"; else rm -rf "$work"; fi
 }
 trap cleanup EXIT
+trap 'exit 130' INT TERM  # a killed test still cleans up (the EXIT trap)
 
 mkdir -p "$work/npm"
 if ! (cd "$work/npm" && echo '{"private": true}' > package.json &&

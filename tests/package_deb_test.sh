@@ -11,6 +11,7 @@ build=$1
 command -v dpkg-deb >/dev/null || { echo "SKIP: no dpkg-deb"; exit 77; }
 work=$(mktemp -d /tmp/pixyslam_deb_test.XXXXXX)
 trap 'rm -rf "$work"' EXIT
+trap 'exit 130' INT TERM  # a killed test still cleans up (the EXIT trap)
 cpack --config "$build/CPackConfig.cmake" -G DEB -B "$work/out" > "$work/cpack.log" 2>&1 || { cat "$work/cpack.log"; exit 1; }
 deb=$(ls "$work"/out/pixyslam_*.deb)
 fail() { echo "FAIL: $*"; exit 1; }

@@ -59,6 +59,7 @@ cleanup() {
   rm -rf "$work"
 }
 trap cleanup EXIT
+trap 'exit 130' INT TERM  # a killed test still cleans up (the EXIT trap)
 
 # The network: one bridge, one veth per host.
 ip netns add "${tag}_sw"

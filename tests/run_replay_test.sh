@@ -9,6 +9,7 @@ set -euo pipefail
 bin=$1 config=$2 log=$3
 work=$(mktemp -d /tmp/pixyslam_replay_test.XXXXXX)
 trap 'rm -rf "$work"' EXIT
+trap 'exit 130' INT TERM  # a killed test still cleans up (the EXIT trap)
 cp -r "$config" "$work/config"
 domain=$((20 + $$ % 100))
 sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/config/*.yaml

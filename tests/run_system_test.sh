@@ -21,6 +21,7 @@ status=0
 "$bin/pixyslam_launch" "$work/config/launch_sim.yaml" --run-dir "$work/run" > "$work/out.log" 2>&1 &
 launcher=$!
 trap 'kill "$launcher" 2>/dev/null || true; rm -rf "$work"' EXIT
+trap 'exit 130' INT TERM  # a killed test still cleans up (the EXIT trap)
 # pixyslam_spy echo of every topic while the system runs: 20 samples each.
 topics=(odometry landmark_observation map_state ground_truth)
 sleep 8

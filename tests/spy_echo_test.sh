@@ -17,6 +17,7 @@ cleanup() {
   rm -rf "$work"
 }
 trap cleanup EXIT
+trap 'exit 130' INT TERM  # a killed test still cleans up (the EXIT trap)
 cp -r "$config" "$work/config"
 domain=$((20 + $$ % 100))
 sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/config/*.yaml
