@@ -122,10 +122,7 @@ int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
   const std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
-    std::fputs(kUsage, args.empty() ? stderr : stdout);
-    return args.empty() ? 2 : 0;
-  }
+  if (const auto status = app::usage_exit(args, kUsage)) return *status;
   player::PlayerOptions options;
   try {
     options = parse(args);

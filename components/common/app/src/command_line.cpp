@@ -1,5 +1,6 @@
 #include "pixyslam/app/command_line.h"
 
+#include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
 
@@ -48,6 +49,18 @@ std::string folder_of(const std::string& path) {
   const auto slash = path.find_last_of('/');
   if (slash == std::string::npos) return ".";
   return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+std::optional<int> usage_exit(const std::vector<std::string>& args, const char* usage) {
+  if (args.empty()) {
+    std::fputs(usage, stderr);
+    return 2;
+  }
+  if (args[0] == "--help" || args[0] == "-h") {
+    std::fputs(usage, stdout);
+    return 0;
+  }
+  return std::nullopt;
 }
 
 }  // namespace pixyslam::app

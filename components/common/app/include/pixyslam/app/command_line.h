@@ -1,8 +1,10 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
+#include <vector>
 
 namespace pixyslam::app {
 
@@ -24,6 +26,11 @@ class CommandLine {
   std::map<std::string, std::string> values_;
   bool help_ = false;
 };
+
+// For programs taking a subcommand or positional arguments: with no arguments
+// prints `usage` to stderr and returns 2; with --help / -h first, to stdout and
+// returns 0; otherwise returns nullopt (go on).
+std::optional<int> usage_exit(const std::vector<std::string>& args, const char* usage);
 
 // Folder of a file path ("." for a bare file name), for resolving paths that a
 // config file gives relative to itself.
