@@ -152,6 +152,19 @@ if [[ $profile == secure ]]; then
   ca_status=0; wait "$other_ca" || ca_status=$?
 fi
 
+# A process that crashes: a DDS participant on the robot, killed with SIGKILL
+# after the link cut; the other hosts' launchers must report it LOST.
+robot_env=(PIXYSLAM_DDS_PROFILE=$profile PIXYSLAM_DDS_INTERFACES=10.200.$net.1
+           "PIXYSLAM_DDS_PEERS=$(grep -oE '10\.200\.[0-9]+\.[0-9]+' "$work/deploy.yaml" | paste -sd,)")
+if [[ $profile == discovery_client ]]; then
+  robot_env+=(PIXYSLAM_DDS_SERVER=10.200.$net.3:11811 PIXYSLAM_DDS_TYPE_INFORMATION=false)
+fi
+if [[ $profile == secure ]]; then robot_env+=(PIXYSLAM_DDS_SECURITY_DIR=$work/security); fi
+ip netns exec "${tag}_robot" env "${robot_env[@]}" "$bin/pixyslam_spy" hz pixyslam/odometry --seconds 60 \
+  > "$work/doomed.log" 2>&1 &
+doomed=$!
+pids+=($doomed)
+
 # Cut the robot's link for cut_s seconds.
 sleep $((cut_at_s - ($(date +%s) - start)))
 ip -n "${tag}_sw" link set v_robot down
@@ -160,6 +173,8 @@ sleep "$cut_s"
 ip -n "${tag}_sw" link set v_robot up
 cut_end_ns=$(date +%s%N)
 echo "link cut for $(( (cut_end_ns - cut_begin_ns) / 1000000 )) ms"
+sleep 1
+kill -KILL "$doomed" 2>/dev/null || true
 
 robot_status=0; wait "$robot_launcher" || robot_status=$?
 sleep 4  # the last samples reach the other hosts
@@ -211,6 +226,12 @@ if [[ -n $capture_tool ]]; then
 else
   echo "no tcpdump/tshark: traffic capture not checked"
 fi
+# Health: the robot's processes seen from the log host, and the killed one LOST.
+grep -qE "^\[health\] encoder_bridge@.*: joined" "$work/$log_host.log" || fail "no health report of the robot's encoder_bridge"
+grep -qE "^\[health\] encoder_bridge@.*: left" "$work/$log_host.log" || fail "the robot's encoder_bridge stopping was not reported"
+grep -qE "^\[health\] pixyslam_spy@.* pid $doomed: LOST" "$work/$log_host.log" ||
+  fail "the killed process on the robot was not reported LOST"
+echo "health: $(grep -cE '^\[health\]' "$work/$log_host.log") reports on $log_host, the killed robot process LOST"
 if [[ $profile == secure ]]; then
   grep -q "seq:" "$work/intruder_plain.txt" && fail "a participant without security received samples"
   grep -q "seq:" "$work/intruder_ca.txt" && fail "a participant with another CA's certificate received samples"
