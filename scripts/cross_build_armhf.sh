@@ -38,6 +38,7 @@ if [[ ! -f $sysroot/.pixyslam_sysroot ]]; then
     grep -v security | head -1 | awk '{print $2}' || true)
   mirror=${mirror:-http://deb.debian.org/debian}
   rm -rf "$sysroot"
+  mkdir -p "$(dirname "$sysroot")"
   echo "cross_build_armhf: armhf sysroot from $mirror (~40 s)"
   $SUDO debootstrap --arch=armhf --foreign --variant=minbase --include="$packages" bookworm "$sysroot" "$mirror" \
     > "$sysroot.log" 2>&1 || { tail -20 "$sysroot.log"; exit 1; }
@@ -46,8 +47,8 @@ if [[ ! -f $sysroot/.pixyslam_sysroot ]]; then
   # No device nodes: qemu -L would open the sysroot's /dev/ptmx instead of the real one.
   $SUDO rm -rf "$sysroot"/dev/* "$sysroot"/var/cache/apt/archives/*.deb
   # Debian's CMake package files name /usr/... absolutely: point them into the sysroot.
-  grep -rlE '"/usr/(lib|include)|_IMPORT_PREFIX "/usr"' "$sysroot"/usr/lib/arm-linux-gnueabihf/cmake \
-    "$sysroot"/usr/share/*/cmake "$sysroot"/usr/lib/cmake 2>/dev/null | while read -r f; do
+  { grep -rlE '"/usr/(lib|include)|_IMPORT_PREFIX "/usr"' "$sysroot"/usr/lib/arm-linux-gnueabihf/cmake \
+      "$sysroot"/usr/share/*/cmake "$sysroot"/usr/lib/cmake 2>/dev/null || true; } | while read -r f; do
     $SUDO sed -i -E "s#\"/usr/(lib|include)#\"$sysroot/usr/\1#g; s#_IMPORT_PREFIX \"/usr\"#_IMPORT_PREFIX \"$sysroot/usr\"#g" "$f"
   done
   $SUDO touch "$sysroot/.pixyslam_sysroot"
