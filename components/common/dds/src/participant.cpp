@@ -211,8 +211,10 @@ eprosima::fastrtps::rtps::Locator_t udp_locator(const std::string& address, std:
   return locator;
 }
 
-// The deployment settings on top of the XML participant profile.
-void apply_deployment(const DdsOptions& o, const std::string& name, fdds::DomainParticipantQos& qos) {
+// The deployment settings on top of the XML participant profile. An
+// `observer` (watching discovery) of a discovery server is a SUPER_CLIENT: a
+// plain client only learns the participants its own endpoints match.
+void apply_deployment(const DdsOptions& o, const std::string& name, bool observer, fdds::DomainParticipantQos& qos) {
   if (!o.interfaces.empty()) {
     // One UDPv4 transport limited to these addresses (replaces the profile's).
     auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
@@ -230,7 +232,8 @@ void apply_deployment(const DdsOptions& o, const std::string& name, fdds::Domain
       throw std::invalid_argument("discovery_server_id " + std::to_string(o.discovery_server_id) + " is not valid");
     }
     server.metatrafficUnicastLocatorList.push_back(udp_locator(address, port));
-    builtin.discovery_config.discoveryProtocol = eprosima::fastrtps::rtps::DiscoveryProtocol_t::CLIENT;
+    builtin.discovery_config.discoveryProtocol = observer ? eprosima::fastrtps::rtps::DiscoveryProtocol_t::SUPER_CLIENT
+                                                          : eprosima::fastrtps::rtps::DiscoveryProtocol_t::CLIENT;
     builtin.discovery_config.m_DiscoveryServers.push_back(server);
   }
   auto& properties = qos.properties().properties();
@@ -292,7 +295,7 @@ fdds::DomainParticipant* create_participant(const DdsOptions& options, const std
                              "'");
   }
   qos.name(name);
-  apply_deployment(options, name, qos);
+  apply_deployment(options, name, listener != nullptr, qos);
   // Who this is, for inspection tools (pixyslam_spy participants): sent in discovery.
   char host[256] = {};
   if (gethostname(host, sizeof(host) - 1) != 0) host[0] = '\0';

@@ -71,7 +71,9 @@ std::string to_yaml(const DdsOptions& options);
 // profile (loaded first), the environment overrides and the deployment
 // settings, announcing pixyslam.host/pid/process properties for inspection.
 // `listener` (may be null) is attached from creation, for discovery callbacks
-// only (a listener set afterwards misses the first announcements). Throws
+// only (a listener set afterwards misses the first announcements); with one,
+// a discovery-server client is a super client that learns every participant
+// (inspection, health), not only those its endpoints match. Throws
 // std::runtime_error / std::invalid_argument naming the file, profile, setting.
 eprosima::fastdds::dds::DomainParticipant* create_participant(const DdsOptions& options, const std::string& name,
                                                               eprosima::fastdds::dds::DomainParticipantListener* listener);
