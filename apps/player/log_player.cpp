@@ -206,7 +206,9 @@ std::vector<TopicReport> LogPlayer::play() {
       }
     }
     if (stopped || !options_.playback.loop) break;
-    stopped = !sleep_until(start + std::chrono::nanoseconds(pass.span_ns));
+    // A window of one instant (a single message) repeats once a second, not in a busy loop.
+    const std::int64_t loop_period_ns = pass.span_ns > 0 ? pass.span_ns : 1000000000;
+    stopped = !sleep_until(start + std::chrono::nanoseconds(loop_period_ns));
   }
 
   for (const auto& channel : channels_) {
