@@ -19,12 +19,14 @@
 #include <iostream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "log_commands.h"
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/config/yaml_text.h"
 #include "spy_commands.h"
 
 #ifndef PIXYSLAM_DEFAULT_PROFILES_FILE
@@ -121,10 +123,8 @@ Arguments parse(const std::string& command, const std::vector<std::string>& args
     } else if (command == "compare" && arg == "--topic") {
       a.compare.topic = value();
     } else if (command == "compare" && arg == "--ignore") {
-      const std::string& list = value();
-      for (std::size_t begin = 0, end = 0; begin <= list.size(); begin = end + 1) {
-        end = std::min(list.find(',', begin), list.size());
-        if (end > begin) a.compare.ignored.push_back(list.substr(begin, end - begin));
+      for (std::string& field : pixyslam::config::split_comma_list(value())) {
+        a.compare.ignored.push_back(std::move(field));
       }
     } else if (command == "compare" && arg == "--tolerance") {
       a.compare.tolerance = non_negative_number(arg, value());

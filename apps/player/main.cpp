@@ -15,6 +15,7 @@
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/config/yaml_text.h"
 
 #ifndef PIXYSLAM_DEFAULT_PROFILES_FILE
 #define PIXYSLAM_DEFAULT_PROFILES_FILE ""
@@ -57,17 +58,6 @@ int integer(const std::string& flag, const std::string& text, int min, int max) 
   return static_cast<int>(v);
 }
 
-std::vector<std::string> split_list(const std::string& text) {
-  std::vector<std::string> items;
-  std::size_t begin = 0;
-  while (begin <= text.size()) {
-    const std::size_t end = std::min(text.find(',', begin), text.size());
-    if (end > begin) items.push_back(text.substr(begin, end - begin));
-    begin = end + 1;
-  }
-  return items;
-}
-
 pixyslam::player::PlayerOptions parse(const std::vector<std::string>& args) {
   using namespace pixyslam;
   player::PlayerOptions o;
@@ -88,7 +78,7 @@ pixyslam::player::PlayerOptions parse(const std::vector<std::string>& args) {
     } else if (arg == "--loop") {
       o.playback.loop = true;
     } else if (arg == "--topics") {
-      o.topics = split_list(value());
+      o.topics = config::split_comma_list(value());
       if (o.topics.empty()) throw std::invalid_argument("--topics needs at least one topic");
     } else if (arg == "--restamp") {
       o.restamp = true;

@@ -1,5 +1,6 @@
 #include "pixyslam/dds/participant.h"
 
+#include "pixyslam/config/yaml_text.h"
 #include "pixyslam/dds/topics.h"
 
 #include <arpa/inet.h>
@@ -33,20 +34,6 @@ namespace pixyslam::dds {
 namespace fdds = eprosima::fastdds::dds;
 
 namespace {
-
-std::vector<std::string> split_commas(const std::string& text) {
-  std::vector<std::string> items;
-  std::size_t begin = 0;
-  while (begin <= text.size()) {
-    const std::size_t end = std::min(text.find(',', begin), text.size());
-    std::string item = text.substr(begin, end - begin);
-    item.erase(0, item.find_first_not_of(" \t"));
-    item.erase(item.find_last_not_of(" \t") + 1);
-    if (!item.empty()) items.push_back(item);
-    begin = end + 1;
-  }
-  return items;
-}
 
 // "ADDR:PORT" -> (ADDR, PORT); throws naming `what`.
 std::pair<std::string, std::uint16_t> split_server(const std::string& text, const std::string& what) {
@@ -145,7 +132,7 @@ void apply_environment(DdsOptions& o, const std::function<const char*(const char
   auto addresses = [&](const char* name, std::vector<std::string>& out) {
     const std::string v = value(name);
     if (v.empty()) return;
-    out = split_commas(v);
+    out = config::split_comma_list(v);
     for (const std::string& a : out) check_ipv4(a, name);
   };
   integer("PIXYSLAM_DDS_DOMAIN", 0, 232, o.domain_id);
