@@ -64,7 +64,14 @@ TEST(SlamOptionsYaml, FullConfigRoundTripsEveryValue) {
       "    readmit_after: 7\n"
       "  resample:\n"
       "    mode: every_frame\n"
-      "    neff_fraction: 0.4\n");
+      "    neff_fraction: 0.4\n"
+      "  delayed_sampling:\n"
+      "    enabled: true\n"
+      "    enter_heading_sigma_rad: 0.2\n"
+      "    enter_position_sigma_m: 0.4\n"
+      "    exit_heading_sigma_rad: 0.03\n"
+      "    exit_position_sigma_m: 0.07\n"
+      "    max_landmarks: 24\n");
   // then each value arrives in its field.
   const FilterOptions d;
   EXPECT_EQ(o.particles, 321);
@@ -87,6 +94,13 @@ TEST(SlamOptionsYaml, FullConfigRoundTripsEveryValue) {
   EXPECT_EQ(o.resample_mode, ResampleMode::kEveryFrame);
   EXPECT_NE(o.resample_mode, d.resample_mode);
   EXPECT_DOUBLE_EQ(o.resample_neff_fraction, 0.4);
+  EXPECT_TRUE(o.delayed_sampling.enabled);
+  EXPECT_NE(o.delayed_sampling.enabled, d.delayed_sampling.enabled);
+  EXPECT_DOUBLE_EQ(o.delayed_sampling.enter_heading_sigma_rad, 0.2);
+  EXPECT_DOUBLE_EQ(o.delayed_sampling.enter_position_sigma_m, 0.4);
+  EXPECT_DOUBLE_EQ(o.delayed_sampling.exit_heading_sigma_rad, 0.03);
+  EXPECT_DOUBLE_EQ(o.delayed_sampling.exit_position_sigma_m, 0.07);
+  EXPECT_EQ(o.delayed_sampling.max_landmarks, 24);
   EXPECT_NO_THROW(validate(o));
 }
 
@@ -161,6 +175,14 @@ TEST(SlamOptionsYaml, CrossFieldViolationIsAConfigErrorNamingTheField) {
   const std::string m = error_of("filter:\n  observation:\n    min_range_m: 5\n    max_range_m: 2\n");
   EXPECT_TRUE(contains(m, kOrigin)) << m;
   EXPECT_TRUE(contains(m, "max_range_m")) << m;
+}
+
+TEST(SlamOptionsYaml, ExitAboveEnterIsAConfigErrorNamingTheField) {
+  const std::string m = error_of(
+      "filter:\n  delayed_sampling:\n    enter_heading_sigma_rad: 0.1\n    exit_heading_sigma_rad: 0.2\n");
+  EXPECT_TRUE(contains(m, kOrigin)) << m;
+  EXPECT_TRUE(contains(m, "delayed_sampling.exit_heading_sigma_rad")) << m;
+  EXPECT_TRUE(contains(m, "enter_heading_sigma_rad")) << m;
 }
 
 TEST(SlamOptionsYaml, BadResampleModeListsAllowedValues) {

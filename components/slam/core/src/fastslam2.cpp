@@ -28,13 +28,22 @@ Pose2 sample_pose(const PoseGaussian& g, std::mt19937_64& rng) {
   return x;
 }
 
+// Whether a pose covariance exceeds a heading sd or a position sd (worst direction).
+bool exceeds(const Eigen::Matrix3d& cov, double heading_sigma, double position_sigma) {
+  if (cov(2, 2) > heading_sigma * heading_sigma) return true;
+  const double half_trace = 0.5 * (cov(0, 0) + cov(1, 1));
+  const double half_diff = 0.5 * (cov(0, 0) - cov(1, 1));
+  const double worst = half_trace + std::sqrt(half_diff * half_diff + cov(0, 1) * cov(0, 1));
+  return worst > position_sigma * position_sigma;
+}
+
 }  // namespace
 
 FastSlam2::FastSlam2(const FilterOptions& options, const Pose2& initial_pose)
     : options_(options), gate_d2_(0.0), rng_(options.seed) {
   validate(options_);
   gate_d2_ = gate_mahalanobis2(options_);
-  Particle p{PoseGaussian{initial_pose, Eigen::Matrix3d::Zero()}, 0.0, LandmarkMap(&pool_)};
+  Particle p{PoseGaussian{initial_pose, Eigen::Matrix3d::Zero()}, 0.0, LandmarkMap(&pool_), JointGaussian{}};
   p.pose.mean.z() = wrap_angle(p.pose.mean.z());
   particles_.assign(static_cast<std::size_t>(options_.particles), p);
 }
@@ -51,7 +60,14 @@ void FastSlam2::advance_to(double t_s) {
   const double moving_until = std::min(t_s, control_end);
   if (moving_until > time_s_ && (control_.v_mps != 0.0 || control_.w_radps != 0.0)) {
     const double dt = moving_until - time_s_;
-    for (Particle& p : particles_) propagate(p.pose, control_.v_mps, control_.w_radps, dt, options_.motion);
+    for (Particle& p : particles_) {
+      if (p.joint.active()) {
+        p.joint.propagate(control_.v_mps, control_.w_radps, dt, options_.motion);
+        p.pose = p.joint.pose();
+      } else {
+        propagate(p.pose, control_.v_mps, control_.w_radps, dt, options_.motion);
+      }
+    }
   }
   if (t_s > control_end && time_s_ <= control_end && (control_.v_mps != 0.0 || control_.w_radps != 0.0)) {
     ++counters_.control_timeouts;
@@ -128,6 +144,13 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
 }
 
 void FastSlam2::update_particle(Particle& p, const std::vector<RangeBearing>& detections) {
+  const DelayedSamplingOptions& delayed = options_.delayed_sampling;
+  if (delayed.enabled &&
+      (p.joint.active() ||
+       exceeds(p.pose.cov, delayed.enter_heading_sigma_rad, delayed.enter_position_sigma_m))) {
+    update_particle_joint(p, detections);
+    return;
+  }
   const std::size_t n = detections.size();
   decision_.assign(n, Decision::kNew);
   PoseGaussian proposal = p.pose;
@@ -194,9 +217,117 @@ void FastSlam2::update_particle(Particle& p, const std::vector<RangeBearing>& de
         break;
       }
       case Decision::kInvalid:
+      case Decision::kNewDone:
         break;
     }
   }
+}
+
+void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearing>& detections) {
+  if (!p.joint.active()) {
+    p.joint.begin(p.pose);
+    ++counters_.delayed_sampling_starts;
+  }
+  JointGaussian& g = p.joint;
+  joint_backup_ = g;
+  g.begin_frame();
+  const std::size_t n = detections.size();
+  decision_.assign(n, Decision::kNew);
+  // First sightings join the state first, at the frame pose; they carry no weight.
+  for (std::size_t k = 0; k < n; ++k) {
+    if (g.find(slots_[k]) >= 0 || p.map.find(slots_[k]) != nullptr) continue;
+    g.add_new(slots_[k], z_[k], r_[k]);
+    decision_[k] = Decision::kNewDone;
+  }
+  double log_w = 0.0;
+  bool end_joint = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (decision_[k] == Decision::kNewDone) continue;
+    int i = g.find(slots_[k]);
+    const Landmark* lm = p.map.find(slots_[k]);
+    if (i < 0) i = g.add_known(slots_[k], lm->mean, lm->cov);
+    if ((g.landmark_mean(i) - g.mean.head<2>()).squaredNorm() < kMinLandmarkDistanceSq) {
+      decision_[k] = Decision::kInvalid;
+      continue;
+    }
+    const JointFit fit = fit_observation(g, i, z_[k], r_[k]);
+    if (!std::isfinite(fit.mahalanobis2) || !std::isfinite(fit.log_likelihood)) {
+      decision_[k] = Decision::kInvalid;
+      continue;
+    }
+    if (options_.gate_enabled && fit.mahalanobis2 > gate_d2_) {
+      // No readmission inside the joint state (one EKF update far outside its
+      // linear range can wreck it): a landmark due for readmission ends the
+      // joint state instead, and plain FastSLAM 2.0 re-admits it next frame.
+      decision_[k] = Decision::kGated;
+      log_w += fit.log_likelihood + 0.5 * (fit.mahalanobis2 - gate_d2_);
+      if (lm->consecutive_rejections + 1 >= static_cast<std::uint32_t>(options_.gate_readmit_after)) {
+        end_joint = true;
+      }
+      continue;
+    }
+    decision_[k] = Decision::kUsed;
+    log_w += fit.log_likelihood;
+    apply_observation(g, fit);
+  }
+  g.end_frame();
+  if (!g.healthy()) {
+    // Numerical breakdown: the frame is dropped for this particle, which goes
+    // back to plain FastSLAM 2.0 from its state before the frame.
+    g = joint_backup_;
+    decision_.assign(n, Decision::kInvalid);
+    p.pose = g.pose();
+    finish_joint(p);
+    return;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    switch (decision_[k]) {
+      case Decision::kNewDone: {
+        Landmark& added = p.map.modify(slots_[k]);
+        added.id = detections[k].landmark_id;
+        ++added.times_observed;
+        decision_[k] = Decision::kNew;
+        break;
+      }
+      case Decision::kUsed: {
+        Landmark& lm = p.map.modify(slots_[k]);
+        ++lm.times_observed;
+        lm.consecutive_rejections = 0;
+        break;
+      }
+      case Decision::kGated:
+        ++p.map.modify(slots_[k]).consecutive_rejections;
+        break;
+      case Decision::kNew:
+      case Decision::kInvalid:
+        break;
+    }
+  }
+  p.log_weight += log_w;
+  p.pose = g.pose();
+  const DelayedSamplingOptions& delayed = options_.delayed_sampling;
+  if (end_joint || !exceeds(p.pose.cov, delayed.exit_heading_sigma_rad, delayed.exit_position_sigma_m) ||
+      g.landmark_count() >= delayed.max_landmarks) {
+    finish_joint(p);
+    return;
+  }
+  for (int i = 0; i < g.landmark_count(); ++i) {
+    Landmark& lm = p.map.modify(g.slots[static_cast<std::size_t>(i)]);
+    lm.mean = g.landmark_mean(i);
+    lm.cov = g.landmark_cov(i);
+  }
+}
+
+void FastSlam2::finish_joint(Particle& p) {
+  const Pose2 x = sample_pose(p.joint.pose(), rng_);
+  for (const ConditionedLandmark& c : condition_on_pose(p.joint, x)) {
+    Landmark& lm = p.map.modify(c.slot);
+    lm.mean = c.mean;
+    lm.cov = c.cov;
+  }
+  p.pose.mean = x;
+  p.pose.cov.setZero();
+  p.joint.clear();
 }
 
 void FastSlam2::resample_if_needed() {
@@ -234,7 +365,10 @@ void FastSlam2::set_prior_map(const std::vector<LandmarkEstimate>& landmarks) {
     lm.times_observed = e.times_observed;
     lm.consecutive_rejections = 0;
   }
-  for (Particle& p : particles_) p.map = map;
+  for (Particle& p : particles_) {
+    p.map = map;
+    p.joint.clear();  // its landmarks belonged to the replaced map
+  }
 }
 
 std::size_t FastSlam2::best_index() const {

@@ -43,6 +43,19 @@ void validate(const FilterOptions& o) {
   require(o.gate_readmit_after >= 1, "gate_readmit_after", o.gate_readmit_after, "must be >= 1");
   require(o.resample_neff_fraction > 0.0 && o.resample_neff_fraction <= 1.0, "resample_neff_fraction",
           o.resample_neff_fraction, "must be in (0, 1]");
+  const DelayedSamplingOptions& d = o.delayed_sampling;
+  require_positive(d.enter_heading_sigma_rad, "delayed_sampling.enter_heading_sigma_rad");
+  require_positive(d.enter_position_sigma_m, "delayed_sampling.enter_position_sigma_m");
+  require(std::isfinite(d.exit_heading_sigma_rad) && d.exit_heading_sigma_rad > 0.0 &&
+              d.exit_heading_sigma_rad <= d.enter_heading_sigma_rad,
+          "delayed_sampling.exit_heading_sigma_rad", d.exit_heading_sigma_rad,
+          "must be > 0 and <= enter_heading_sigma_rad");
+  require(std::isfinite(d.exit_position_sigma_m) && d.exit_position_sigma_m > 0.0 &&
+              d.exit_position_sigma_m <= d.enter_position_sigma_m,
+          "delayed_sampling.exit_position_sigma_m", d.exit_position_sigma_m,
+          "must be > 0 and <= enter_position_sigma_m");
+  require(d.max_landmarks >= 1 && d.max_landmarks <= 1000, "delayed_sampling.max_landmarks", d.max_landmarks,
+          "must be in [1, 1000]");
 }
 
 double gate_mahalanobis2(const FilterOptions& o) {

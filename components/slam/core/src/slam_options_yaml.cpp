@@ -45,6 +45,17 @@ FilterOptions read_filter_options(config::YamlReader& f) {
     o.resample_neff_fraction = r.number("neff_fraction", 1e-6, 1.0, o.resample_neff_fraction);
     r.finish();
   }
+  if (f.has("delayed_sampling")) {
+    config::YamlReader d = f.child("delayed_sampling");
+    DelayedSamplingOptions& ds = o.delayed_sampling;
+    ds.enabled = d.boolean("enabled", ds.enabled);
+    ds.enter_heading_sigma_rad = d.number("enter_heading_sigma_rad", 1e-6, 10.0, ds.enter_heading_sigma_rad);
+    ds.enter_position_sigma_m = d.number("enter_position_sigma_m", 1e-6, 1000.0, ds.enter_position_sigma_m);
+    ds.exit_heading_sigma_rad = d.number("exit_heading_sigma_rad", 1e-6, 10.0, ds.exit_heading_sigma_rad);
+    ds.exit_position_sigma_m = d.number("exit_position_sigma_m", 1e-6, 1000.0, ds.exit_position_sigma_m);
+    ds.max_landmarks = static_cast<int>(d.integer("max_landmarks", 1, 1000, ds.max_landmarks));
+    d.finish();
+  }
   f.finish();
   try {
     validate(o);

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include "pixyslam/slam/joint_gaussian.h"
 #include "pixyslam/slam/landmark_map.h"
 #include "pixyslam/slam/motion_model.h"
 #include "pixyslam/slam/slam_options.h"
@@ -17,10 +18,13 @@ namespace pixyslam::slam {
 
 // One hypothesis: the pose Gaussian accumulated since its last sampled pose
 // (zero covariance right after sampling), a log importance weight, and its map.
+// While sampling is delayed, joint holds the pose and the landmarks seen since;
+// pose is then its pose marginal and the map mirrors the landmark marginals.
 struct Particle {
   PoseGaussian pose;
   double log_weight = 0.0;
   LandmarkMap map;
+  JointGaussian joint;
 };
 
 struct LandmarkEstimate {
@@ -52,6 +56,7 @@ struct FilterCounters {
   std::uint64_t observations_gated = 0;
   std::uint64_t observations_invalid = 0;
   std::uint64_t resamples = 0;
+  std::uint64_t delayed_sampling_starts = 0;  // particle-frames that began a joint state
 };
 
 // FastSLAM 2.0 (Montemerlo, Thrun, Koller, Wegbreit 2003) with known data
@@ -95,11 +100,14 @@ class FastSlam2 {
   const LandmarkMapPool& pool() const { return pool_; }
 
  private:
-  enum class Decision : std::uint8_t { kUsed, kGated, kNew, kInvalid };
+  // kNewDone: a first sighting already added to a joint state this frame.
+  enum class Decision : std::uint8_t { kUsed, kGated, kNew, kInvalid, kNewDone };
 
   void advance_to(double t_s);
   std::uint32_t slot_for(int landmark_id);
   void update_particle(Particle& p, const std::vector<RangeBearing>& detections);
+  void update_particle_joint(Particle& p, const std::vector<RangeBearing>& detections);
+  void finish_joint(Particle& p);
   void resample_if_needed();
   std::size_t best_index() const;
 
@@ -109,6 +117,7 @@ class FastSlam2 {
   LandmarkMapPool pool_;  // declared before particles_: outlives their maps
   std::vector<Particle> particles_;
   std::vector<Particle> scratch_;
+  JointGaussian joint_backup_;  // state before a joint update, restored on breakdown
 
   bool has_time_ = false;
   double time_s_ = 0.0;

@@ -32,6 +32,15 @@ struct PoseGaussian {
 //   x += d cos(theta + a/2), y += d sin(theta + a/2), theta += a.
 Pose2 move(const Pose2& pose, double v_mps, double w_radps, double dt_s);
 
+// One step of move() linearised at pose: the moved mean, F = d move / d pose and
+// the noise covariance V Q V^T (V = d move / d (d, a), Q = diag(var d, var a)).
+struct MotionStep {
+  Pose2 mean = Pose2::Zero();
+  Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d q = Eigen::Matrix3d::Zero();
+};
+MotionStep motion_step(const Pose2& pose, double v_mps, double w_radps, double dt_s, const MotionNoise& noise);
+
 // Propagates a pose Gaussian through move(): mean moved, covariance
 // F cov F^T + V Q V^T with F = d move / d pose and V = d move / d (d, a).
 void propagate(PoseGaussian& g, double v_mps, double w_radps, double dt_s, const MotionNoise& noise);

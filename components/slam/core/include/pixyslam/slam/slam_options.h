@@ -12,6 +12,23 @@ enum class ResampleMode {
   kEveryFrame,           // after every observation frame (the seed paper)
 };
 
+// Delayed sampling: a particle whose pose has become more uncertain than the
+// "enter" limits since it was last sampled (a long stretch without landmarks) is
+// not sampled at the next frame. Its pose and the landmarks it then sees are kept
+// in one Gaussian (JointGaussian) until the pose is pinned below the "exit"
+// limits again (typically by re-observing a well known landmark: loop closure),
+// or the state holds max_landmarks; then the pose is sampled and the landmarks
+// are conditioned on it. Sigmas: heading sd, and sd of position along its worst
+// direction.
+struct DelayedSamplingOptions {
+  bool enabled = false;
+  double enter_heading_sigma_rad = 0.15;
+  double enter_position_sigma_m = 0.3;
+  double exit_heading_sigma_rad = 0.08;
+  double exit_position_sigma_m = 0.2;
+  int max_landmarks = 16;
+};
+
 // Everything that configures FastSlam2. Units in the names; validate() checks
 // ranges and throws std::invalid_argument naming the field.
 struct FilterOptions {
@@ -41,6 +58,7 @@ struct FilterOptions {
 
   ResampleMode resample_mode = ResampleMode::kEffectiveSampleSize;
   double resample_neff_fraction = 0.667;
+  DelayedSamplingOptions delayed_sampling;
 };
 
 void validate(const FilterOptions& options);

@@ -1,0 +1,92 @@
+#pragma once
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pixyslam/slam/motion_model.h"
+#include "pixyslam/slam/types.h"
+
+namespace pixyslam::slam {
+
+// One particle's pose and the landmarks it saw while its pose was too uncertain
+// to sample (delayed sampling, see FastSlam2): a single Gaussian over
+// (x, y, theta, m1x, m1y, m2x, ...), updated like EKF-SLAM. Landmarks seen from
+// an uncertain pose stay correlated with it, so a later observation of a well
+// known landmark moves the pose and those landmarks together (loop closure)
+// instead of leaving them in the frame the pose had when they were first seen.
+//
+// Jacobians follow the first-estimates rule (Huang, Mourikis, Roumeliotis 2008,
+// FEJ-EKF): observations are linearised at the landmark's first estimate and the
+// pose predicted for the frame, and the motion Jacobian at predicted poses.
+// Linearising at ever-updated estimates instead lets relative observations
+// "observe" the absolute heading, which is unobservable: the heading covariance
+// collapses and the loop closure this state exists for cannot happen. After a
+// large correction (over 0.25 m) the motion Jacobian keeps the updated pose.
+// Plain data; an empty JointGaussian (no state) is inactive.
+struct JointGaussian {
+  Eigen::VectorXd mean;
+  Eigen::MatrixXd cov;
+  std::vector<std::uint32_t> slots;       // landmark slot of state block i (at 3 + 2i)
+  std::vector<Eigen::Vector2d> first;     // first estimate of landmark i
+  Eigen::Vector3d frame_pose = Eigen::Vector3d::Zero();  // pose predicted for the frame
+
+  bool active() const { return mean.size() != 0; }
+  // Finite, with non-negative and bounded variances.
+  bool healthy() const;
+  int landmark_count() const { return static_cast<int>(slots.size()); }
+  // Block index of a landmark slot, -1 when it is not in the state.
+  int find(std::uint32_t slot) const;
+  PoseGaussian pose() const;
+  Eigen::Vector2d landmark_mean(int i) const { return mean.segment<2>(3 + 2 * i); }
+  Eigen::Matrix2d landmark_cov(int i) const { return cov.block<2, 2>(3 + 2 * i, 3 + 2 * i); }
+
+  // Starts from a pose Gaussian with no landmarks.
+  void begin(const PoseGaussian& pose);
+  void clear();
+  // Pose block moved through motion_step(); cross-covariances multiplied by F.
+  void propagate(double v_mps, double w_radps, double dt_s, const MotionNoise& noise);
+  // Brackets the observations of one frame. end_frame() re-linearises the motion
+  // Jacobian at the predicted pose: with c the position correction of the frame,
+  // P <- Fc P Fc^T, Fc = I + [0 0 -c_y; 0 0 c_x; 0 0 0] (the unicycle Jacobians
+  // are unipotent and compose by adding displacements).
+  void begin_frame() { frame_pose = mean.head<3>(); }
+  void end_frame();
+  // Appends a mapped landmark, independent of the rest (FastSLAM's factorisation).
+  int add_known(std::uint32_t slot, const Eigen::Vector2d& landmark_mean, const Eigen::Matrix2d& landmark_cov);
+  // Appends a first sighting through the inverse observation model at the frame
+  // pose, with its correlation to the pose: P_ll = Gx Pxx Gx^T + Gz R Gz^T,
+  // P_l* = Gx P_x*. Add new landmarks before the frame's updates.
+  int add_new(std::uint32_t slot, const Eigen::Vector2d& z, const Eigen::Matrix2d& r);
+};
+
+// How an observation of state landmark i fits the joint Gaussian: innovation
+// nu = z - h(mean), S = H P H^T + R with H = [H_pose, H_landmark] on its blocks,
+// evaluated at the frame pose and the landmark's first estimate.
+struct JointFit {
+  int index = -1;
+  Eigen::Vector2d innovation = Eigen::Vector2d::Zero();
+  Eigen::Matrix<double, 2, 3> h_pose = Eigen::Matrix<double, 2, 3>::Zero();
+  Eigen::Matrix2d h_landmark = Eigen::Matrix2d::Zero();
+  Eigen::Matrix2d s = Eigen::Matrix2d::Identity();
+  double mahalanobis2 = 0.0;
+  double log_likelihood = 0.0;
+};
+JointFit fit_observation(const JointGaussian& g, int index, const Eigen::Vector2d& z, const Eigen::Matrix2d& r);
+// EKF update with a fit: K = P H^T S^-1, mean += K nu, P -= K S K^T.
+void apply_observation(JointGaussian& g, const JointFit& fit);
+
+// The landmarks given a pose drawn from the state's pose marginal: mean_i +
+// P_ix Pxx^-1 (x - mean_x), covariance P_ii - P_ix Pxx^-1 P_xi. The landmarks'
+// correlations with each other given the pose are dropped (FastSLAM's factorised
+// map); they come only from motion noise between their sightings.
+struct ConditionedLandmark {
+  std::uint32_t slot = 0;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+};
+std::vector<ConditionedLandmark> condition_on_pose(const JointGaussian& g, const Pose2& pose);
+
+}  // namespace pixyslam::slam

@@ -1,0 +1,188 @@
+#include "pixyslam/slam/joint_gaussian.h"
+
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include "pixyslam/slam/observation_model.h"
+
+namespace pixyslam::slam {
+namespace {
+
+constexpr double kMinLandmarkVariance = 1e-10;  // (10 um)^2
+// A state variance beyond this ((1 km)^2) means the linearisation broke down.
+constexpr double kMaxVariance = 1e6;
+// A frame correction beyond this is not folded back into the motion Jacobian.
+constexpr double kRelineariseDistance = 0.25;  // m
+
+void symmetrise(Eigen::MatrixXd& m) { m = 0.5 * (m + m.transpose()).eval(); }
+
+// Grows the state by one landmark block, zero-filled; returns its index.
+int append_block(JointGaussian& g, std::uint32_t slot) {
+  const Eigen::Index n = g.mean.size();
+  g.mean.conservativeResize(n + 2);
+  g.cov.conservativeResize(n + 2, n + 2);
+  g.mean.tail<2>().setZero();
+  g.cov.bottomRows<2>().setZero();
+  g.cov.rightCols<2>().setZero();
+  g.slots.push_back(slot);
+  g.first.emplace_back(Eigen::Vector2d::Zero());
+  return g.landmark_count() - 1;
+}
+
+}  // namespace
+
+bool JointGaussian::healthy() const {
+  if (!mean.allFinite() || !cov.allFinite()) return false;
+  for (Eigen::Index i = 0; i < cov.rows(); ++i) {
+    if (cov(i, i) < 0.0 || cov(i, i) > kMaxVariance) return false;
+  }
+  return true;
+}
+
+int JointGaussian::find(std::uint32_t slot) const {
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    if (slots[i] == slot) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+PoseGaussian JointGaussian::pose() const {
+  PoseGaussian p;
+  p.mean = mean.head<3>();
+  p.cov = cov.topLeftCorner<3, 3>();
+  return p;
+}
+
+void JointGaussian::begin(const PoseGaussian& pose) {
+  mean = pose.mean;
+  cov = pose.cov;
+  slots.clear();
+  first.clear();
+  frame_pose = pose.mean;
+}
+
+void JointGaussian::clear() {
+  mean.resize(0);
+  cov.resize(0, 0);
+  slots.clear();
+  first.clear();
+}
+
+void JointGaussian::end_frame() {
+  // After a large jump (a loop closure) the motion Jacobian keeps the updated
+  // pose: inflating by a metre-sized correction would wreck the covariance.
+  const Eigen::Vector2d c = mean.head<2>() - frame_pose.head<2>();
+  if (c.norm() > kRelineariseDistance) return;
+  Eigen::Matrix3d fc = Eigen::Matrix3d::Identity();
+  fc(0, 2) = -c.y();
+  fc(1, 2) = c.x();
+  cov.topRows<3>() = (fc * cov.topRows<3>()).eval();
+  cov.leftCols<3>() = (cov.leftCols<3>() * fc.transpose()).eval();
+}
+
+void JointGaussian::propagate(double v_mps, double w_radps, double dt_s, const MotionNoise& noise) {
+  if (dt_s <= 0.0) return;
+  const MotionStep step = motion_step(mean.head<3>(), v_mps, w_radps, dt_s, noise);
+  const Eigen::Index m = mean.size() - 3;
+  cov.topLeftCorner<3, 3>() = step.f * cov.topLeftCorner<3, 3>() * step.f.transpose() + step.q;
+  if (m > 0) {
+    cov.topRightCorner(3, m) = step.f * cov.topRightCorner(3, m);
+    cov.bottomLeftCorner(m, 3) = cov.topRightCorner(3, m).transpose();
+  }
+  mean.head<3>() = step.mean;
+}
+
+int JointGaussian::add_known(std::uint32_t slot, const Eigen::Vector2d& landmark_mean,
+                             const Eigen::Matrix2d& landmark_cov) {
+  const int i = append_block(*this, slot);
+  mean.tail<2>() = landmark_mean;
+  cov.bottomRightCorner<2, 2>() = landmark_cov;
+  first.back() = landmark_mean;
+  return i;
+}
+
+int JointGaussian::add_new(std::uint32_t slot, const Eigen::Vector2d& z, const Eigen::Matrix2d& r) {
+  const double heading = frame_pose(2) + z.y();
+  const double c = std::cos(heading);
+  const double s = std::sin(heading);
+  Eigen::Matrix<double, 2, 3> gx;
+  gx << 1.0, 0.0, -z.x() * s,
+        0.0, 1.0, z.x() * c;
+  Eigen::Matrix2d gz;
+  gz << c, -z.x() * s,
+        s, z.x() * c;
+  const Eigen::Vector2d landmark(frame_pose(0) + z.x() * c, frame_pose(1) + z.x() * s);
+  const Eigen::MatrixXd cross = gx * cov.topRows<3>();  // 2 x n, before the state grows
+  const int i = append_block(*this, slot);
+  const Eigen::Index n = cross.cols();
+  mean.tail<2>() = landmark;
+  first.back() = landmark;
+  cov.bottomLeftCorner(2, n) = cross;
+  cov.topRightCorner(n, 2) = cross.transpose();
+  cov.bottomRightCorner<2, 2>() =
+      gx * cov.topLeftCorner<3, 3>() * gx.transpose() + gz * r * gz.transpose();
+  return i;
+}
+
+JointFit fit_observation(const JointGaussian& g, int index, const Eigen::Vector2d& z, const Eigen::Matrix2d& r) {
+  const Eigen::Index j = 3 + 2 * index;
+  const PredictedObservation p =
+      predict_observation(g.frame_pose, g.first[static_cast<std::size_t>(index)]);
+  JointFit fit;
+  fit.index = index;
+  fit.innovation = innovation(z, predict_observation(g.mean.head<3>(), g.mean.segment<2>(j)).z);
+  fit.h_pose = p.h_pose;
+  fit.h_landmark = p.h_landmark;
+  const Eigen::Matrix<double, 2, 3> pose_rows_x = p.h_pose * g.cov.block<3, 3>(0, 0);
+  const Eigen::Matrix2d cross = p.h_pose * g.cov.block<3, 2>(0, j) * p.h_landmark.transpose();
+  fit.s = pose_rows_x * p.h_pose.transpose() + cross + cross.transpose() +
+          p.h_landmark * g.cov.block<2, 2>(j, j) * p.h_landmark.transpose() + r;
+  fit.mahalanobis2 = fit.innovation.dot(fit.s.inverse() * fit.innovation);
+  fit.log_likelihood = -0.5 * fit.mahalanobis2 - std::log(2.0 * M_PI) - 0.5 * std::log(fit.s.determinant());
+  return fit;
+}
+
+void apply_observation(JointGaussian& g, const JointFit& fit) {
+  const Eigen::Index j = 3 + 2 * fit.index;
+  // P H^T touches only the pose and landmark columns of H.
+  const Eigen::MatrixXd pht =
+      g.cov.leftCols<3>() * fit.h_pose.transpose() + g.cov.middleCols<2>(j) * fit.h_landmark.transpose();
+  const Eigen::MatrixXd k = pht * fit.s.inverse();
+  g.mean += k * fit.innovation;
+  g.mean(2) = wrap_angle(g.mean(2));
+  g.cov -= k * pht.transpose();
+  symmetrise(g.cov);
+}
+
+std::vector<ConditionedLandmark> condition_on_pose(const JointGaussian& g, const Pose2& pose) {
+  // A tiny ridge keeps Pxx invertible when a direction has no uncertainty yet.
+  const Eigen::Matrix3d pxx = g.cov.topLeftCorner<3, 3>() + 1e-12 * Eigen::Matrix3d::Identity();
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(pxx);
+  Eigen::Vector3d dx = pose - g.mean.head<3>();
+  dx(2) = wrap_angle(dx(2));
+  std::vector<ConditionedLandmark> out;
+  out.reserve(g.slots.size());
+  for (int i = 0; i < g.landmark_count(); ++i) {
+    const Eigen::Index j = 3 + 2 * i;
+    const Eigen::Matrix<double, 3, 2> pxi = g.cov.block<3, 2>(0, j);
+    const Eigen::Matrix<double, 2, 3> a = ldlt.solve(pxi).transpose();  // P_ix Pxx^-1
+    ConditionedLandmark c;
+    c.slot = g.slots[static_cast<std::size_t>(i)];
+    c.mean = g.mean.segment<2>(j) + a * dx;
+    c.cov = g.cov.block<2, 2>(j, j) - a * pxi;
+    c.cov = 0.5 * (c.cov + c.cov.transpose()).eval();
+    // Rounding can leave a nearly singular block indefinite: floor its eigenvalues.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(c.cov);
+    if (eig.eigenvalues().minCoeff() < kMinLandmarkVariance) {
+      const Eigen::Vector2d floored = eig.eigenvalues().cwiseMax(kMinLandmarkVariance);
+      c.cov = eig.eigenvectors() * floored.asDiagonal() * eig.eigenvectors().transpose();
+    }
+    out.push_back(c);
+  }
+  return out;
+}
+
+}  // namespace pixyslam::slam
