@@ -12,6 +12,7 @@ PACKAGES=(
   libopencv-dev
   openssl iproute2 tcpdump
   podman runc debootstrap
+  clang-14 libclang-rt-14-dev
 )
 
 missing=()

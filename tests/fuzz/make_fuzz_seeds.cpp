@@ -1,0 +1,151 @@
+// Writes the seed corpora of the fuzz targets into corpus/<target>/ (run once
+// by hand when a format changes; the output is committed):
+//   build-fuzz/bin/make_fuzz_seeds tests/fuzz/corpus config
+// Seeds are small valid inputs of each format, so the fuzzers start from the
+// interesting paths instead of rediscovering the syntax.
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "pixyslam/encoder/arduino_line_parser.h"
+#include "pixyslam/logger/mcap_reader.h"
+#include "pixyslam/logger/mcap_writer.h"
+#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/pixy/pixy_block_parser.h"
+
+namespace fs = std::filesystem;
+using Bytes = std::vector<std::uint8_t>;
+
+namespace {
+
+void write(const fs::path& dir, const std::string& name, const Bytes& bytes) {
+  fs::create_directories(dir);
+  std::ofstream out(dir / name, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+}
+
+Bytes text(std::uint8_t first, const std::string& s) {
+  Bytes b{first};
+  b.insert(b.end(), s.begin(), s.end());
+  return b;
+}
+
+pixyslam::msg::Odometry odometry(std::uint64_t seq) {
+  pixyslam::msg::Odometry m;
+  m.header().stamp_ns(1'000'000'000ull + seq * 100'000'000ull);
+  m.header().seq(seq);
+  m.header().robot_id("robot1");
+  m.header().frame_id("base_link");
+  m.v_mps(0.2);
+  m.w_radps(0.1);
+  m.period_s(0.1);
+  m.distance_m(0.02);
+  m.rotation_rad(0.01);
+  m.encoder_samples(5);
+  return m;
+}
+
+pixyslam::msg::LandmarkObservation observation(std::uint64_t seq) {
+  pixyslam::msg::LandmarkObservation m;
+  m.header().stamp_ns(1'000'000'000ull + seq * 200'000'000ull);
+  m.header().seq(seq);
+  m.header().robot_id("robot1");
+  m.header().frame_id("camera");
+  m.camera_frame(static_cast<std::uint32_t>(seq));
+  m.blocks_in_frame(2);
+  for (int id : {3, 7}) {
+    pixyslam::msg::LandmarkDetection d;
+    d.landmark_id(id);
+    d.range_m(1.0 + 0.5 * id);
+    d.bearing_rad(0.1 * (id - 5));
+    m.detections().push_back(d);
+  }
+  return m;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::cerr << "usage: make_fuzz_seeds CORPUS_DIR CONFIG_DIR\n";
+    return 2;
+  }
+  const fs::path root = argv[1];
+  const fs::path config_dir = argv[2];
+  using namespace pixyslam;
+
+  // Arduino lines (first byte: chunk size).
+  const fs::path arduino = root / "fuzz_arduino_parser";
+  write(arduino, "enc", text(7, encoder::format_line(encoder::EncoderSample{1, 20000, 12, -7})));
+  write(arduino, "rst_enc", text(3, encoder::format_line(encoder::EncoderReset{"1.2.0", 1440}) +
+                                        encoder::format_line(encoder::EncoderSample{2, 40000, 30, 25})));
+  write(arduino, "garbage_then_line", text(1, "xx$ENC,1,2*00\n$" + encoder::format_line(encoder::EncoderSample{3, 1, 2, 3})));
+
+  // Pixy block stream (first byte: chunk size).
+  const fs::path pixy = root / "fuzz_pixy_parser";
+  pixy::PixyBlock normal;
+  normal.signature = 1;
+  normal.x = 160;
+  normal.y = 100;
+  normal.width = 20;
+  normal.height = 60;
+  pixy::PixyBlock code = normal;
+  code.signature = 012;
+  code.colour_code = true;
+  code.angle_deg = -3;
+  Bytes frames{5};
+  for (int i = 0; i < 3; ++i) {
+    const Bytes f = pixy::encode_frame({normal, code});
+    frames.insert(frames.end(), f.begin(), f.end());
+  }
+  write(pixy, "three_frames", frames);
+
+  // YAML option files: the shipped configs.
+  const fs::path yaml = root / "fuzz_yaml_options";
+  fs::create_directories(yaml);
+  for (const char* name : {"slam_sim.yaml", "slam_mrclam.yaml", "encoder_bridge.yaml", "pixy_bridge.yaml",
+                           "robot_sim.yaml"}) {
+    fs::copy_file(config_dir / name, yaml / name, fs::copy_options::overwrite_existing);
+  }
+
+  // CDR payloads (first byte: topic, 0 Odometry, 1 LandmarkObservation, 2 MapState, 3 GroundTruth).
+  const fs::path cdr = root / "fuzz_cdr_topics";
+  const auto cdr_seed = [&](const std::string& name, std::uint8_t topic, const Bytes& payload) {
+    Bytes b{topic};
+    b.insert(b.end(), payload.begin(), payload.end());
+    write(cdr, name, b);
+  };
+  cdr_seed("odometry", 0, logger_node::to_cdr(odometry(1)));
+  cdr_seed("odometry_delayed", 0x10, logger_node::to_cdr(odometry(2)));
+  cdr_seed("observation", 1, logger_node::to_cdr(observation(1)));
+  cdr_seed("observation_delayed", 0x11, logger_node::to_cdr(observation(2)));
+  msg::MapState map;
+  map.header().seq(1);
+  cdr_seed("map_state", 2, logger_node::to_cdr(map));
+  msg::GroundTruth truth;
+  truth.header().seq(1);
+  cdr_seed("ground_truth", 3, logger_node::to_cdr(truth));
+
+  // MCAP files: chunked and unchunked, with the project's schemas.
+  const fs::path mcap = root / "fuzz_mcap_reader";
+  fs::create_directories(mcap);
+  for (const bool chunked : {true, false}) {
+    logger::McapWriterOptions options;
+    options.chunk_size_bytes = chunked ? 256 : 0;
+    const fs::path path = mcap / (chunked ? "chunked.mcap" : "unchunked.mcap");
+    logger::McapWriter writer(path.string(), options);
+    const std::uint16_t schema = writer.add_schema("pixyslam::msg::Odometry", "omgidl", "struct Odometry {};");
+    const std::uint16_t channel = writer.add_channel("pixyslam/odometry", "cdr", schema);
+    for (std::uint64_t i = 1; i <= 4; ++i) {
+      writer.write_message(channel, static_cast<std::uint32_t>(i), i * 1000, i * 1000, logger_node::to_cdr(odometry(i)));
+    }
+    writer.close();
+    (void)logger::McapReader(path.string());  // the seed must itself be clean
+  }
+  std::cout << "seeds written under " << root << "\n";
+  return 0;
+}
