@@ -8,6 +8,7 @@
 #include <limits>
 #include <memory>
 #include <numeric>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -406,6 +407,55 @@ TEST(FastSlam2, InvalidObservationsAreCountedAndIgnored) {
   f.add_observations({2.0, {{4, 2.0, 0.2}}});
   EXPECT_EQ(f.counters().observations_used, 1u);
   expect_finite(f.pose_estimate());
+}
+
+// Property: whatever arrives (NaN, inf, negative or huge ranges, bearings out
+// of range, time going backwards or jumping by days, absurd speeds, bursts of
+// one landmark, unknown ids), the estimate and the map stay finite. Random
+// sequences from fixed seeds, with delayed sampling off and on.
+TEST(FastSlam2, HostileInputSequencesNeverProduceNonFiniteEstimates) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<double> odd = {nan, inf, -inf, -1.0, 0.0, 1e-300, 1e300, -1e300, 7.0, 1e6};
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    std::mt19937_64 prng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    auto pick = [&](double sane) { return u(prng) < 0.3 ? odd[prng() % odd.size()] : sane; };
+    FilterOptions o;
+    o.particles = 20;
+    o.seed = seed;
+    o.delayed_sampling.enabled = seed % 2 == 0;
+    FastSlam2 f(o, Pose2::Zero());
+    double t = 0.0;
+    for (int step = 0; step < 1500; ++step) {
+      const double r = u(prng);
+      t = r < 0.02 ? t - 5.0 : (r < 0.03 ? t + 86400.0 : t + 0.1);
+      if (u(prng) < 0.5) {
+        f.add_odometry({pick(t), pick(0.2 * u(prng)), pick(u(prng) - 0.5)});
+      } else {
+        ObservationFrame frame{pick(t), {}};
+        const int n = u(prng) < 0.05 ? 40 : static_cast<int>(prng() % 4);
+        for (int k = 0; k < n; ++k) {
+          RangeBearing z;
+          z.landmark_id = u(prng) < 0.1 ? static_cast<int>(prng()) : static_cast<int>(prng() % 6);
+          z.range_m = pick(0.3 + 3.0 * u(prng));
+          z.bearing_rad = pick(u(prng) - 0.5);
+          z.range_sigma_m = u(prng) < 0.2 ? pick(0.05) : 0.0;
+          z.bearing_sigma_rad = u(prng) < 0.2 ? pick(0.02) : 0.0;
+          frame.detections.push_back(z);
+        }
+        f.add_observations(frame);
+      }
+      const PoseEstimate e = f.pose_estimate();
+      ASSERT_TRUE(e.mean.allFinite() && e.cov.allFinite()) << "seed " << seed << " step " << step;
+      for (const LandmarkEstimate& lm : f.landmarks_of_best()) {
+        ASSERT_TRUE(lm.mean.allFinite() && lm.cov.allFinite())
+            << "seed " << seed << " step " << step << " landmark " << lm.id;
+      }
+    }
+    EXPECT_GT(f.counters().observations_invalid, 0u);
+    EXPECT_GT(f.counters().frames_out_of_order + f.counters().odometry_out_of_order, 0u);
+  }
 }
 
 TEST(FastSlam2, ObservationAtZeroPredictedRangeKeepsTheEstimateFinite) {

@@ -51,6 +51,8 @@ TEST(SlamOptionsYaml, FullConfigRoundTripsEveryValue) {
       "    distance_sigma_per_sqrt_m: 0.05\n"
       "    heading_sigma_rad_per_sqrt_m: 0.06\n"
       "    rotation_sigma_per_sqrt_rad: 0.07\n"
+      "  max_speed_mps: 3.5\n"
+      "  max_turn_rate_radps: 6.5\n"
       "  control_timeout_s: 2.5\n"
       "  observation:\n"
       "    range_sigma_m: 0.11\n"
@@ -81,6 +83,8 @@ TEST(SlamOptionsYaml, FullConfigRoundTripsEveryValue) {
   EXPECT_DOUBLE_EQ(o.motion.distance_sigma_per_sqrt_m, 0.05);
   EXPECT_DOUBLE_EQ(o.motion.heading_sigma_rad_per_sqrt_m, 0.06);
   EXPECT_DOUBLE_EQ(o.motion.rotation_sigma_per_sqrt_rad, 0.07);
+  EXPECT_DOUBLE_EQ(o.max_speed_mps, 3.5);
+  EXPECT_DOUBLE_EQ(o.max_turn_rate_radps, 6.5);
   EXPECT_DOUBLE_EQ(o.control_timeout_s, 2.5);
   EXPECT_DOUBLE_EQ(o.range_sigma_m, 0.11);
   EXPECT_DOUBLE_EQ(o.range_sigma_per_m, 0.02);

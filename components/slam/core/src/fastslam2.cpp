@@ -28,6 +28,12 @@ Pose2 sample_pose(const PoseGaussian& g, std::mt19937_64& rng) {
   return x;
 }
 
+// A detection's own sigma: 0 (or less) = use the configured noise; otherwise it
+// must be a usable number (1 um .. 1 km, or rad).
+bool plausible_sigma(double sigma) {
+  return std::isfinite(sigma) && (sigma <= 0.0 || (sigma >= 1e-6 && sigma <= 1e3));
+}
+
 // Whether a pose covariance exceeds a heading sd or a position sd (worst direction).
 bool exceeds(const Eigen::Matrix3d& cov, double heading_sigma, double position_sigma) {
   if (cov(2, 2) > heading_sigma * heading_sigma) return true;
@@ -77,6 +83,11 @@ void FastSlam2::advance_to(double t_s) {
 
 void FastSlam2::add_odometry(const OdometrySample& sample) {
   ++counters_.odometry_samples;
+  if (!std::isfinite(sample.t_s) || !std::isfinite(sample.v_mps) || !std::isfinite(sample.w_radps) ||
+      std::abs(sample.v_mps) > options_.max_speed_mps || std::abs(sample.w_radps) > options_.max_turn_rate_radps) {
+    ++counters_.odometry_invalid;
+    return;
+  }
   if (has_time_ && sample.t_s < time_s_) ++counters_.odometry_out_of_order;
   advance_to(sample.t_s);
   control_ = sample;
@@ -91,6 +102,11 @@ std::uint32_t FastSlam2::slot_for(int landmark_id) {
 
 void FastSlam2::add_observations(const ObservationFrame& frame) {
   ++counters_.frames;
+  if (!std::isfinite(frame.t_s)) {
+    ++counters_.frames_invalid;
+    counters_.observations_invalid += frame.detections.size();
+    return;
+  }
   if (has_time_ && frame.t_s < time_s_) ++counters_.frames_out_of_order;
   advance_to(frame.t_s);
 
@@ -104,8 +120,8 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
   for (const RangeBearing& d : frame.detections) {
     const bool ok = std::isfinite(d.range_m) && std::isfinite(d.bearing_rad) &&
                     d.range_m >= options_.min_range_m && d.range_m <= options_.max_range_m &&
-                    std::abs(d.bearing_rad) <= M_PI && std::isfinite(d.range_sigma_m) &&
-                    std::isfinite(d.bearing_sigma_rad);
+                    std::abs(d.bearing_rad) <= M_PI && plausible_sigma(d.range_sigma_m) &&
+                    plausible_sigma(d.bearing_sigma_rad);
     if (!ok) {
       ++counters_.observations_invalid;
       continue;

@@ -31,6 +31,8 @@ void validate(const FilterOptions& o) {
   require_non_negative(o.motion.distance_sigma_per_sqrt_m, "motion.distance_sigma_per_sqrt_m");
   require_non_negative(o.motion.heading_sigma_rad_per_sqrt_m, "motion.heading_sigma_rad_per_sqrt_m");
   require_non_negative(o.motion.rotation_sigma_per_sqrt_rad, "motion.rotation_sigma_per_sqrt_rad");
+  require_positive(o.max_speed_mps, "max_speed_mps");
+  require_positive(o.max_turn_rate_radps, "max_turn_rate_radps");
   require_positive(o.control_timeout_s, "control_timeout_s");
   require_positive(o.range_sigma_m, "range_sigma_m");
   require_non_negative(o.range_sigma_per_m, "range_sigma_per_m");

@@ -21,6 +21,8 @@ FilterOptions read_filter_options(config::YamlReader& f) {
         m.number("rotation_sigma_per_sqrt_rad", 0.0, 10.0, o.motion.rotation_sigma_per_sqrt_rad);
     m.finish();
   }
+  o.max_speed_mps = f.number("max_speed_mps", 1e-3, 1000.0, o.max_speed_mps);
+  o.max_turn_rate_radps = f.number("max_turn_rate_radps", 1e-3, 1000.0, o.max_turn_rate_radps);
   o.control_timeout_s = f.number("control_timeout_s", 1e-3, 3600.0, o.control_timeout_s);
   if (f.has("observation")) {
     config::YamlReader z = f.child("observation");

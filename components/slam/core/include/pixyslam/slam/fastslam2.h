@@ -47,9 +47,11 @@ struct PoseEstimate {
 // half of the particles rejected it.
 struct FilterCounters {
   std::uint64_t odometry_samples = 0;
+  std::uint64_t odometry_invalid = 0;  // non-finite, or faster than max_speed / max_turn_rate: dropped
   std::uint64_t odometry_out_of_order = 0;
   std::uint64_t control_timeouts = 0;
   std::uint64_t frames = 0;
+  std::uint64_t frames_invalid = 0;  // non-finite time: dropped with their detections
   std::uint64_t frames_out_of_order = 0;
   std::uint64_t observations_used = 0;
   std::uint64_t observations_new_landmark = 0;

@@ -36,6 +36,10 @@ struct FilterOptions {
   std::uint64_t seed = 1;
 
   MotionNoise motion;
+  // Odometry beyond these is physically impossible for the robot: dropped and
+  // counted (FilterCounters::odometry_invalid), like non-finite values.
+  double max_speed_mps = 10.0;
+  double max_turn_rate_radps = 20.0;
   // Control held longer than this (no new odometry) is treated as stopped.
   double control_timeout_s = 5.0;
 
