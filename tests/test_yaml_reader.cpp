@@ -204,3 +204,26 @@ TEST(YamlReader, MissingFileIsAConfigError) {
 
 }  // namespace
 }  // namespace pixyslam::config
+
+namespace pixyslam::config {
+namespace {
+
+// Found by fuzz_yaml_options: a mapping used as a key ("? a: 1") made finish()
+// throw yaml-cpp's BadConversion instead of a ConfigError.
+TEST(YamlReader, NonScalarKeyIsAConfigErrorNamingTheLine) {
+  YamlReader root = YamlReader::from_string("filter:\n  particles: 5\n  ? neff: 0.6\n", "complex_key.yaml");
+  YamlReader filter = root.child("filter");
+  EXPECT_EQ(filter.integer("particles", 1, 10, 1), 5);
+  try {
+    filter.finish();
+    FAIL() << "finish() accepted a mapping as a key";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("complex_key.yaml"), std::string::npos) << m;
+    EXPECT_NE(m.find("line 3"), std::string::npos) << m;
+  }
+  EXPECT_THROW(filter.keys(), ConfigError);
+}
+
+}  // namespace
+}  // namespace pixyslam::config

@@ -55,9 +55,18 @@ void YamlReader::fail(const std::string& key, const std::string& what) const {
 
 bool YamlReader::has(const std::string& key) const { return static_cast<bool>(node_[key]); }
 
+std::string YamlReader::key_text(const YAML::Node& key) const {
+  if (key.IsScalar()) return key.Scalar();
+  // YAML allows a mapping or a sequence as a key ("? [a, b]: 1"); no option is one.
+  const YAML::Mark mark = key.Mark();
+  const std::string where = mark.is_null() ? std::string("?") : std::to_string(mark.line + 1);
+  throw ConfigError(origin_ + ": mapping '" + path() + "': a key at line " + where + " is " + describe(key) +
+                    ", not a plain name");
+}
+
 std::vector<std::string> YamlReader::keys() const {
   std::vector<std::string> out;
-  for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+  for (const auto& kv : node_) out.push_back(key_text(kv.first));
   return out;
 }
 
@@ -179,7 +188,7 @@ std::string YamlReader::choice(const std::string& key, std::initializer_list<con
 
 void YamlReader::finish() const {
   for (const auto& kv : node_) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = key_text(kv.first);
     if (!used_.count(key)) fail(key, "unknown key (check the spelling; see the documented options)");
   }
 }

@@ -77,6 +77,8 @@ class YamlReader {
 
  private:
   YAML::Node scalar(const std::string& key);
+  // The text of a mapping key; a ConfigError if the key is not a plain scalar.
+  std::string key_text(const YAML::Node& key) const;
   // An absent optional key counts as read and yields `fallback`.
   template <class T, class Read>
   T or_fallback(const std::string& key, const T& fallback, const Read& read) {
