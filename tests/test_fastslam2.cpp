@@ -203,6 +203,25 @@ TEST(FastSlam2, PoseNeesIsConsistentInTheFirstHalfLap) {
   RecordProperty("average_nees_per_run", per_run);
 }
 
+// A 150 s simulated run with the given odometry noise per sample.
+sim::WorldRun noisy_world(std::uint64_t seed, double v_sigma_mps, double w_sigma_radps, sim::WorldOptions& w) {
+  w.seed = seed;
+  w.duration_s = 150.0;
+  w.v_sigma_mps = v_sigma_mps;
+  w.w_sigma_radps = w_sigma_radps;
+  return sim::simulate(w);
+}
+
+// The filter's mean pose after every odometry sample of the run.
+std::vector<eval::TimedPose> estimated_trajectory(FastSlam2& f, const sim::WorldRun& run) {
+  std::vector<eval::TimedPose> est;
+  feed(f, run, [&](std::size_t i) {
+    const PoseEstimate e = f.pose_estimate();
+    est.push_back({run.odometry[i].t_s, e.mean.x(), e.mean.y(), e.mean.z()});
+  });
+  return est;
+}
+
 // With large odometry noise (0.2 m/s, 0.2 rad/s per sample), over ~2 laps, the
 // filter's pose error is far below dead reckoning: for the correct filter the
 // ATE is ~0.11 of dead reckoning in total (0.28 m at worst per run on x86-64;
@@ -211,18 +230,9 @@ TEST(FastSlam2, PoseErrorFarBelowDeadReckoning) {
   double ate_sum = 0.0, dr_sum = 0.0;
   for (int r = 1; r <= 5; ++r) {
     sim::WorldOptions w;
-    w.seed = 100 + r;
-    w.duration_s = 150.0;
-    w.v_sigma_mps = 0.2;
-    w.w_sigma_radps = 0.2;
-    const sim::WorldRun run = sim::simulate(w);
+    const sim::WorldRun run = noisy_world(100 + r, 0.2, 0.2, w);
     FastSlam2 f(options_for_world(w, 100, static_cast<std::uint64_t>(r)), run.initial_pose);
-    std::vector<eval::TimedPose> est;
-    feed(f, run, [&](std::size_t i) {
-      const PoseEstimate e = f.pose_estimate();
-      est.push_back({run.odometry[i].t_s, e.mean.x(), e.mean.y(), e.mean.z()});
-    });
-    const eval::TrajectoryErrors slam = eval::compare_trajectory(est, run.truth);
+    const eval::TrajectoryErrors slam = eval::compare_trajectory(estimated_trajectory(f, run), run.truth);
     const eval::TrajectoryErrors dr = eval::compare_trajectory(dead_reckoning(run), run.truth);
     ASSERT_GT(slam.samples, 1000u);
     EXPECT_LT(slam.ate_rmse_m, 0.5 * dr.ate_rmse_m) << "run " << r;
@@ -245,11 +255,7 @@ TEST(FastSlam2, DelayedSamplingThroughACameraGap) {
   double ate_plain = 0.0, ate_delayed = 0.0, dr_sum = 0.0;
   for (int r = 1; r <= 5; ++r) {
     sim::WorldOptions w;
-    w.seed = 200 + r;
-    w.duration_s = 150.0;
-    w.v_sigma_mps = 0.1;
-    w.w_sigma_radps = 0.15;
-    sim::WorldRun run = sim::simulate(w);
+    sim::WorldRun run = noisy_world(200 + r, 0.1, 0.15, w);
     std::vector<ObservationFrame> kept;
     for (const ObservationFrame& f : run.frames) {
       if (f.t_s < 20.0 || f.t_s > 60.0) kept.push_back(f);
@@ -259,11 +265,7 @@ TEST(FastSlam2, DelayedSamplingThroughACameraGap) {
       FilterOptions o = options_for_world(w, 100, static_cast<std::uint64_t>(r));
       o.delayed_sampling.enabled = delayed;
       FastSlam2 f(o, run.initial_pose);
-      std::vector<eval::TimedPose> est;
-      feed(f, run, [&](std::size_t i) {
-        const PoseEstimate e = f.pose_estimate();
-        est.push_back({run.odometry[i].t_s, e.mean.x(), e.mean.y(), e.mean.z()});
-      });
+      const std::vector<eval::TimedPose> est = estimated_trajectory(f, run);
       if (counters) *counters = f.counters();
       if (last) *last = f.pose_estimate();
       return eval::compare_trajectory(est, run.truth).ate_rmse_m;

@@ -34,12 +34,18 @@ Bytes text(std::uint8_t first, const std::string& s) {
   return b;
 }
 
+pixyslam::msg::MessageHeader header(std::uint64_t seq, std::uint64_t period_ns, const char* frame_id) {
+  pixyslam::msg::MessageHeader h;
+  h.stamp_ns(1'000'000'000ull + seq * period_ns);
+  h.seq(seq);
+  h.robot_id("robot1");
+  h.frame_id(frame_id);
+  return h;
+}
+
 pixyslam::msg::Odometry odometry(std::uint64_t seq) {
   pixyslam::msg::Odometry m;
-  m.header().stamp_ns(1'000'000'000ull + seq * 100'000'000ull);
-  m.header().seq(seq);
-  m.header().robot_id("robot1");
-  m.header().frame_id("base_link");
+  m.header(header(seq, 100'000'000ull, "base_link"));
   m.v_mps(0.2);
   m.w_radps(0.1);
   m.period_s(0.1);
@@ -51,10 +57,7 @@ pixyslam::msg::Odometry odometry(std::uint64_t seq) {
 
 pixyslam::msg::LandmarkObservation observation(std::uint64_t seq) {
   pixyslam::msg::LandmarkObservation m;
-  m.header().stamp_ns(1'000'000'000ull + seq * 200'000'000ull);
-  m.header().seq(seq);
-  m.header().robot_id("robot1");
-  m.header().frame_id("camera");
+  m.header(header(seq, 200'000'000ull, "camera"));
   m.camera_frame(static_cast<std::uint32_t>(seq));
   m.blocks_in_frame(2);
   for (int id : {3, 7}) {
