@@ -12,7 +12,7 @@ shift || true
 targets=("$@")
 ((${#targets[@]})) || targets=(fuzz_arduino_parser fuzz_pixy_parser fuzz_yaml_options fuzz_mcap_reader fuzz_cdr_topics)
 build_dir=${FUZZ_BUILD_DIR:-$root/build-fuzz}
-if ! command -v clang++-14 >/dev/null || [[ ! -f /usr/lib/llvm-14/lib/clang/14.0.6/lib/linux/libclang_rt.fuzzer-x86_64.a ]]; then
+if ! command -v clang++-14 >/dev/null || ! compgen -G "/usr/lib/llvm-14/lib/clang/*/lib/linux/libclang_rt.fuzzer-*.a" >/dev/null; then
   echo "run_fuzz: clang-14 with libFuzzer (libclang-rt-14-dev) not installed, skipping"
   exit 77
 fi
