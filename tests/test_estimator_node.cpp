@@ -1,6 +1,8 @@
 // The estimator process's node, fed over DDS (loopback profile) with the
 // simulated world's odometry and camera frames by writers in this test.
 #include <chrono>
+#include <filesystem>
+#include <unistd.h>
 #include <mutex>
 #include <set>
 #include <string>
@@ -23,6 +25,38 @@ EstimatorOptions test_options() {
   o.status_period_s = 0.0;
   o.dds.robot_id = "test_robot";
   return o;
+}
+
+// Publishes the run's odometry and frames with stamps in [from_s, to_s],
+// interleaved by time, frames slightly out of order with odometry (as live:
+// odometry is sent at the end of its period).
+void feed(const sim::WorldRun& run, double from_s, double to_s, std::uint64_t base_ns,
+          dds::Writer<msg::Odometry>& odometry_writer, dds::Writer<msg::LandmarkObservation>& observation_writer) {
+  auto in_window = [&](double t) { return t >= from_s && t <= to_s; };
+  std::vector<slam::OdometrySample> odometry;
+  for (const slam::OdometrySample& s : run.odometry) {
+    if (in_window(s.t_s)) odometry.push_back(s);
+  }
+  std::vector<slam::ObservationFrame> frames;
+  for (const slam::ObservationFrame& f : run.frames) {
+    if (in_window(f.t_s)) frames.push_back(f);
+  }
+  std::size_t o = 0, f = 0;
+  const double period = run.odometry.size() > 1 ? run.odometry[1].t_s - run.odometry[0].t_s : 0.1;
+  while (o < odometry.size() || f < frames.size()) {
+    const bool send_odometry =
+        f == frames.size() || (o < odometry.size() && odometry[o].t_s + period <= frames[f].t_s);
+    if (send_odometry) {
+      const slam::OdometrySample& s = odometry[o++];
+      msg::Odometry m = test_support::odometry_msg(s, period, to_stamp_ns(s.t_s, base_ns));
+      ASSERT_TRUE(odometry_writer.publish(m));
+    } else {
+      const slam::ObservationFrame& frame = frames[f++];
+      msg::LandmarkObservation m = test_support::observation_msg(frame, to_stamp_ns(frame.t_s, base_ns));
+      ASSERT_TRUE(observation_writer.publish(m));
+    }
+    if ((o + f) % 50 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
 }
 
 TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
@@ -52,25 +86,7 @@ TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
   ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
   ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
 
-  // Interleave the streams by time, frames slightly out of order with odometry
-  // (as live: odometry is sent at the end of its period).
-  std::size_t o = 0, f = 0;
-  const double period = 1.0 / world.odometry_rate_hz;
-  while (o < run.odometry.size() || f < run.frames.size()) {
-    const bool send_odometry =
-        f == run.frames.size() ||
-        (o < run.odometry.size() && run.odometry[o].t_s + period <= run.frames[f].t_s);
-    if (send_odometry) {
-      const slam::OdometrySample& s = run.odometry[o++];
-      msg::Odometry m = test_support::odometry_msg(s, period, to_stamp_ns(s.t_s, base_ns));
-      ASSERT_TRUE(odometry_writer.publish(m));
-    } else {
-      const slam::ObservationFrame& frame = run.frames[f++];
-      msg::LandmarkObservation m = test_support::observation_msg(frame, to_stamp_ns(frame.t_s, base_ns));
-      ASSERT_TRUE(observation_writer.publish(m));
-    }
-    if ((o + f) % 50 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
+  feed(run, 0.0, world.duration_s, base_ns, odometry_writer, observation_writer);
   ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
   ASSERT_TRUE(observation_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
@@ -107,6 +123,102 @@ TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
   ASSERT_FALSE(states.empty());
   EXPECT_EQ(states.back().header().seq(), c.map_states_published);
   EXPECT_EQ(map_reader.lost(), 0u);
+}
+
+// A restarted estimator (same checkpoint file) continues the map: it starts from
+// the saved pose and landmarks although 2 s of sensor data went missing.
+TEST(EstimatorNode, ResumesFromItsCheckpointAfterARestart) {
+  sim::WorldOptions world;
+  world.duration_s = 50.0;
+  world.camera_rate_hz = 10.0;
+  world.max_range_m = 4.0;
+  const sim::WorldRun run = sim::simulate(world);
+  const std::uint64_t base_ns = dds::now_ns();
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("pixyslam_checkpoint_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  EstimatorOptions options = test_options();
+  options.initial_pose = run.initial_pose;
+  options.checkpoint.file = (dir / "checkpoint.yaml").string();
+  const double restart_s = 30.0, resume_s = 32.0;
+
+  auto run_node = [&](double from_s, double to_s, std::vector<eval::TimedPose>& estimate, bool& resumed) {
+    EstimatorNode node(options);
+    node.start();
+    dds::Participant sensors(options.dds, "test_sensors");
+    dds::Writer<msg::Odometry> odometry_writer(sensors);
+    dds::Writer<msg::LandmarkObservation> observation_writer(sensors);
+    ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
+    ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
+    feed(run, from_s, to_s, base_ns, odometry_writer, observation_writer);
+    ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+    ASSERT_TRUE(observation_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    node.stop();
+    EXPECT_GT(node.counters().checkpoints_written, 10u);
+    EXPECT_EQ(node.counters().checkpoint_errors, 0u);
+    resumed = node.counters().resumed;
+    for (const auto& [stamp_ns, pose] : node.trajectory()) {
+      estimate.push_back({static_cast<double>(stamp_ns - base_ns) * 1e-9, pose.x(), pose.y(), pose.z()});
+    }
+  };
+  std::vector<eval::TimedPose> before, after;
+  bool resumed_first = true, resumed_second = false;
+  run_node(0.0, restart_s, before, resumed_first);
+  const MapCheckpoint saved = read_map_checkpoint(options.checkpoint.file);
+  EXPECT_GE(saved.landmarks.size(), 8u);
+  EXPECT_FALSE(resumed_first);  // no file at the first start
+  run_node(resume_s, world.duration_s, after, resumed_second);
+  std::filesystem::remove_all(dir);
+  EXPECT_TRUE(resumed_second);
+
+  // From the first step after the restart the pose is near the truth (from
+  // scratch it would be the initial pose, metres away), and the pose error
+  // after the restart is as small as before it.
+  ASSERT_FALSE(after.empty());
+  std::vector<eval::TimedPose> first_second;
+  for (const eval::TimedPose& p : after) {
+    if (p.t_s <= after.front().t_s + 1.0) first_second.push_back(p);
+  }
+  EXPECT_LT(eval::compare_trajectory(first_second, run.truth).max_position_error_m, 0.5);
+  const eval::TrajectoryErrors errors_before = eval::compare_trajectory(before, run.truth);
+  const eval::TrajectoryErrors errors_after = eval::compare_trajectory(after, run.truth);
+  EXPECT_LT(errors_before.ate_rmse_m, 0.15);
+  EXPECT_LT(errors_after.ate_rmse_m, 0.15);
+}
+
+// A checkpoint older than max_age_s belongs to another run: ignored.
+TEST(EstimatorNode, IgnoresAStaleCheckpoint) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("pixyslam_stale_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  EstimatorOptions options = test_options();
+  options.checkpoint.file = (dir / "checkpoint.yaml").string();
+  MapCheckpoint old;
+  old.stamp_ns = dds::now_ns() - 3600ull * 1000000000ull;  // an hour ago
+  old.pose.mean = slam::Pose2(5.0, 5.0, 1.0);
+  old.landmarks.push_back({7, Eigen::Vector2d(6.0, 5.0), Eigen::Matrix2d::Identity() * 0.01, 3});
+  write_map_checkpoint(options.checkpoint.file, old);
+  {
+    EstimatorNode node(options);
+    node.start();
+    dds::Participant sensors(options.dds, "test_sensors");
+    dds::Writer<msg::Odometry> odometry_writer(sensors);
+    ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
+    slam::OdometrySample s;
+    s.v_mps = 0.1;
+    msg::Odometry m = test_support::odometry_msg(s, 0.1, dds::now_ns());
+    ASSERT_TRUE(odometry_writer.publish(m));
+    ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    node.stop();
+    EXPECT_FALSE(node.counters().resumed);
+    EXPECT_TRUE(node.latest_map_state().landmarks().empty());
+    EXPECT_NEAR(node.latest_map_state().mean_pose().x_m(), 0.0, 1e-9);
+  }
+  // The clean stop saved the new (empty) map over the stale one.
+  EXPECT_TRUE(read_map_checkpoint(options.checkpoint.file).landmarks.empty());
+  std::filesystem::remove_all(dir);
 }
 
 TEST(EstimatorOptions, ShippedConfigIsValid) {

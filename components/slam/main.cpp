@@ -1,6 +1,8 @@
 // slam_estimator: FastSLAM 2.0 over DDS. Odometry + LandmarkObservation in,
 // MapState out, until SIGINT/SIGTERM.
-//   slam_estimator --config config/slam_estimator.yaml [--seed S] [--out DIR]
+//   slam_estimator --config config/slam_estimator.yaml [--seed S] [--out DIR] [--checkpoint FILE]
+// --checkpoint (or estimator.checkpoint.file) saves the pose and map every
+// period and resumes from the file at start when it is fresh (a restart).
 // --out writes DIR/trajectory.csv (every MapState's mean pose) and DIR/landmarks.csv at exit.
 #include <cstdio>
 #include <filesystem>
@@ -38,13 +40,14 @@ int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
   return app::run_main("slam_estimator", [&] {
-    const app::CommandLine args(argc, argv, {"config", "seed", "out"});
+    const app::CommandLine args(argc, argv, {"config", "seed", "out", "checkpoint"});
     if (args.help()) {
-      std::puts("usage: slam_estimator --config FILE [--seed S] [--out DIR]");
+      std::puts("usage: slam_estimator --config FILE [--seed S] [--out DIR] [--checkpoint FILE]");
       return 0;
     }
     slam_node::EstimatorOptions options = slam_node::read_estimator_options_file(args.get("config"));
     if (args.has("seed")) options.filter.seed = static_cast<std::uint64_t>(args.number("seed", 0));
+    if (args.has("checkpoint")) options.checkpoint.file = args.get("checkpoint");
     std::fprintf(stderr, "slam_estimator: %d particles, seed %llu, DDS domain %d, profiles '%s'\n",
                  options.filter.particles, static_cast<unsigned long long>(options.filter.seed),
                  options.dds.domain_id, options.dds.profiles_file.c_str());

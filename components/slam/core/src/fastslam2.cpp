@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -13,6 +14,18 @@ namespace pixyslam::slam {
 namespace {
 
 constexpr double kMinLandmarkDistanceSq = 1e-6;  // (1 mm)^2
+// Above this initial heading sd the heading is split across particles.
+constexpr double kMaxLinearHeadingSigma = 0.05;
+
+// erf^-1 on (-1, 1) by Newton's method on std::erf (start: Winitzki's approximation).
+double inverse_erf(double y) {
+  const double a = 0.147;
+  const double l = std::log(1.0 - y * y);
+  const double t = 2.0 / (M_PI * a) + 0.5 * l;
+  double x = std::copysign(std::sqrt(std::sqrt(t * t - l / a) - t), y);
+  for (int k = 0; k < 3; ++k) x -= (std::erf(x) - y) / (2.0 / std::sqrt(M_PI) * std::exp(-x * x));
+  return x;
+}
 
 // Draws x ~ N(g.mean, g.cov); g.cov may be singular (positive semi-definite).
 Pose2 sample_pose(const PoseGaussian& g, std::mt19937_64& rng) {
@@ -46,12 +59,38 @@ bool exceeds(const Eigen::Matrix3d& cov, double heading_sigma, double position_s
 }  // namespace
 
 FastSlam2::FastSlam2(const FilterOptions& options, const Pose2& initial_pose)
+    : FastSlam2(options, PoseGaussian{initial_pose, Eigen::Matrix3d::Zero()}) {}
+
+FastSlam2::FastSlam2(const FilterOptions& options, const PoseGaussian& initial_pose)
     : options_(options), gate_d2_(0.0), rng_(options.seed) {
   validate(options_);
   gate_d2_ = gate_mahalanobis2(options_);
-  Particle p{PoseGaussian{initial_pose, Eigen::Matrix3d::Zero()}, 0.0, LandmarkMap(&pool_), JointGaussian{}};
+  if (!initial_pose.mean.allFinite() || !initial_pose.cov.allFinite() ||
+      initial_pose.cov.diagonal().minCoeff() < 0.0) {
+    throw std::invalid_argument("FastSlam2: the initial pose and its covariance must be finite, variances >= 0");
+  }
+  Particle p{initial_pose, 0.0, LandmarkMap(&pool_), JointGaussian{}};
   p.pose.mean.z() = wrap_angle(p.pose.mean.z());
   particles_.assign(static_cast<std::size_t>(options_.particles), p);
+  const double heading_var = initial_pose.cov(2, 2);
+  if (heading_var <= kMaxLinearHeadingSigma * kMaxLinearHeadingSigma) return;
+  // A wide heading: the range-bearing proposal is linear only for small heading
+  // errors, so the heading is split across the particles at the quantiles of
+  // its marginal and each particle keeps the position conditioned on its heading.
+  const Eigen::Vector2d gain = initial_pose.cov.block<2, 1>(0, 2) / heading_var;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  cov.topLeftCorner<2, 2>() =
+      initial_pose.cov.topLeftCorner<2, 2>() - gain * initial_pose.cov.block<1, 2>(2, 0);
+  cov(2, 2) = kMaxLinearHeadingSigma * kMaxLinearHeadingSigma;
+  const std::size_t m = particles_.size();
+  for (std::size_t i = 0; i < m; ++i) {
+    const double u = (static_cast<double>(i) + 0.5) / static_cast<double>(m);
+    const double offset = std::sqrt(heading_var) * std::sqrt(2.0) * inverse_erf(2.0 * u - 1.0);
+    PoseGaussian& g = particles_[i].pose;
+    g.mean.head<2>() = initial_pose.mean.head<2>() + gain * offset;
+    g.mean.z() = wrap_angle(initial_pose.mean.z() + offset);
+    g.cov = cov;
+  }
 }
 
 void FastSlam2::advance_to(double t_s) {

@@ -2,6 +2,9 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+
+#include "pixyslam/config/yaml_reader.h"
 
 #include "pixyslam/slam_node/map_state_conversions.h"
 
@@ -16,6 +19,18 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options)
       *participant_, [this](const msg::Odometry& m) { enqueue(m); });
   observation_reader_ = std::make_unique<dds::Reader<msg::LandmarkObservation>>(
       *participant_, [this](const msg::LandmarkObservation& m) { enqueue(m); });
+  const CheckpointOptions& k = options_.checkpoint;
+  if (!k.file.empty() && k.resume) {
+    if (!std::filesystem::exists(k.file)) {
+      std::fprintf(stderr, "slam_estimator: no checkpoint at %s: starting from scratch\n", k.file.c_str());
+    } else {
+      try {
+        checkpoint_ = read_map_checkpoint(k.file);
+      } catch (const config::ConfigError& e) {
+        std::fprintf(stderr, "slam_estimator: checkpoint unusable, starting from scratch: %s\n", e.what());
+      }
+    }
+  }
 }
 
 EstimatorNode::~EstimatorNode() {
@@ -39,7 +54,10 @@ void EstimatorNode::stop() {
     stopping_ = true;
   }
   inbox_cv_.notify_all();
-  if (thread_.joinable()) thread_.join();
+  if (!thread_.joinable()) return;
+  thread_.join();
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  if (filter_ && !options_.checkpoint.file.empty()) write_checkpoint(true);
 }
 
 void EstimatorNode::enqueue(Inbox&& item) {
@@ -140,9 +158,7 @@ void EstimatorNode::filter_loop() {
 void EstimatorNode::step(const slam::SensorInput& input) {
   std::lock_guard<std::mutex> lock(state_mutex_);
   const auto begin = std::chrono::steady_clock::now();
-  if (!filter_) {
-    filter_ = std::make_unique<slam::FastSlam2>(options_.filter, options_.initial_pose);
-  }
+  if (!filter_) create_filter(slam::input_time(input));
   if (const auto* odometry = std::get_if<slam::OdometryInput>(&input)) {
     filter_->add_odometry(odometry->sample);
     last_odometry_seq_ = odometry->seq;
@@ -164,6 +180,69 @@ void EstimatorNode::step(const slam::SensorInput& input) {
                            slam::Pose2(mean.x_m(), mean.y_m(), mean.theta_rad()));
   ++counters_.steps;
   if (map_writer_->publish(map_state_)) ++counters_.map_states_published;
+  const std::uint64_t stamp = map_state_.header().stamp_ns();
+  if (!options_.checkpoint.file.empty() &&
+      (counters_.checkpoints_written + counters_.checkpoint_errors == 0 ||
+       stamp >= last_checkpoint_ns_ + static_cast<std::uint64_t>(options_.checkpoint.period_s * 1e9))) {
+    write_checkpoint(false);
+  }
+}
+
+void EstimatorNode::create_filter(double first_t_s) {
+  const CheckpointOptions& k = options_.checkpoint;
+  if (checkpoint_) {
+    const MapCheckpoint& c = *checkpoint_;
+    const double gap_s =
+        static_cast<double>(static_cast<std::int64_t>(epoch_ns_ - c.stamp_ns)) * 1e-9 + first_t_s;
+    // A checkpoint from the future (another clock, a replayed log) is as unusable as an old one.
+    if (gap_s >= -1.0 && gap_s <= k.max_age_s) {
+      const slam::PoseGaussian pose = resume_pose(c, gap_s, k.max_speed_mps, k.max_turn_rate_radps);
+      filter_ = std::make_unique<slam::FastSlam2>(options_.filter, pose);
+      filter_->set_prior_map(c.landmarks);
+      counters_.resumed = true;
+      std::fprintf(stderr,
+                   "slam_estimator: resumed from %s: %.1f s old, %zu landmarks, pose (%.3f, %.3f, %.3f) "
+                   "sd %.2f m / %.2f rad\n",
+                   k.file.c_str(), gap_s, c.landmarks.size(), pose.mean.x(), pose.mean.y(), pose.mean.z(),
+                   std::sqrt(std::max(pose.cov(0, 0), pose.cov(1, 1))), std::sqrt(pose.cov(2, 2)));
+    } else {
+      std::fprintf(stderr,
+                   "slam_estimator: checkpoint %s is %.1f s old (usable: -1 .. %.1f s): starting from scratch\n",
+                   k.file.c_str(), gap_s, k.max_age_s);
+    }
+    checkpoint_.reset();
+  }
+  if (!filter_) filter_ = std::make_unique<slam::FastSlam2>(options_.filter, options_.initial_pose);
+}
+
+void EstimatorNode::write_checkpoint(bool final) {
+  MapCheckpoint c;
+  c.stamp_ns = map_state_.header().stamp_ns();
+  const msg::Pose2D& mean = map_state_.mean_pose();
+  c.pose.mean = slam::Pose2(mean.x_m(), mean.y_m(), mean.theta_rad());
+  for (int i = 0; i < 9; ++i) c.pose.cov(i / 3, i % 3) = map_state_.pose_covariance()[static_cast<std::size_t>(i)];
+  c.pose.cov = 0.5 * (c.pose.cov + c.pose.cov.transpose()).eval();
+  for (const msg::LandmarkEstimate& l : map_state_.landmarks()) {
+    slam::LandmarkEstimate e;
+    e.id = l.landmark_id();
+    e.mean = Eigen::Vector2d(l.x_m(), l.y_m());
+    e.cov << l.cov_xx_m2(), l.cov_xy_m2(), l.cov_xy_m2(), l.cov_yy_m2();
+    e.times_observed = l.times_observed();
+    c.landmarks.push_back(e);
+  }
+  try {
+    write_map_checkpoint(options_.checkpoint.file, c);
+    ++counters_.checkpoints_written;
+    last_checkpoint_ns_ = c.stamp_ns;
+    if (final) {
+      std::fprintf(stderr, "slam_estimator: final checkpoint %s (%zu landmarks)\n",
+                   options_.checkpoint.file.c_str(), c.landmarks.size());
+    }
+  } catch (const std::runtime_error& e) {
+    // Logged on the first failure and every 100th after it; the filter goes on.
+    if (counters_.checkpoint_errors++ % 100 == 0) std::fprintf(stderr, "slam_estimator: %s\n", e.what());
+    last_checkpoint_ns_ = c.stamp_ns;
+  }
 }
 
 void EstimatorNode::log_status() const {
@@ -173,7 +252,7 @@ void EstimatorNode::log_status() const {
   std::fprintf(stderr,
                "slam_estimator: odometry %llu (lost %llu), observations %llu (lost %llu), "
                "steps %llu, late %llu, reordered %llu; detections used %llu, new %llu, gated %llu, "
-               "invalid %llu; resamples %llu; landmarks %zu\n",
+               "invalid %llu; resamples %llu; landmarks %zu; checkpoints %llu (errors %llu)%s\n",
                static_cast<unsigned long long>(c.odometry_received),
                static_cast<unsigned long long>(c.odometry_lost),
                static_cast<unsigned long long>(c.observations_received),
@@ -184,7 +263,9 @@ void EstimatorNode::log_status() const {
                static_cast<unsigned long long>(f.observations_new_landmark),
                static_cast<unsigned long long>(f.observations_gated),
                static_cast<unsigned long long>(f.observations_invalid),
-               static_cast<unsigned long long>(f.resamples), map_state_.landmarks().size());
+               static_cast<unsigned long long>(f.resamples), map_state_.landmarks().size(),
+               static_cast<unsigned long long>(c.checkpoints_written),
+               static_cast<unsigned long long>(c.checkpoint_errors), c.resumed ? "; resumed" : "");
 }
 
 }  // namespace pixyslam::slam_node

@@ -31,6 +31,18 @@ EstimatorOptions read_estimator_options_file(const std::string& path) {
       estimator.integer("published_particle_poses", 0, 512, o.published_particle_poses));
   o.landmarks = estimator.choice("landmarks", {"best", "mixture"}, o.landmarks);
   o.status_period_s = estimator.number("status_period_s", 0.0, 3600.0, o.status_period_s);
+  if (estimator.has("checkpoint")) {
+    config::YamlReader c = estimator.child("checkpoint");
+    CheckpointOptions& k = o.checkpoint;
+    k.file = c.text("file", k.file);
+    if (!k.file.empty() && k.file.front() != '/') k.file = app::folder_of(path) + "/" + k.file;
+    k.period_s = c.number("period_s", 0.01, 3600.0, k.period_s);
+    k.resume = c.boolean("resume", k.resume);
+    k.max_age_s = c.number("max_age_s", 0.0, 1e9, k.max_age_s);
+    k.max_speed_mps = c.number("max_speed_mps", 0.0, 100.0, k.max_speed_mps);
+    k.max_turn_rate_radps = c.number("max_turn_rate_radps", 0.0, 100.0, k.max_turn_rate_radps);
+    c.finish();
+  }
   estimator.finish();
 
   if (root.has("dds")) {

@@ -76,6 +76,11 @@ struct FilterCounters {
 class FastSlam2 {
  public:
   FastSlam2(const FilterOptions& options, const Pose2& initial_pose);
+  // Every particle starts with this pose Gaussian (not sampled: the first
+  // frame's proposal folds its observations into it), e.g. a restart whose
+  // pose is only roughly known. A heading sd above 0.05 rad is split across
+  // the particles (quantiles of its marginal, position conditioned on it).
+  FastSlam2(const FilterOptions& options, const PoseGaussian& initial_pose);
   FastSlam2(const FastSlam2&) = delete;
   FastSlam2& operator=(const FastSlam2&) = delete;
 

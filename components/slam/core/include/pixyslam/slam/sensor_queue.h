@@ -25,6 +25,12 @@ struct ObservationInput {
 
 using SensorInput = std::variant<OdometryInput, ObservationInput>;
 
+// The time an input refers to.
+inline double input_time(const SensorInput& input) {
+  if (const auto* o = std::get_if<OdometryInput>(&input)) return o->sample.t_s;
+  return std::get<ObservationInput>(input).frame.t_s;
+}
+
 // How long a live stream may lag behind the wall clock before the queue stops
 // waiting for it. Odometry is stamped at the start of its period and sent at
 // its end, so it lags by about one period; camera frames by their transport only.

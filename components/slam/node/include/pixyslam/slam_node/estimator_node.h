@@ -6,6 +6,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <utility>
 #include <variant>
@@ -18,6 +19,7 @@
 #include "pixyslam/slam/fastslam2.h"
 #include "pixyslam/slam/sensor_queue.h"
 #include "pixyslam/slam_node/estimator_options.h"
+#include "pixyslam/slam_node/map_checkpoint.h"
 
 namespace pixyslam::slam_node {
 
@@ -30,6 +32,9 @@ struct EstimatorCounters {
   std::uint64_t map_states_published = 0;
   std::uint64_t samples_late = 0;
   std::uint64_t samples_reordered = 0;
+  std::uint64_t checkpoints_written = 0;
+  std::uint64_t checkpoint_errors = 0;
+  bool resumed = false;                  // started from a checkpoint
 };
 
 // The SLAM estimator process: subscribes to Odometry and LandmarkObservation,
@@ -60,6 +65,9 @@ class EstimatorNode {
   void enqueue(Inbox&& item);
   void filter_loop();
   void step(const slam::SensorInput& input);
+  // The filter, from the checkpoint when there is a fresh one (state_mutex_ held).
+  void create_filter(double first_t_s);
+  void write_checkpoint(bool final);
   void log_status() const;
 
   EstimatorOptions options_;
@@ -85,6 +93,8 @@ class EstimatorNode {
   msg::MapState map_state_;
   std::vector<std::pair<std::uint64_t, slam::Pose2>> trajectory_;
   EstimatorCounters counters_;
+  std::optional<MapCheckpoint> checkpoint_;  // read at start, used by create_filter()
+  std::uint64_t last_checkpoint_ns_ = 0;
 };
 
 }  // namespace pixyslam::slam_node

@@ -9,6 +9,17 @@
 
 namespace pixyslam::slam_node {
 
+// `estimator.checkpoint`: the pose and map saved every period_s of filter time
+// (and at a clean stop), so a restarted estimator continues the map.
+struct CheckpointOptions {
+  std::string file;                  // "" = no checkpoints; relative to the config file's folder
+  double period_s = 1.0;             // filter time between writes
+  bool resume = true;                // start from the file when it is fresh enough
+  double max_age_s = 30.0;           // older than this at the first input: start from scratch
+  double max_speed_mps = 0.5;        // how fast the robot may have moved while no estimator ran
+  double max_turn_rate_radps = 1.0;  // (they widen the resumed pose's covariance)
+};
+
 // Everything the estimator process is configured with (config/slam_estimator.yaml).
 struct EstimatorOptions {
   slam::FilterOptions filter;            // `filter:` (see config/slam_mrclam.yaml for the keys)
@@ -18,6 +29,7 @@ struct EstimatorOptions {
   int published_particle_poses = 100;    // MapState.particle_poses subsample size (<= 512)
   std::string landmarks = "best";        // MapState landmarks: "best" particle or "mixture"
   double status_period_s = 10.0;         // counters to the log every so often (0: never)
+  CheckpointOptions checkpoint;          // `estimator.checkpoint`
   dds::DdsOptions dds;                   // `dds:`
 };
 

@@ -1,0 +1,147 @@
+// The estimator's checkpoint file (pose + map to resume from) and the filter
+// started from a pose Gaussian, as a restart uses them.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/slam/fastslam2.h"
+#include "pixyslam/slam_node/map_checkpoint.h"
+
+namespace pixyslam::slam_node {
+namespace {
+
+MapCheckpoint sample_checkpoint() {
+  MapCheckpoint c;
+  c.stamp_ns = 1732400000123456789ull;
+  c.pose.mean = slam::Pose2(1.25, -0.5, 2.9);
+  c.pose.cov << 0.01, 0.002, 0.0001, 0.002, 0.02, -0.0003, 0.0001, -0.0003, 0.004;
+  c.landmarks.push_back({3, Eigen::Vector2d(2.0 / 3.0, 1e-7), (Eigen::Matrix2d() << 0.003, 0.001, 0.001, 0.002).finished(), 17});
+  c.landmarks.push_back({12, Eigen::Vector2d(-4.5, 3.25), Eigen::Matrix2d::Identity() * 0.05, 1});
+  return c;
+}
+
+TEST(MapCheckpoint, RoundTripsExactly) {
+  const MapCheckpoint c = sample_checkpoint();
+  const MapCheckpoint back = parse_map_checkpoint(to_yaml(c), "checkpoint.yaml");
+  EXPECT_EQ(back.stamp_ns, c.stamp_ns);
+  EXPECT_EQ(back.pose.mean, c.pose.mean);
+  EXPECT_EQ(back.pose.cov, c.pose.cov);
+  ASSERT_EQ(back.landmarks.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(back.landmarks[i].id, c.landmarks[i].id);
+    EXPECT_EQ(back.landmarks[i].mean, c.landmarks[i].mean);
+    EXPECT_EQ(back.landmarks[i].cov, c.landmarks[i].cov);
+    EXPECT_EQ(back.landmarks[i].times_observed, c.landmarks[i].times_observed);
+  }
+  MapCheckpoint empty;
+  EXPECT_TRUE(parse_map_checkpoint(to_yaml(empty), "empty.yaml").landmarks.empty());
+}
+
+TEST(MapCheckpoint, BadFilesAreErrorsNamingFileAndKey) {
+  const std::string good = to_yaml(sample_checkpoint());
+  auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string text = good;
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return text.replace(at, from.size(), to);
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {replaced("version: 1", "version: 2"), "key 'version'"},
+      {replaced("  x_m: 1.25", "  x_m: .nan"), "key 'pose.x_m'"},
+      {replaced("  cov_tt: 0.004", "  cov_tt: -1"), "key 'pose.cov_tt'"},
+      {replaced("  cov_xy: 0.002", "  cov_xy: 0.9"), "not positive semi-definite"},
+      {replaced("{id: 12,", "{id: 3,"), "appears twice"},
+      {replaced("cov_yy_m2: 0.05", "cov_yy_m2: oops"), "key 'landmarks[1].cov_yy_m2'"},
+      {replaced("stamp_ns:", "stamp:"), "stamp"},
+      {good.substr(0, good.size() / 2), "torn.yaml"},
+  };
+  for (const auto& [text, expected] : cases) {
+    try {
+      parse_map_checkpoint(text, "torn.yaml");
+      ADD_FAILURE() << "accepted:\n" << text;
+    } catch (const config::ConfigError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("torn.yaml"), std::string::npos) << what;
+      EXPECT_NE(what.find(expected), std::string::npos) << "wanted '" << expected << "' in: " << what;
+    }
+  }
+  EXPECT_THROW(read_map_checkpoint("/nonexistent/checkpoint.yaml"), config::ConfigError);
+}
+
+TEST(MapCheckpoint, WriteReplacesTheFileWholeAndLeavesNoTemporary) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("pixyslam_ckpt_unit_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "c.yaml").string();
+  MapCheckpoint c = sample_checkpoint();
+  write_map_checkpoint(path, c);
+  c.landmarks.pop_back();
+  c.stamp_ns += 1000;
+  write_map_checkpoint(path, c);
+  const MapCheckpoint back = read_map_checkpoint(path);
+  EXPECT_EQ(back.stamp_ns, c.stamp_ns);
+  EXPECT_EQ(back.landmarks.size(), 1u);
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+  EXPECT_THROW(write_map_checkpoint((dir / "missing" / "c.yaml").string(), c), std::runtime_error);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(MapCheckpoint, ResumePoseWidensWithTheGap) {
+  const MapCheckpoint c = sample_checkpoint();
+  const slam::PoseGaussian now = resume_pose(c, 0.0, 0.5, 1.0);
+  EXPECT_EQ(now.cov, c.pose.cov);
+  const slam::PoseGaussian later = resume_pose(c, 2.0, 0.5, 1.0);
+  EXPECT_EQ(later.mean, c.pose.mean);
+  EXPECT_NEAR(later.cov(0, 0), c.pose.cov(0, 0) + 0.25, 1e-12);  // (0.5 m/s * 2 s / 2)^2
+  EXPECT_NEAR(later.cov(1, 1), c.pose.cov(1, 1) + 0.25, 1e-12);
+  EXPECT_NEAR(later.cov(2, 2), c.pose.cov(2, 2) + 1.0, 1e-12);    // (1 rad/s * 2 s / 2)^2
+  EXPECT_NEAR(resume_pose(c, 1e6, 0.5, 1.0).cov(2, 2), c.pose.cov(2, 2) + M_PI * M_PI, 1e-9);
+}
+
+// A filter restarted 0.4 m and 0.15 rad off with a saved map: started with the
+// widened covariance it locks on to the map within a few frames.
+TEST(MapCheckpoint, FilterStartedFromAWidePoseGaussianLocksOnToThePriorMap) {
+  slam::FilterOptions options;
+  options.particles = 100;
+  options.seed = 3;
+  const slam::Pose2 truth(1.0, 0.5, 0.3);
+  std::vector<slam::LandmarkEstimate> map;
+  for (int i = 0; i < 6; ++i) {
+    const double a = -0.6 + 0.25 * i;
+    map.push_back({i + 1, truth.head<2>() + 2.5 * Eigen::Vector2d(std::cos(truth.z() + a), std::sin(truth.z() + a)),
+                   Eigen::Matrix2d::Identity() * 1e-4, 20});
+  }
+  MapCheckpoint c;
+  c.pose.mean = truth + slam::Pose2(0.3, -0.25, 0.15);
+  c.pose.cov = Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal();
+  c.landmarks = map;
+  slam::FastSlam2 filter(options, resume_pose(c, 2.0, 0.5, 0.3));
+  filter.set_prior_map(map);
+  for (int k = 0; k < 5; ++k) {
+    slam::ObservationFrame frame;
+    frame.t_s = 0.1 * k;
+    for (const slam::LandmarkEstimate& l : map) {
+      const Eigen::Vector2d d = l.mean - truth.head<2>();
+      frame.detections.push_back({l.id, d.norm(), slam::wrap_angle(std::atan2(d.y(), d.x()) - truth.z()), 0.05, 0.02});
+    }
+    filter.add_observations(frame);
+  }
+  const slam::PoseEstimate e = filter.pose_estimate();
+  EXPECT_LT((e.mean.head<2>() - truth.head<2>()).norm(), 0.05);
+  EXPECT_LT(std::abs(slam::wrap_angle(e.mean.z() - truth.z())), 0.03);
+  EXPECT_EQ(filter.counters().observations_gated, 0u);
+}
+
+TEST(MapCheckpoint, FilterRejectsANonFiniteStartPose) {
+  slam::PoseGaussian bad;
+  bad.cov(2, 2) = std::nan("");
+  EXPECT_THROW(slam::FastSlam2(slam::FilterOptions{}, bad), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pixyslam::slam_node
