@@ -32,6 +32,8 @@ RobotSimProcessConfig read_robot_sim_process_config(const std::string& sim_yaml,
   r.ground_truth_rate_hz = run.number("ground_truth_rate_hz", 0.1, 1000.0, r.ground_truth_rate_hz);
   r.tick_s = run.number("tick_s", 0.0005, 0.1, r.tick_s);
   r.speed_factor = run.number("speed_factor", 0.1, 10.0, r.speed_factor);
+  r.unplug_at_s = run.number("unplug_at_s", 0.0, 1e6, r.unplug_at_s);
+  r.unplug_for_s = run.number("unplug_for_s", 0.01, 3600.0, r.unplug_for_s);
   run.finish();
   if (root.has("dds")) {
     config::YamlReader dds = root.child("dds");
@@ -51,8 +53,7 @@ struct RobotSimNode::Impl {
       const auto folder = std::filesystem::path(link).parent_path();
       if (!folder.empty()) std::filesystem::create_directories(folder);
     }
-    arduino = std::make_unique<serial::PseudoTerminal>(c.run.arduino_link);
-    pixy = std::make_unique<serial::PseudoTerminal>(c.run.pixy_link);
+    plug_in();
     for (const sim::Pole& pole : emulator.poles()) {
       if (!emulator.signature_of(pole.id)) continue;  // invisible: not part of the map
       msg::TrueLandmark l;
@@ -60,6 +61,22 @@ struct RobotSimNode::Impl {
       l.x_m(pole.x_m);
       l.y_m(pole.y_m);
       landmarks.push_back(l);
+    }
+  }
+
+  void plug_in() {
+    arduino = std::make_unique<serial::PseudoTerminal>(config.run.arduino_link);
+    pixy = std::make_unique<serial::PseudoTerminal>(config.run.pixy_link);
+  }
+
+  // Bytes to a device, or lost while it is unplugged.
+  template <class Bytes>
+  void write(std::unique_ptr<serial::PseudoTerminal>& device, const Bytes& bytes) {
+    if (bytes.empty()) return;
+    if (device) {
+      device->write_all(bytes);
+    } else {
+      unplugged_bytes += bytes.size();
     }
   }
 
@@ -85,6 +102,8 @@ struct RobotSimNode::Impl {
   std::unique_ptr<serial::PseudoTerminal> pixy;
   std::vector<msg::TrueLandmark> landmarks;
   std::uint64_t power_on_ns = 0;
+  std::uint64_t unplugged_bytes = 0;
+  std::uint64_t dropped_bytes = 0;  // by the ptys' drop policy, over every pty the run had
 };
 
 RobotSimNode::RobotSimNode(const RobotSimProcessConfig& config) : impl_(std::make_unique<Impl>(config)) {}
@@ -114,8 +133,19 @@ double RobotSimNode::run() {
     t = std::chrono::duration<double>(Clock::now() - start).count() * run.speed_factor;
     if (run.duration_s > 0.0 && t > run.duration_s) t = run.duration_s;
     const HardwareOutput out = s.emulator.advance_to(t);
-    if (!out.arduino_bytes.empty()) s.arduino->write_all(out.arduino_bytes);
-    if (!out.pixy_bytes.empty()) s.pixy->write_all(out.pixy_bytes);
+    if (run.unplug_at_s > 0.0 && s.arduino && t >= run.unplug_at_s && t < run.unplug_at_s + run.unplug_for_s) {
+      s.dropped_bytes += s.arduino->counters().dropped_bytes + s.pixy->counters().dropped_bytes;
+      s.arduino.reset();
+      s.pixy.reset();
+      std::fprintf(stderr, "robot_sim: t %.1f s: serial devices unplugged for %.1f s\n", t, run.unplug_for_s);
+    } else if (!s.arduino && t >= run.unplug_at_s + run.unplug_for_s) {
+      s.plug_in();
+      std::fprintf(stderr, "robot_sim: t %.1f s: serial devices plugged back in (%s, %s); %llu bytes lost\n", t,
+                   s.arduino->slave_path().c_str(), s.pixy->slave_path().c_str(),
+                   static_cast<unsigned long long>(s.unplugged_bytes));
+    }
+    s.write(s.arduino, out.arduino_bytes);
+    s.write(s.pixy, out.pixy_bytes);
     for (const eval::TimedPose& pose : out.truth) {
       if (pose.t_s + 1e-9 < next_truth_s) continue;
       s.publish_truth(pose);
@@ -139,15 +169,17 @@ double RobotSimNode::run() {
   std::fprintf(stderr,
                "robot_sim: done at t %.1f s: %llu Arduino lines, %llu Pixy frames (%llu sent), %llu blocks "
                "(%llu clipped); poles behind %llu, out of range %llu, outside image %llu, too small %llu; "
-               "%llu ground truth messages; pty bytes dropped %llu / %llu\n",
+               "%llu ground truth messages; serial bytes dropped %llu, lost while unplugged %llu\n",
                t, static_cast<unsigned long long>(c.arduino_lines), static_cast<unsigned long long>(c.pixy_frames),
                static_cast<unsigned long long>(c.pixy_frames_sent), static_cast<unsigned long long>(c.blocks_sent),
                static_cast<unsigned long long>(c.blocks_clipped), static_cast<unsigned long long>(c.behind_camera),
                static_cast<unsigned long long>(c.out_of_range), static_cast<unsigned long long>(c.outside_image),
                static_cast<unsigned long long>(c.too_small),
                static_cast<unsigned long long>(s.truth_writer.published()),
-               static_cast<unsigned long long>(s.arduino->counters().dropped_bytes),
-               static_cast<unsigned long long>(s.pixy->counters().dropped_bytes));
+               static_cast<unsigned long long>(s.dropped_bytes +
+                                               (s.arduino ? s.arduino->counters().dropped_bytes : 0) +
+                                               (s.pixy ? s.pixy->counters().dropped_bytes : 0)),
+               static_cast<unsigned long long>(s.unplugged_bytes));
   return t;
 }
 
