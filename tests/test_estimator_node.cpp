@@ -1,6 +1,7 @@
 // The estimator process's node, fed over DDS (loopback profile) with the
 // simulated world's odometry and camera frames by writers in this test.
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <unistd.h>
 #include <mutex>
@@ -219,6 +220,59 @@ TEST(EstimatorNode, IgnoresAStaleCheckpoint) {
   // The clean stop saved the new (empty) map over the stale one.
   EXPECT_TRUE(read_map_checkpoint(options.checkpoint.file).landmarks.empty());
   std::filesystem::remove_all(dir);
+}
+
+// Rejected input is counted and shows on the diagnostics topic: WARN naming the
+// counter that grew, then OK again once nothing more is rejected.
+TEST(EstimatorNode, ReportsRejectedInputOnTheDiagnosticsTopic) {
+  EstimatorOptions options = test_options();
+  options.dds.diagnostics_period_s = 0.2;
+  EstimatorNode node(options);
+  node.start();
+  dds::Participant sensors(options.dds, "test_sensors");
+  dds::Writer<msg::Odometry> odometry_writer(sensors);
+  std::mutex mutex;
+  std::vector<msg::Diagnostics> reports;
+  dds::Reader<msg::Diagnostics> diagnostics_reader(sensors, [&](const msg::Diagnostics& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (m.process() == "slam_estimator") reports.push_back(m);
+  });
+  ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  const std::uint64_t base_ns = dds::now_ns();
+  slam::OdometrySample good;
+  good.v_mps = 0.1;
+  slam::OdometrySample bad = good;
+  bad.w_radps = std::nan("");
+  for (int i = 0; i < 3; ++i) {
+    good.t_s = bad.t_s = 0.1 * i;
+    msg::Odometry m = test_support::odometry_msg(i == 1 ? bad : good, 0.1, to_stamp_ns(good.t_s, base_ns));
+    ASSERT_TRUE(odometry_writer.publish(m));
+  }
+  ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  node.stop();
+  std::lock_guard<std::mutex> lock(mutex);
+  ASSERT_GE(reports.size(), 3u);
+  auto counter = [](const msg::Diagnostics& d, const std::string& name) -> std::int64_t {
+    for (const msg::DiagnosticCounter& c : d.counters()) {
+      if (c.name() == name) return static_cast<std::int64_t>(c.value());
+    }
+    return -1;
+  };
+  int warnings = 0;
+  for (const msg::Diagnostics& d : reports) {
+    EXPECT_EQ(d.header().frame_id(), "slam_estimator");
+    EXPECT_EQ(d.pid(), static_cast<std::uint32_t>(::getpid()));
+    if (d.level() == 1) {
+      ++warnings;
+      EXPECT_EQ(d.status(), "odometry_invalid +1");
+      EXPECT_EQ(counter(d, "odometry_invalid"), 1);
+    }
+  }
+  EXPECT_EQ(warnings, 1);
+  EXPECT_EQ(reports.back().level(), 0);
+  EXPECT_EQ(counter(reports.back(), "odometry_received"), 3);
+  EXPECT_EQ(counter(reports.back(), "odometry_invalid"), 1);
 }
 
 TEST(EstimatorOptions, ShippedConfigIsValid) {

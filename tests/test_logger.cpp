@@ -148,7 +148,7 @@ TEST(CdrPayload, StrictDecodingRejectsCutPaddedAndMistypedPayloads) {
 
 TEST(CdrPayload, KnownTopicsAreTheSystemsTopicsWithTheirDdsTypeNames) {
   const auto& topics = known_topics();
-  ASSERT_EQ(topics.size(), 4u);
+  ASSERT_EQ(topics.size(), 5u);
   EXPECT_EQ(topics[0].topic, dds::kOdometryTopic);
   EXPECT_EQ(topics[0].type_name, "pixyslam::msg::Odometry");
   EXPECT_EQ(topics[0].idl_stem, "odometry");
@@ -156,6 +156,8 @@ TEST(CdrPayload, KnownTopicsAreTheSystemsTopicsWithTheirDdsTypeNames) {
   ASSERT_NE(find_topic("pixyslam/ground_truth"), nullptr);
   EXPECT_EQ(find_topic("pixyslam/ground_truth")->type_name, "pixyslam::msg::GroundTruth");
   EXPECT_EQ(find_topic("odometry"), nullptr);
+  EXPECT_EQ(topics[4].topic, dds::kDiagnosticsTopic);
+  EXPECT_EQ(topics[4].type_name, "pixyslam::msg::Diagnostics");
 }
 
 // ---------------------------------------------------------------- topic patterns, file names
@@ -181,7 +183,8 @@ const std::vector<std::string> kKnown = {"pixyslam/odometry", "pixyslam/landmark
 
 TEST(TopicSelection, IncludesExcludesAndKeepsTheKnownOrder) {
   EXPECT_EQ(select_topics({"pixyslam/*", "!pixyslam/ground_truth"}, kKnown).topics,
-            (std::vector<std::string>{"pixyslam/odometry", "pixyslam/landmark_observation", "pixyslam/map_state"}));
+            (std::vector<std::string>{"pixyslam/odometry", "pixyslam/landmark_observation", "pixyslam/map_state",
+                                      "pixyslam/diagnostics"}));
   EXPECT_EQ(select_topics({"!pixyslam/ground_truth", "!*observation"}, kKnown).topics,
             (std::vector<std::string>{"pixyslam/odometry", "pixyslam/map_state"}));
   EXPECT_EQ(select_topics({"pixyslam/map_state", "pixyslam/odometry"}, kKnown).topics,
@@ -232,7 +235,7 @@ std::string config_error(const std::string& yaml) {
 TEST(LoggerOptions, ShippedConfigLoads) {
   const LoggerOptions o = read_logger_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/logger.yaml");
   EXPECT_EQ(o.output_file, "pixyslam_run.mcap");
-  EXPECT_EQ(o.topics.size(), 4u);
+  EXPECT_EQ(o.topics.size(), 5u);
   EXPECT_EQ(o.chunk_size_bytes, 1048576u);
   EXPECT_EQ(o.compression, default_compression());
   EXPECT_DOUBLE_EQ(o.flush_period_s, 1.0);
@@ -269,7 +272,8 @@ TEST(LoggerOptions, TopicPatternsAndRotation) {
       "logger_test.yaml");
   const LoggerOptions o = read_logger_options(root, "/cfg");
   EXPECT_EQ(o.topics,
-            (std::vector<std::string>{"pixyslam/odometry", "pixyslam/landmark_observation", "pixyslam/map_state"}));
+            (std::vector<std::string>{"pixyslam/odometry", "pixyslam/landmark_observation", "pixyslam/map_state",
+                                      "pixyslam/diagnostics"}));
   EXPECT_EQ(o.rotate_size_bytes, 1000000u);
   EXPECT_DOUBLE_EQ(o.rotate_period_s, 60.0);
   EXPECT_TRUE(rotation_enabled(o));
@@ -354,6 +358,7 @@ LoggerOptions node_options(const std::string& path) {
   o.output_file = path;
   o.dds = loopback_options();
   o.chunk_size_bytes = 4096;  // many chunks, so that a cut file still holds some
+  o.dds.diagnostics_period_s = 0.0;  // no reports of its own: the message counts stay exact
   return o;
 }
 
@@ -553,8 +558,9 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
   const std::map<std::string, std::uint64_t> expected = {{"pixyslam/odometry", 500},
                                                          {"pixyslam/landmark_observation", 50},
                                                          {"pixyslam/map_state", 100},
-                                                         {"pixyslam/ground_truth", 20}};
-  ASSERT_EQ(c.topics.size(), 4u);
+                                                         {"pixyslam/ground_truth", 20},
+                                                         {"pixyslam/diagnostics", 0}};
+  ASSERT_EQ(c.topics.size(), 5u);
   for (const auto& [topic, count] : expected) {
     const TopicCounters& t = topic_counters(c, topic);
     EXPECT_EQ(t.received, count) << topic;
@@ -579,8 +585,8 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
   }
 
   // Channels and schemas.
-  ASSERT_EQ(reader.channels().size(), 4u);
-  ASSERT_EQ(reader.schemas().size(), 4u);
+  ASSERT_EQ(reader.channels().size(), 5u);
+  ASSERT_EQ(reader.schemas().size(), 5u);
   for (const TopicInfo& info : known_topics()) {
     const logger::McapChannel* channel = reader.find_channel(info.topic);
     ASSERT_NE(channel, nullptr) << info.topic;
@@ -749,7 +755,7 @@ TEST(LoggerNode, RotatesBySizeIntoCompleteFiles) {
   const LoggerCounters c = node.counters();
   EXPECT_TRUE(c.error.empty()) << c.error;
   EXPECT_GE(files.size(), 3u);
-  expect_complete_rotation(files, c, 3, kCount);
+  expect_complete_rotation(files, c, 4, kCount);  // all but the ground truth
   for (std::size_t i = 0; i + 1 < files.size(); ++i) {
     const auto size = std::filesystem::file_size(files[i]);
     EXPECT_GE(size + 8192, options.rotate_size_bytes) << files[i];  // rotated near the limit,

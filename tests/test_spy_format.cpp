@@ -218,5 +218,36 @@ TEST(CompareValues, ListLengthsAndNaN) {
   EXPECT_EQ(compare_values(to_value(a), to_value(b), {}, 0.0, 10).size(), 1u);
 }
 
+TEST(SpyFormat, DiagnosticsTableOneReportPerProcessSortedAndWrapped) {
+  auto report = [](const std::string& robot, const std::string& process, std::uint32_t pid, std::uint8_t level,
+                   const std::string& status, int counters) {
+    msg::Diagnostics d;
+    d.header().robot_id(robot);
+    d.process(process);
+    d.pid(pid);
+    d.level(level);
+    d.status(status);
+    d.uptime_s(12.4);
+    for (int i = 0; i < counters; ++i) {
+      msg::DiagnosticCounter c;
+      c.name("counter_number_" + std::to_string(i));
+      c.value(static_cast<std::uint64_t>(i) * 1000);
+      d.counters().push_back(c);
+    }
+    return d;
+  };
+  const std::string table = diagnostics_table({report("robot1", "slam_estimator", 40, 1, "observations_gated +2", 2),
+                                               report("robot1", "encoder_bridge", 7, 0, "", 8),
+                                               report("robot1", "pixy_bridge", 9, 2, "device '/dev/ttyUSB0' is not open", 0)});
+  const std::string expected =
+      "robot1 encoder_bridge (pid 7): OK, up 12 s\n"
+      "    counter_number_0 0 counter_number_1 1000 counter_number_2 2000 counter_number_3 3000\n"
+      "    counter_number_4 4000 counter_number_5 5000 counter_number_6 6000 counter_number_7 7000\n"
+      "robot1 pixy_bridge (pid 9): ERROR, up 12 s: device '/dev/ttyUSB0' is not open\n"
+      "robot1 slam_estimator (pid 40): WARN, up 12 s: observations_gated +2\n"
+      "    counter_number_0 0 counter_number_1 1000\n";
+  EXPECT_EQ(table, expected);
+}
+
 }  // namespace
 }  // namespace pixyslam::log_tool

@@ -121,7 +121,7 @@ struct TopicCheck {
   std::string first_error;
   std::uint64_t sequence_mismatches = 0;      // MCAP sequence != header seq (low 32 bits)
   std::uint64_t publish_time_mismatches = 0;  // MCAP publish_time != header stamp_ns
-  std::map<std::string, std::vector<std::uint64_t>> seqs_by_robot;
+  std::map<std::string, std::vector<std::uint64_t>> seqs_by_writer;
 };
 
 }  // namespace
@@ -157,7 +157,11 @@ int run_check(const CheckRequest& request, std::ostream& out) {
     if (t.channel->message_encoding != "cdr") {
       error = "message encoding '" + t.channel->message_encoding + "' is not cdr";
     } else if (logger_node::decode_header(t.type_name, m.data.data(), m.data.size(), header, error)) {
-      t.seqs_by_robot[header.robot_id].push_back(header.seq);
+      // One sequence per writer: per robot, and per process on the diagnostics
+      // topic, which every process writes (frame_id = the process).
+      std::string writer = header.robot_id;
+      if (t.channel->topic == dds::kDiagnosticsTopic) writer += " " + header.frame_id;
+      t.seqs_by_writer[writer].push_back(header.seq);
       if (m.sequence != static_cast<std::uint32_t>(header.seq)) ++t.sequence_mismatches;
       if (m.publish_time_ns != header.stamp_ns) ++t.publish_time_mismatches;
       continue;
@@ -185,10 +189,10 @@ int run_check(const CheckRequest& request, std::ostream& out) {
       problems.push_back("expected " + std::to_string(expected->second) + " messages");
     }
     std::vector<std::string> sequences;
-    for (const auto& [robot, seqs] : t.seqs_by_robot) {
+    for (const auto& [robot, seqs] : t.seqs_by_writer) {
       const SequenceReport report = analyze_sequence(seqs);
       std::string line = describe(report);
-      if (t.seqs_by_robot.size() > 1) line = robot + ": " + line;
+      if (t.seqs_by_writer.size() > 1) line = robot + ": " + line;
       if (!report.complete()) problems.push_back("seq not exactly 1..N");
       sequences.push_back(line);
     }
@@ -196,7 +200,7 @@ int run_check(const CheckRequest& request, std::ostream& out) {
     ok = ok && topic_ok;
     out << (topic_ok ? "OK   " : "FAIL ") << topic << ": " << t.messages << " messages";
     for (const std::string& s : sequences) out << ", " << s;
-    if (t.seqs_by_robot.size() == 1) out << " (robot " << t.seqs_by_robot.begin()->first << ")";
+    if (t.seqs_by_writer.size() == 1) out << " (" << (topic == dds::kDiagnosticsTopic ? "" : "robot ") << t.seqs_by_writer.begin()->first << ")";
     for (const std::string& p : problems) out << "; " << p;
     out << "\n";
   }
@@ -226,6 +230,7 @@ bool decode_value(const std::string& topic, const std::vector<std::uint8_t>& byt
   if (topic == dds::kLandmarkObservationTopic) return decode_as<msg::LandmarkObservation>(bytes, value, error);
   if (topic == dds::kMapStateTopic) return decode_as<msg::MapState>(bytes, value, error);
   if (topic == dds::kGroundTruthTopic) return decode_as<msg::GroundTruth>(bytes, value, error);
+  if (topic == dds::kDiagnosticsTopic) return decode_as<msg::Diagnostics>(bytes, value, error);
   error = "not a topic of this project";
   return false;
 }

@@ -9,6 +9,7 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <tuple>
 #include <stdexcept>
 #include <vector>
 
@@ -236,9 +237,11 @@ int with_topic_type(const std::string& topic, Function f) {
   if (topic == dds::kLandmarkObservationTopic) return f(msg::LandmarkObservation{});
   if (topic == dds::kMapStateTopic) return f(msg::MapState{});
   if (topic == dds::kGroundTruthTopic) return f(msg::GroundTruth{});
-  std::fprintf(stderr, "pixyslam_spy: unknown topic '%s'; known: %s, %s, %s, %s\n", topic.c_str(),
+  if (topic == dds::kDiagnosticsTopic) return f(msg::Diagnostics{});
+  std::fprintf(stderr, "pixyslam_spy: unknown topic '%s'; known: %s, %s, %s, %s, %s\n", topic.c_str(),
                std::string(dds::kOdometryTopic).c_str(), std::string(dds::kLandmarkObservationTopic).c_str(),
-               std::string(dds::kMapStateTopic).c_str(), std::string(dds::kGroundTruthTopic).c_str());
+               std::string(dds::kMapStateTopic).c_str(), std::string(dds::kGroundTruthTopic).c_str(),
+               std::string(dds::kDiagnosticsTopic).c_str());
   return 2;
 }
 
@@ -332,6 +335,26 @@ int run_echo(const dds::DdsOptions& options, const EchoRequest& request, std::os
     }
     return 0;
   });
+}
+
+int run_diagnostics(const dds::DdsOptions& options, double seconds, std::ostream& out) {
+  std::mutex mutex;
+  std::map<std::tuple<std::string, std::string, std::uint32_t>, msg::Diagnostics> latest;
+  dds::Participant participant(options, "pixyslam_spy");
+  dds::Reader<msg::Diagnostics> reader(participant, [&](const msg::Diagnostics& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    latest[{m.header().robot_id(), m.process(), m.pid()}] = m;
+  });
+  wait(seconds, [] { return false; });
+  std::lock_guard<std::mutex> lock(mutex);
+  if (latest.empty()) {
+    out << "no diagnostics received in " << format_double(seconds) << " s\n";
+    return 1;
+  }
+  std::vector<msg::Diagnostics> reports;
+  for (const auto& [key, report] : latest) reports.push_back(report);
+  out << diagnostics_table(reports);
+  return 0;
 }
 
 int run_hz(const dds::DdsOptions& options, const std::string& topic, double seconds, std::ostream& out) {

@@ -30,6 +30,9 @@ struct EchoRequest {
 int run_echo(const dds::DdsOptions& dds, const EchoRequest& request, std::ostream& out);
 
 // Message rate and inter-arrival gap statistics over `seconds` (0: until a signal).
+// The latest pixyslam/diagnostics report of every process heard within `seconds`
+// (diagnostics_table); exit status 1 if none.
+int run_diagnostics(const dds::DdsOptions& dds, double seconds, std::ostream& out);
 int run_hz(const dds::DdsOptions& dds, const std::string& topic, double seconds, std::ostream& out);
 
 }  // namespace pixyslam::log_tool

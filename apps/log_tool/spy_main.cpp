@@ -3,6 +3,7 @@
 //   pixyslam_spy participants | topics                     [DDS options] [--seconds N]
 //   pixyslam_spy echo TOPIC [--json] [--count N] [--seconds N] [DDS options]
 //   pixyslam_spy hz TOPIC [--seconds N]                    [DDS options]
+//   pixyslam_spy diagnostics [--seconds N]                 [DDS options]
 //   pixyslam_spy info FILE.mcap
 //   pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]
 //   pixyslam_spy print FILE.mcap [--topic T] [--json]
@@ -40,6 +41,7 @@ constexpr const char* kUsage =
     "       pixyslam_spy topics [--seconds N] [DDS options]\n"
     "       pixyslam_spy echo TOPIC [--json] [--count N] [--seconds N] [DDS options]\n"
     "       pixyslam_spy hz TOPIC [--seconds N] [DDS options]\n"
+    "       pixyslam_spy diagnostics [--seconds N] [DDS options]\n"
     "       pixyslam_spy info FILE.mcap\n"
     "       pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]\n"
     "       pixyslam_spy print FILE.mcap [--topic TOPIC] [--json]\n"
@@ -47,7 +49,8 @@ constexpr const char* kUsage =
     "DDS options: --dds-config FILE (YAML with a dds: mapping; default " PIXYSLAM_DEFAULT_PROFILES_FILE
     ", domain 0)\n"
     "             --domain N (overrides the file's domain_id)\n"
-    "TOPIC: pixyslam/odometry, pixyslam/landmark_observation, pixyslam/map_state, pixyslam/ground_truth\n";
+    "TOPIC: pixyslam/odometry, pixyslam/landmark_observation, pixyslam/map_state, pixyslam/ground_truth,\n"
+    "       pixyslam/diagnostics\n";
 
 // TOPIC=N, N a non-negative integer.
 void add_expectation(const std::string& text, pixyslam::log_tool::CheckRequest& request) {
@@ -90,7 +93,8 @@ struct Arguments {
 };
 
 Arguments parse(const std::string& command, const std::vector<std::string>& args) {
-  const bool live = command == "participants" || command == "topics" || command == "echo" || command == "hz";
+  const bool live = command == "participants" || command == "topics" || command == "echo" || command == "hz" ||
+                    command == "diagnostics";
   Arguments a;
   for (std::size_t i = 1; i < args.size(); ++i) {
     const std::string& arg = args[i];
@@ -139,7 +143,7 @@ Arguments parse(const std::string& command, const std::vector<std::string>& args
     if (a.compare.topic.empty()) throw std::invalid_argument("compare needs --topic");
     return a;
   }
-  const std::size_t wanted = (command == "participants" || command == "topics") ? 0 : 1;
+  const std::size_t wanted = (command == "participants" || command == "topics" || command == "diagnostics") ? 0 : 1;
   if (a.positional.size() != wanted) {
     const char* what = command == "info" || command == "check" || command == "print" ? "an MCAP file" : "a TOPIC";
     if (wanted == 0) throw std::invalid_argument(command + " takes no positional argument");
@@ -166,6 +170,7 @@ int main(int argc, char** argv) {
   Arguments a;
   try {
     if (command != "participants" && command != "topics" && command != "echo" && command != "hz" &&
+        command != "diagnostics" &&
         command != "info" && command != "check" && command != "compare" &&
         command != "print") {
       throw std::invalid_argument("unknown command '" + command + "'");
@@ -191,6 +196,9 @@ int main(int argc, char** argv) {
     const dds::DdsOptions options = dds_options(a);
     if (command == "participants") return log_tool::run_participants(options, a.seconds < 0 ? 4.0 : a.seconds, std::cout);
     if (command == "topics") return log_tool::run_topics(options, a.seconds < 0 ? 4.0 : a.seconds, std::cout);
+    if (command == "diagnostics") {
+      return log_tool::run_diagnostics(options, a.seconds < 0 ? 3.0 : a.seconds, std::cout);
+    }
     if (command == "hz") return log_tool::run_hz(options, a.positional[0], a.seconds < 0 ? 5.0 : a.seconds, std::cout);
     log_tool::EchoRequest request;
     request.topic = a.positional[0];

@@ -71,6 +71,7 @@ std::unique_ptr<LogPlayer::Channel> make_channel(const std::string& topic, dds::
   }
   if (topic == dds::kMapStateTopic) return std::make_unique<TypedChannel<msg::MapState>>(participant);
   if (topic == dds::kGroundTruthTopic) return std::make_unique<TypedChannel<msg::GroundTruth>>(participant);
+  if (topic == dds::kDiagnosticsTopic) return std::make_unique<TypedChannel<msg::Diagnostics>>(participant);
   throw std::logic_error("no channel type for " + topic);
 }
 

@@ -48,7 +48,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // with delayed sampling on or off.
   pixyslam::slam::FastSlam2 filter(small_filter((data[0] & 0x10) != 0), pixyslam::slam::Pose2::Zero());
   const std::uint64_t epoch_ns = 1'000'000'000ull;
-  switch (data[0] % 4) {
+  switch (data[0] & 0x07) {
     case 0: {
       pixyslam::msg::Odometry m;
       if (!from_cdr(payload, m, error)) return 0;
@@ -70,6 +70,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     case 2: {
       pixyslam::msg::MapState m;
+      (void)from_cdr(payload, m, error);
+      break;
+    }
+    case 4: {
+      pixyslam::msg::Diagnostics m;
       (void)from_cdr(payload, m, error);
       break;
     }

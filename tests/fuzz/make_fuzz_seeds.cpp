@@ -115,7 +115,8 @@ int main(int argc, char** argv) {
     fs::copy_file(config_dir / name, yaml / name, fs::copy_options::overwrite_existing);
   }
 
-  // CDR payloads (first byte: topic, 0 Odometry, 1 LandmarkObservation, 2 MapState, 3 GroundTruth).
+  // CDR payloads (first byte & 7: topic, 0 Odometry, 1 LandmarkObservation, 2 MapState, 3 GroundTruth,
+  // 4 Diagnostics).
   const fs::path cdr = root / "fuzz_cdr_topics";
   const auto cdr_seed = [&](const std::string& name, std::uint8_t topic, const Bytes& payload) {
     Bytes b{topic};
@@ -132,6 +133,13 @@ int main(int argc, char** argv) {
   msg::GroundTruth truth;
   truth.header().seq(1);
   cdr_seed("ground_truth", 3, logger_node::to_cdr(truth));
+  msg::Diagnostics diagnostics;
+  diagnostics.header().seq(1);
+  diagnostics.process("encoder_bridge");
+  diagnostics.counters().resize(2);
+  diagnostics.counters()[0].name("lines_rejected");
+  diagnostics.counters()[0].value(3);
+  cdr_seed("diagnostics", 4, logger_node::to_cdr(diagnostics));
 
   // MCAP files: chunked and unchunked, with the project's schemas.
   const fs::path mcap = root / "fuzz_mcap_reader";

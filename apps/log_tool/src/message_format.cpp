@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <tuple>
 
 namespace pixyslam::log_tool {
 
@@ -291,6 +292,51 @@ Value to_value(const msg::GroundTruth& m) {
       .add("w_radps", Value::number(m.w_radps()))
       .add("landmarks", list_of(m.landmarks(), true_landmark_value));
   return v;
+}
+
+Value to_value(const msg::Diagnostics& m) {
+  Value v = Value::structure();
+  v.add("header", header_value(m.header()))
+      .add("process", Value::string(m.process()))
+      .add("pid", Value::unsigned_integer(m.pid()))
+      .add("level", Value::unsigned_integer(m.level()))
+      .add("status", Value::string(m.status()))
+      .add("uptime_s", Value::number(m.uptime_s()))
+      .add("counters", list_of(m.counters(), [](const msg::DiagnosticCounter& c) {
+             Value e = Value::structure();
+             e.add("name", Value::string(c.name())).add("value", Value::unsigned_integer(c.value()));
+             return e;
+           }));
+  return v;
+}
+
+std::string diagnostics_table(std::vector<msg::Diagnostics> reports) {
+  std::sort(reports.begin(), reports.end(), [](const msg::Diagnostics& a, const msg::Diagnostics& b) {
+    return std::make_tuple(a.header().robot_id(), a.process(), a.pid()) <
+           std::make_tuple(b.header().robot_id(), b.process(), b.pid());
+  });
+  static const char* const kLevels[] = {"OK", "WARN", "ERROR"};
+  std::string out;
+  for (const msg::Diagnostics& d : reports) {
+    char head[256];
+    std::snprintf(head, sizeof(head), "%s %s (pid %u): %s, up %.0f s", d.header().robot_id().c_str(),
+                  d.process().c_str(), static_cast<unsigned>(d.pid()), d.level() < 3 ? kLevels[d.level()] : "?",
+                  d.uptime_s());
+    out += head;
+    if (!d.status().empty()) out += ": " + d.status();
+    out += "\n";
+    std::string line = "   ";
+    for (const msg::DiagnosticCounter& c : d.counters()) {
+      const std::string item = " " + c.name() + " " + std::to_string(c.value());
+      if (line.size() + item.size() > 100) {
+        out += line + "\n";
+        line = "   ";
+      }
+      line += item;
+    }
+    if (line.size() > 3) out += line + "\n";
+  }
+  return out;
 }
 
 std::string format_double(double v) {

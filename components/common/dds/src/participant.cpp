@@ -76,6 +76,7 @@ DdsOptions read_dds_options(config::YamlReader& reader, const std::string& confi
   o.robot_id = reader.text("robot_id", o.robot_id);
   if (o.robot_id.empty()) reader.fail("robot_id", "must not be empty");
   o.type_information = reader.boolean("type_information", o.type_information);
+  o.diagnostics_period_s = reader.number("diagnostics_period_s", 0.0, 3600.0, o.diagnostics_period_s);
   auto addresses = [&](const char* key) {
     std::vector<std::string> list = reader.has(key) ? reader.text_list(key) : std::vector<std::string>{};
     for (const std::string& a : list) {
@@ -164,6 +165,7 @@ std::string to_yaml(const DdsOptions& o) {
          "  participant_profile: " + quoted(o.participant_profile) + "\n" +
          "  robot_id: " + quoted(o.robot_id) + "\n" +
          "  type_information: " + (o.type_information ? "true" : "false") + "\n" +
+         "  diagnostics_period_s: " + config::yaml_number(o.diagnostics_period_s) + "\n" +
          "  interfaces: " + yaml_list(o.interfaces) + "\n" +
          "  initial_peers: " + yaml_list(o.initial_peers) + "\n" +
          "  discovery_server: " + quoted(o.discovery_server) + "\n" +
@@ -183,6 +185,7 @@ void register_all_type_objects() {
     MessageTraits<msg::LandmarkObservation>::register_type_object();
     MessageTraits<msg::MapState>::register_type_object();
     MessageTraits<msg::GroundTruth>::register_type_object();
+    MessageTraits<msg::Diagnostics>::register_type_object();
   });
 }
 

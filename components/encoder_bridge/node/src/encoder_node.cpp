@@ -35,7 +35,25 @@ void EncoderNode::start() {
                     on_bytes(data, size, receive_ns);
                   },
                   [this](std::uint64_t now_ns) { on_poll(now_ns); },
-                  [this] { return status_lines_locked(); }});
+                  [this] { return status_lines_locked(); },
+                  [this] { return diagnostic_counters_locked(); }});
+}
+
+std::vector<diagnostics::Counter> EncoderNode::diagnostic_counters_locked() const {
+  const encoder::ArduinoParserCounters& p = parser_.counters();
+  const encoder::WheelCounters& w = odometry_.counters();
+  return {{"bytes_in", p.bytes_in, false},
+          {"bytes_skipped", p.bytes_skipped, true},
+          {"samples", p.samples, false},
+          {"arduino_resets", p.resets, false},
+          {"lines_rejected", p.rejected_lines(), true},
+          {"bad_checksum", p.bad_checksum, true},
+          {"wheel_steps", w.steps, false},
+          {"samples_lost", w.lost_samples, true},
+          {"sequence_backwards", w.sequence_backwards, true},
+          {"time_gaps", w.time_gaps, true},
+          {"implausible_steps", w.implausible, true},
+          {"empty_periods", empty_periods_, true}};
 }
 
 void EncoderNode::stop() { runtime_.stop(); }

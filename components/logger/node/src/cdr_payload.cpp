@@ -105,7 +105,8 @@ const std::vector<Entry>& entries() {
       {topic_info<msg::Odometry>(), &decode_strict<msg::Odometry>},
       {topic_info<msg::LandmarkObservation>(), &decode_strict<msg::LandmarkObservation>},
       {topic_info<msg::MapState>(), &decode_strict<msg::MapState>},
-      {topic_info<msg::GroundTruth>(), &decode_strict<msg::GroundTruth>}};
+      {topic_info<msg::GroundTruth>(), &decode_strict<msg::GroundTruth>},
+      {topic_info<msg::Diagnostics>(), &decode_strict<msg::Diagnostics>}};
   return table;
 }
 

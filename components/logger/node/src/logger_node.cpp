@@ -92,10 +92,30 @@ LoggerNode::LoggerNode(const LoggerOptions& options) : options_(options) {
       subscribe<msg::MapState>(i);
     } else if (name == dds::kGroundTruthTopic) {
       subscribe<msg::GroundTruth>(i);
+    } else if (name == dds::kDiagnosticsTopic) {
+      subscribe<msg::Diagnostics>(i);
     } else {
       throw std::logic_error("logger: no reader for topic '" + name + "'");
     }
   }
+  diagnostics_ = std::make_unique<diagnostics::DiagnosticsPublisher>(
+      *participant_, "logger", options_.dds.diagnostics_period_s, [this] { return diagnostics_snapshot(); });
+}
+
+diagnostics::Snapshot LoggerNode::diagnostics_snapshot() const {
+  const LoggerCounters c = counters();
+  diagnostics::Snapshot s;
+  for (const TopicCounters& t : c.topics) {
+    const std::string name = t.topic.substr(t.topic.find('/') + 1);
+    s.counters.push_back({name + "_written", t.written, false});
+    s.counters.push_back({name + "_dropped", t.dropped, true});
+    s.counters.push_back({name + "_seq_gaps", t.seq_gaps, true});
+  }
+  s.counters.push_back({"files", c.files.size(), false});
+  s.counters.push_back({"bytes_written", c.file.bytes_written, false});
+  s.counters.push_back({"queue_peak_bytes", c.queue_peak_bytes, false});
+  s.error = c.error;
+  return s;
 }
 
 void LoggerNode::open_file(std::size_t index) {
@@ -168,6 +188,7 @@ LoggerNode::~LoggerNode() {
     stop();
   } catch (...) {  // a destructor must not throw; counters().error has the cause
   }
+  diagnostics_.reset();
   participant_.reset();
 }
 
@@ -202,6 +223,7 @@ void LoggerNode::stop() {
   } else {
     writer_loop();  // never started: write what is queued and close, here
   }
+  if (diagnostics_) diagnostics_->stop();
 }
 
 void LoggerNode::enqueue(std::size_t topic, std::uint64_t seq, std::uint64_t stamp_ns,

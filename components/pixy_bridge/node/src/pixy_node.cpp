@@ -39,7 +39,26 @@ void PixyNode::start() {
                     on_bytes(data, size, receive_ns);
                   },
                   [this](std::uint64_t now_ns) { on_poll(now_ns); },
-                  [this] { return status_lines_locked(); }});
+                  [this] { return status_lines_locked(); },
+                  [this] { return diagnostic_counters_locked(); }});
+}
+
+std::vector<diagnostics::Counter> PixyNode::diagnostic_counters_locked() const {
+  const pixy::PixyParserCounters& p = parser_.counters();
+  const pixy::DetectionCounters& k = detection_counters_;
+  return {{"bytes_in", p.bytes_in, false},
+          {"bytes_skipped", p.bytes_skipped, true},
+          {"frames", p.frames, false},
+          {"blocks_ok", p.blocks_ok, false},
+          {"checksum_errors", p.checksum_errors, true},
+          {"resyncs", p.resyncs, true},
+          {"detections", k.detections, false},
+          {"unknown_signature", k.unknown_signature, true},
+          {"bad_aspect", k.bad_aspect, true},
+          {"outside_image", k.outside_image, true},
+          {"zero_height", k.zero_height, true},
+          {"duplicate_landmark", k.duplicate_landmark, false},
+          {"detections_dropped", detections_dropped_, true}};
 }
 
 void PixyNode::stop() { runtime_.stop(); }

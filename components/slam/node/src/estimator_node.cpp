@@ -19,6 +19,8 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options)
       *participant_, [this](const msg::Odometry& m) { enqueue(m); });
   observation_reader_ = std::make_unique<dds::Reader<msg::LandmarkObservation>>(
       *participant_, [this](const msg::LandmarkObservation& m) { enqueue(m); });
+  diagnostics_ = std::make_unique<diagnostics::DiagnosticsPublisher>(
+      *participant_, "slam_estimator", options_.dds.diagnostics_period_s, [this] { return diagnostics_snapshot(); });
   const CheckpointOptions& k = options_.checkpoint;
   if (!k.file.empty() && k.resume) {
     if (!std::filesystem::exists(k.file)) {
@@ -35,6 +37,7 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options)
 
 EstimatorNode::~EstimatorNode() {
   stop();
+  diagnostics_.reset();
   // Readers first: no callback may run into a half-destroyed node.
   odometry_reader_.reset();
   observation_reader_.reset();
@@ -56,8 +59,40 @@ void EstimatorNode::stop() {
   inbox_cv_.notify_all();
   if (!thread_.joinable()) return;
   thread_.join();
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    if (filter_ && !options_.checkpoint.file.empty()) write_checkpoint(true);
+  }
+  diagnostics_->stop();
+}
+
+diagnostics::Snapshot EstimatorNode::diagnostics_snapshot() const {
+  const EstimatorCounters c = counters();
   std::lock_guard<std::mutex> lock(state_mutex_);
-  if (filter_ && !options_.checkpoint.file.empty()) write_checkpoint(true);
+  const slam::FilterCounters f = filter_ ? filter_->counters() : slam::FilterCounters{};
+  diagnostics::Snapshot s;
+  s.counters = {{"odometry_received", c.odometry_received, false},
+                {"odometry_lost", c.odometry_lost, true},
+                {"observations_received", c.observations_received, false},
+                {"observations_lost", c.observations_lost, true},
+                {"steps", c.steps, false},
+                {"samples_late", c.samples_late, true},
+                {"samples_reordered", c.samples_reordered, false},
+                {"odometry_invalid", f.odometry_invalid, true},
+                {"odometry_out_of_order", f.odometry_out_of_order, true},
+                {"control_timeouts", f.control_timeouts, false},
+                {"frames_invalid", f.frames_invalid, true},
+                {"frames_out_of_order", f.frames_out_of_order, true},
+                {"observations_used", f.observations_used, false},
+                {"observations_new_landmark", f.observations_new_landmark, false},
+                {"observations_gated", f.observations_gated, true},
+                {"observations_invalid", f.observations_invalid, true},
+                {"resamples", f.resamples, false},
+                {"landmarks", map_state_.landmarks().size(), false},
+                {"checkpoints_written", c.checkpoints_written, false},
+                {"checkpoint_errors", c.checkpoint_errors, true},
+                {"resumed_from_checkpoint", c.resumed ? 1u : 0u, false}};
+  return s;
 }
 
 void EstimatorNode::enqueue(Inbox&& item) {

@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "diagnostics.h"
 #include "ground_truth.h"
 #include "landmark_observation.h"
 #include "map_state.h"
@@ -56,6 +57,11 @@ Value to_value(const msg::Odometry& m);
 Value to_value(const msg::LandmarkObservation& m);
 Value to_value(const msg::MapState& m);
 Value to_value(const msg::GroundTruth& m);
+Value to_value(const msg::Diagnostics& m);
+
+// One report per process (sorted by robot, process, pid): a line "robot process
+// (pid P): LEVEL, up S s[: status]", then its counters, wrapped at 100 columns.
+std::string diagnostics_table(std::vector<msg::Diagnostics> reports);
 
 // One YAML document: "---\n" then a block mapping; lists of scalars in flow
 // style ([1, 2]), lists of structs as block sequences, strings double-quoted

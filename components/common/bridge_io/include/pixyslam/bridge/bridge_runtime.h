@@ -15,6 +15,7 @@
 #include "pixyslam/bridge/device_reader.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/dds/participant.h"
+#include "pixyslam/diagnostics/diagnostics_publisher.h"
 
 namespace pixyslam::bridge {
 
@@ -38,13 +39,17 @@ class BridgeRuntime {
     std::function<void(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns)> on_bytes;
     std::function<void(std::uint64_t now_ns)> on_poll;
     std::function<std::vector<std::string>()> status_lines;  // the node's counters as log lines
+    // Optional: the node's counters for the diagnostics topic (the device's are
+    // added, and an ERROR while the device is not open).
+    std::function<std::vector<diagnostics::Counter>()> diagnostics;
   };
 
   // `log` empty: stderr_log(process).
   BridgeRuntime(const std::string& process, const dds::DdsOptions& dds_options,
                 const BridgeProcessOptions& options, std::unique_ptr<ByteSource> source, LogFunction log,
                 ClockFunction clock, std::mutex& mutex)
-      : mutex_(mutex),
+      : process_(process),
+        mutex_(mutex),
         status_period_s_(options.status_period_s),
         log_(log ? std::move(log) : stderr_log(process)),
         participant_(dds_options, process),
@@ -84,11 +89,14 @@ class BridgeRuntime {
       }
     };
     reader_.start(std::move(locked));
+    diagnostics_ = std::make_unique<diagnostics::DiagnosticsPublisher>(
+        participant_, process_, participant_.options().diagnostics_period_s, [this] { return snapshot(); });
   }
 
   // Joins the reader thread (within ~50 ms) and logs the final status lines; idempotent.
   void stop() {
     reader_.stop();
+    if (diagnostics_) diagnostics_->stop();
     std::lock_guard<std::mutex> lock(mutex_);
     if (!started_ || stopped_) return;
     stopped_ = true;
@@ -117,12 +125,34 @@ class BridgeRuntime {
   std::string device_status_line() const { return reader_.status_line(); }
 
  private:
+  diagnostics::Snapshot snapshot() {
+    diagnostics::Snapshot s;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (handlers_.diagnostics) s.counters = handlers_.diagnostics();
+      s.counters.push_back({"published", published_, false});
+      s.counters.push_back({"publish_failures", publish_failures_, true});
+    }
+    const DeviceCounters d = reader_.counters();
+    s.counters.push_back({"device_opens", d.opens, false});
+    s.counters.push_back({"device_open_failures", d.open_failures, false});
+    s.counters.push_back({"device_hangups", d.hangups, true});
+    s.counters.push_back({"device_read_errors", d.read_errors, true});
+    s.counters.push_back({"device_bytes", d.bytes, false});
+    if (d.opens <= d.hangups + d.read_errors) {
+      s.error = "device '" + reader_.device_name() + "' is not open (" + std::to_string(d.open_failures) +
+                " failed attempts so far)";
+    }
+    return s;
+  }
+
   void schedule_status() {
     next_status_ = std::chrono::steady_clock::now() +
                    std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                        std::chrono::duration<double>(status_period_s_));
   }
 
+  const std::string process_;
   std::mutex& mutex_;
   const double status_period_s_;
   const LogFunction log_;
@@ -135,7 +165,8 @@ class BridgeRuntime {
 
   dds::Participant participant_;
   dds::Writer<Message> writer_;
-  DeviceReader reader_;  // last: its thread uses the members above
+  DeviceReader reader_;  // its thread uses the members above
+  std::unique_ptr<diagnostics::DiagnosticsPublisher> diagnostics_;  // reads all of the above
 };
 
 }  // namespace pixyslam::bridge

@@ -38,6 +38,7 @@ struct DdsOptions {
   std::vector<std::string> initial_peers;  // IPv4 addresses of other hosts, for unicast discovery
   std::string discovery_server;            // "ADDR:PORT" of a `fastdds discovery` server: be its client
   int discovery_server_id = 0;             // that server's `-i`
+  double diagnostics_period_s = 1.0;  // every process's report on pixyslam/diagnostics (0: none)
   std::string security_dir;  // DDS Security: ca.cert.pem, governance.p7s, permissions.p7s and
                              // <participant name>.cert.pem / .key.pem (scripts/make_dds_security.sh)
 };

@@ -3,6 +3,8 @@
 #include <string_view>
 
 #include "common.h"
+#include "diagnostics.h"
+#include "diagnosticsPubSubTypes.h"
 #include "ground_truth.h"
 #include "ground_truthPubSubTypes.h"
 #include "landmark_observation.h"
@@ -20,6 +22,7 @@ void registerodometryTypes();
 void registerlandmark_observationTypes();
 void registermap_stateTypes();
 void registerground_truthTypes();
+void registerdiagnosticsTypes();
 
 namespace pixyslam::msg {
 // IDL of idl/<stem>.idl with its includes inlined (an `omgidl` schema); "" if unknown.
@@ -35,6 +38,7 @@ inline constexpr std::string_view kOdometryTopic = "pixyslam/odometry";
 inline constexpr std::string_view kLandmarkObservationTopic = "pixyslam/landmark_observation";
 inline constexpr std::string_view kMapStateTopic = "pixyslam/map_state";
 inline constexpr std::string_view kGroundTruthTopic = "pixyslam/ground_truth";
+inline constexpr std::string_view kDiagnosticsTopic = "pixyslam/diagnostics";
 
 // Message type -> its topic, generated TopicDataType and IDL file.
 template <class Message>
@@ -54,6 +58,7 @@ PIXYSLAM_MESSAGE_TRAITS(LandmarkObservation, kLandmarkObservationTopic, "landmar
                         registerlandmark_observationTypes)
 PIXYSLAM_MESSAGE_TRAITS(MapState, kMapStateTopic, "map_state", registermap_stateTypes)
 PIXYSLAM_MESSAGE_TRAITS(GroundTruth, kGroundTruthTopic, "ground_truth", registerground_truthTypes)
+PIXYSLAM_MESSAGE_TRAITS(Diagnostics, kDiagnosticsTopic, "diagnostics", registerdiagnosticsTypes)
 
 #undef PIXYSLAM_MESSAGE_TRAITS
 

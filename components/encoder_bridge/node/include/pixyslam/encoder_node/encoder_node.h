@@ -76,6 +76,7 @@ class EncoderNode {
   void on_reset(const encoder::EncoderReset& reset);
   void publish(const encoder::OdometryOutput& output);
   double to_seconds(std::int64_t host_ns) const;
+  std::vector<diagnostics::Counter> diagnostic_counters_locked() const;
   std::vector<std::string> status_lines_locked() const;
 
   EncoderNodeOptions options_;

@@ -11,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "pixyslam/diagnostics/diagnostics_publisher.h"
 #include "pixyslam/dds/participant.h"
 #include "pixyslam/logger/mcap_writer.h"
 #include "pixyslam/logger_node/cdr_payload.h"
@@ -117,6 +118,7 @@ class LoggerNode {
   bool size_limit_reached() const;
   // Copies the writer's counters into totals_ (mutex_ held).
   void update_file_counters();
+  diagnostics::Snapshot diagnostics_snapshot() const;
   // The writer thread's failure: recorded once, recording stops.
   void record_error(const std::string& what);
 
@@ -145,6 +147,7 @@ class LoggerNode {
 
   // Declared last so they go first: no callback may outlive the queue.
   std::unique_ptr<dds::Participant> participant_;
+  std::unique_ptr<diagnostics::DiagnosticsPublisher> diagnostics_;
   mutable std::mutex subscriptions_mutex_;
   std::vector<std::unique_ptr<detail::Subscription>> subscriptions_;  // one per topics_ entry; cleared by stop()
 };

@@ -69,6 +69,7 @@ class PixyNode {
   void on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns);
   void on_poll(std::uint64_t now_ns);
   void publish(const pixy::PixyFrame& frame, std::uint64_t end_ns);
+  std::vector<diagnostics::Counter> diagnostic_counters_locked() const;
   std::vector<std::string> status_lines_locked() const;
 
   PixyNodeOptions options_;

@@ -16,6 +16,7 @@
 #include "map_state.h"
 #include "odometry.h"
 #include "pixyslam/dds/endpoints.h"
+#include "pixyslam/diagnostics/diagnostics_publisher.h"
 #include "pixyslam/slam/fastslam2.h"
 #include "pixyslam/slam/sensor_queue.h"
 #include "pixyslam/slam_node/estimator_options.h"
@@ -69,12 +70,14 @@ class EstimatorNode {
   void create_filter(double first_t_s);
   void write_checkpoint(bool final);
   void log_status() const;
+  diagnostics::Snapshot diagnostics_snapshot() const;
 
   EstimatorOptions options_;
   std::unique_ptr<dds::Participant> participant_;
   std::unique_ptr<dds::Writer<msg::MapState>> map_writer_;
   std::unique_ptr<dds::Reader<msg::Odometry>> odometry_reader_;
   std::unique_ptr<dds::Reader<msg::LandmarkObservation>> observation_reader_;
+  std::unique_ptr<diagnostics::DiagnosticsPublisher> diagnostics_;
 
   mutable std::mutex inbox_mutex_;
   std::condition_variable inbox_cv_;
