@@ -92,7 +92,7 @@ record() {
   cat > "$dir/logger.yaml" <<YAML
 logger:
   output_file: $dir/run.mcap
-  topics: ['pixyslam/*']
+  topics: ['pixyslam/*', '!pixyslam/diagnostics']  # what mcap_sample_publisher sends
   compression: $compression
   chunk_size_bytes: $chunk
   rotate_size_bytes: $rotate
