@@ -11,6 +11,10 @@
 # 5 s of the link coming back, and a capture on the robot's link shows the
 # payload in the clear (plain profiles) or never (secure; where also a
 # participant without a valid certificate must receive nothing).
+# LINK_SCHEDULE=T:LOSS:DELAY_MS,... (with LINK_EMULATOR=path): the robot's link
+# is a TAP pair joined by link_emulator, which drops and delays frames by that
+# schedule (tc netem's job, on kernels without it), and there is no cut; then
+# MapState must keep arriving in every phase (no gap over 3 s) instead.
 # RUNNER=podman: the same with every host a container (images from
 # docker/build_images.sh) in its namespace: hosts robot, estimator, logger
 # and viewer, one per image, sharing one run folder.
@@ -61,7 +65,8 @@ cleanup() {
 trap cleanup EXIT
 trap 'exit 130' INT TERM  # a killed test still cleans up (the EXIT trap)
 
-# The network: one bridge, one veth per host.
+# The network: one bridge, one veth per host (the robot's link emulated when asked).
+link_schedule=${LINK_SCHEDULE:-}
 ip netns add "${tag}_sw"
 ip -n "${tag}_sw" link add br0 type bridge mcast_snooping 0
 ip -n "${tag}_sw" link set br0 up
@@ -69,7 +74,16 @@ i=0
 for h in "${hosts[@]}"; do
   i=$((i + 1))
   ip netns add "${tag}_$h"
-  ip link add "v_$h" netns "${tag}_sw" type veth peer name eth0 netns "${tag}_$h"
+  if [[ -n $link_schedule && $h == robot ]]; then
+    "$LINK_EMULATOR" --a "${tag}_robot:eth0" --b "${tag}_sw:v_robot" --schedule "$link_schedule" \
+      > "$work/link_emulator.log" 2>&1 &
+    emulator=$!
+    pids+=($emulator)
+    for _ in $(seq 50); do grep -q ready "$work/link_emulator.log" && break; sleep 0.1; done
+    grep -q ready "$work/link_emulator.log" || { cat "$work/link_emulator.log"; echo "FAIL: link_emulator"; exit 1; }
+  else
+    ip link add "v_$h" netns "${tag}_sw" type veth peer name eth0 netns "${tag}_$h"
+  fi
   ip -n "${tag}_sw" link set "v_$h" master br0 up
   ip -n "${tag}_$h" link set lo up
   ip -n "${tag}_$h" addr add "10.200.$net.$i/24" dev eth0
@@ -165,14 +179,18 @@ ip netns exec "${tag}_robot" env "${robot_env[@]}" "$bin/pixyslam_spy" hz pixysl
 doomed=$!
 pids+=($doomed)
 
-# Cut the robot's link for cut_s seconds.
+# Cut the robot's link for cut_s seconds (not when it is emulated).
 sleep $((cut_at_s - ($(date +%s) - start)))
-ip -n "${tag}_sw" link set v_robot down
-cut_begin_ns=$(date +%s%N)
-sleep "$cut_s"
-ip -n "${tag}_sw" link set v_robot up
-cut_end_ns=$(date +%s%N)
-echo "link cut for $(( (cut_end_ns - cut_begin_ns) / 1000000 )) ms"
+if [[ -z $link_schedule ]]; then
+  ip -n "${tag}_sw" link set v_robot down
+  cut_begin_ns=$(date +%s%N)
+  sleep "$cut_s"
+  ip -n "${tag}_sw" link set v_robot up
+  cut_end_ns=$(date +%s%N)
+  echo "link cut for $(( (cut_end_ns - cut_begin_ns) / 1000000 )) ms"
+else
+  sleep "$cut_s"
+fi
 sleep 1
 kill -KILL "$doomed" 2>/dev/null || true
 
@@ -185,6 +203,7 @@ for h in "${stop_order[@]}"; do
   wait "${launcher_of[$h]}" || status_of[$h]=$?
 done
 if [[ -n ${capture:-} ]]; then kill -INT "$capture" 2>/dev/null || true; wait "$capture" || true; fi
+if [[ -n ${emulator:-} ]]; then kill -INT "$emulator" 2>/dev/null || true; wait "$emulator" || true; fi
 
 for h in "${hosts[@]}"; do grep -v "robot_sim: t \|status: \|^\[map_view\]   " "$work/$h.log" | sed "s/^/$h| /"; done
 fail() { echo "FAIL ($profile, $runner): $*"; exit 1; }
@@ -205,9 +224,23 @@ for n in "$odometry" "$observations" "$truth"; do [[ -n $n && $n -gt 0 ]] || fai
   --expect "pixyslam/landmark_observation=$observations" --expect "pixyslam/ground_truth=$truth" ||
   fail "the laptop's log does not hold every message the robot sent"
 
+map_times() {
+  "$bin/pixyslam_log" print "$log" --topic pixyslam/map_state --json | grep -oE '"log_time_ns":[0-9]+' | grep -oE '[0-9]+'
+}
+if [[ -n $link_schedule ]]; then
+  # MapState all along: the longest gap between two in the laptop's log, and
+  # what the link did in each phase.
+  cat "$work/link_emulator.log"
+  max_gap_ms=$(map_times | sort -n | awk 'NR > 1 && $1 - p > g { g = $1 - p } { p = $1 } END { print int(g / 1000000) }')
+  echo "longest gap between MapStates on the laptop: $max_gap_ms ms"
+  [[ $max_gap_ms -le 3000 ]] || fail "MapState stopped for $max_gap_ms ms on the impaired link"
+  grep -q "loss 30 %.*dropped [1-9]" "$work/link_emulator.log" || fail "the emulated link dropped nothing at 30 %"
+  echo "PASS ($profile, $runner, link $link_schedule)"
+  exit 0
+fi
+
 # MapState after the link came back.
-first_after=$("$bin/pixyslam_log" print "$log" --topic pixyslam/map_state --json |
-  grep -oE '"log_time_ns":[0-9]+' | grep -oE '[0-9]+' | awk -v t="$cut_end_ns" '$1 > t && !found { print $1; found = 1 }')
+first_after=$(map_times | awk -v t="$cut_end_ns" '$1 > t && !found { print $1; found = 1 }')
 [[ -n $first_after ]] || fail "no MapState after the link came back"
 resume_ms=$(( (first_after - cut_end_ns) / 1000000 ))
 echo "MapState resumed $resume_ms ms after the link came back"
