@@ -54,9 +54,10 @@ std::vector<diagnostics::Counter> PixyNode::diagnostic_counters_locked() const {
           {"resyncs", p.resyncs, true},
           {"detections", k.detections, false},
           {"unknown_signature", k.unknown_signature, true},
-          {"bad_aspect", k.bad_aspect, true},
-          {"outside_image", k.outside_image, true},
-          {"zero_height", k.zero_height, true},
+          // Partly visible poles (image edges) fail these checks all the time: not a warning.
+          {"bad_aspect", k.bad_aspect, false},
+          {"outside_image", k.outside_image, false},
+          {"zero_height", k.zero_height, false},
           {"duplicate_landmark", k.duplicate_landmark, false},
           {"detections_dropped", detections_dropped_, true}};
 }
