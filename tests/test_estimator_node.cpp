@@ -60,11 +60,16 @@ void feed(const sim::WorldRun& run, double from_s, double to_s, std::uint64_t ba
   }
 }
 
-TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
+sim::WorldOptions test_world(double duration_s) {
   sim::WorldOptions world;
-  world.duration_s = 60.0;
+  world.duration_s = duration_s;
   world.camera_rate_hz = 10.0;
   world.max_range_m = 4.0;
+  return world;
+}
+
+TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
+  const sim::WorldOptions world = test_world(60.0);
   const sim::WorldRun run = sim::simulate(world);
   // Stamps from now on: the data runs ahead of the wall clock, so the queue
   // orders by the streams' own stamps (the wall-clock timeouts never fire).
@@ -129,10 +134,7 @@ TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
 // A restarted estimator (same checkpoint file) continues the map: it starts from
 // the saved pose and landmarks although 2 s of sensor data went missing.
 TEST(EstimatorNode, ResumesFromItsCheckpointAfterARestart) {
-  sim::WorldOptions world;
-  world.duration_s = 50.0;
-  world.camera_rate_hz = 10.0;
-  world.max_range_m = 4.0;
+  const sim::WorldOptions world = test_world(50.0);
   const sim::WorldRun run = sim::simulate(world);
   const std::uint64_t base_ns = dds::now_ns();
   const std::filesystem::path dir =
