@@ -12,8 +12,10 @@ namespace pixyslam::app {
 
 namespace {
 
-std::mutex g_mutex;
-std::condition_variable g_cv;
+// Never destroyed: the detached signal thread may still be notifying when the
+// process exits and runs static destructors (TSan: cond destroyed while in use).
+std::mutex& g_mutex = *new std::mutex;
+std::condition_variable& g_cv = *new std::condition_variable;
 std::atomic<bool> g_requested{false};
 std::atomic<int> g_signal{0};
 std::atomic<int> g_count{0};
