@@ -10,6 +10,7 @@
 #include <numeric>
 #include <random>
 #include <stdexcept>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -244,6 +245,51 @@ TEST(FastSlam2, PoseErrorFarBelowDeadReckoning) {
   EXPECT_LT(ate_sum, 0.25 * dr_sum) << "SLAM " << ate_sum / 5 << " m vs dead reckoning " << dr_sum / 5 << " m";
 }
 
+// Ids withheld (maximum-likelihood association), simulated world with
+// moderate odometry noise: every pole seen is in the map (none merged into
+// another), no landmark lies away from a pole (no phantom), duplicates stay
+// few (a pole re-seen after drift beyond the gate starts a second landmark;
+// nothing removes it yet), and the pose error is within 1.5 times that of the
+// known-id filter.
+TEST(FastSlam2, MaximumLikelihoodAssociationMapsEveryPoleWithoutPhantoms) {
+  double known_sum = 0.0, unknown_sum = 0.0;
+  for (int r = 1; r <= 3; ++r) {
+    sim::WorldOptions w;
+    const sim::WorldRun run = noisy_world(300 + r, 0.05, 0.05, w);
+    FilterOptions options = options_for_world(w, 100, static_cast<std::uint64_t>(r));
+    FastSlam2 known(options, run.initial_pose);
+    known_sum += eval::compare_trajectory(estimated_trajectory(known, run), run.truth).ate_rmse_m;
+    options.association = Association::kMaximumLikelihood;
+    options.new_landmark_probability = 0.999;
+    FastSlam2 unknown(options, run.initial_pose);
+    unknown_sum += eval::compare_trajectory(estimated_trajectory(unknown, run), run.truth).ate_rmse_m;
+    std::set<int> seen, mapped_poles;
+    for (const ObservationFrame& f : run.frames) {
+      for (const RangeBearing& d : f.detections) seen.insert(d.landmark_id);
+    }
+    const std::vector<LandmarkEstimate> map = unknown.landmarks_of_best();
+    for (const LandmarkEstimate& l : map) {
+      EXPECT_GE(l.id, FastSlam2::kFirstUnlabelledId);
+      const sim::Pole* nearest = nullptr;
+      double distance = 1e9;
+      for (const sim::Pole& pole : run.poles) {
+        const double d = std::hypot(pole.x_m - l.mean.x(), pole.y_m - l.mean.y());
+        if (d < distance) {
+          distance = d;
+          nearest = &pole;
+        }
+      }
+      // Duplicates born while the pose had drifted sit up to ~0.4 m off.
+      EXPECT_LT(distance, 0.5) << "run " << r << ": landmark " << l.id << " is no pole";
+      if (distance < 0.5) mapped_poles.insert(nearest->id);
+    }
+    EXPECT_EQ(mapped_poles, seen) << "run " << r;
+    EXPECT_LE(map.size(), seen.size() * 3 / 2) << "run " << r;
+    RecordProperty("landmarks_run_" + std::to_string(r), static_cast<int>(map.size()));
+  }
+  EXPECT_LT(unknown_sum, 1.5 * known_sum) << "ATE ids withheld " << unknown_sum / 3 << " m, known " << known_sum / 3;
+}
+
 void expect_finite(const PoseEstimate& e);
 
 // The camera is blind for 40 s (frames dropped) while odometry is noisy: the
@@ -330,6 +376,11 @@ TEST(FastSlam2, ValidateNamesTheOffendingField) {
     FilterOptions o;
     o.bearing_sigma_rad = std::numeric_limits<double>::quiet_NaN();
     EXPECT_NE(invalid_argument_of(o).find("bearing_sigma_rad"), std::string::npos);
+  }
+  {
+    FilterOptions o;
+    o.new_landmark_probability = 1.0;
+    EXPECT_NE(invalid_argument_of(o).find("new_landmark_probability"), std::string::npos);
   }
   {
     FilterOptions o;

@@ -197,6 +197,19 @@ TEST(SlamOptionsYaml, BadResampleModeListsAllowedValues) {
   EXPECT_TRUE(contains(m, "every_frame")) << m;
 }
 
+TEST(SlamOptionsYaml, AssociationModeAndItsErrors) {
+  const FilterOptions o =
+      read("filter:\n  association:\n    mode: maximum_likelihood\n    new_landmark_probability: 0.995\n");
+  EXPECT_EQ(o.association, Association::kMaximumLikelihood);
+  EXPECT_DOUBLE_EQ(o.new_landmark_probability, 0.995);
+  EXPECT_EQ(read("filter:\n  particles: 3\n").association, Association::kKnownId);
+  const std::string m = error_of("filter:\n  association:\n    mode: nearest\n");
+  EXPECT_TRUE(contains(m, "filter.association.mode")) << m;
+  EXPECT_TRUE(contains(m, "maximum_likelihood")) << m;
+  EXPECT_TRUE(contains(error_of("filter:\n  association:\n    new_landmark_probability: 1.5\n"),
+                       "filter.association.new_landmark_probability"));
+}
+
 TEST(SlamOptionsYaml, SyntaxErrorGivesLineNumber) {
   // Line 3 opens a flow sequence that is never closed.
   try {

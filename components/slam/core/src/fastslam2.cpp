@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
@@ -65,6 +66,7 @@ FastSlam2::FastSlam2(const FilterOptions& options, const PoseGaussian& initial_p
     : options_(options), gate_d2_(0.0), rng_(options.seed) {
   validate(options_);
   gate_d2_ = gate_mahalanobis2(options_);
+  new_landmark_d2_ = -2.0 * std::log(1.0 - options_.new_landmark_probability);  // chi-square, 2 dof
   if (!initial_pose.mean.allFinite() || !initial_pose.cov.allFinite() ||
       initial_pose.cov.diagonal().minCoeff() < 0.0) {
     throw std::invalid_argument("FastSlam2: the initial pose and its covariance must be finite, variances >= 0");
@@ -172,14 +174,16 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
                                             : options_.range_sigma_m + options_.range_sigma_per_m * d.range_m;
     const double sb = d.bearing_sigma_rad > 0.0 ? d.bearing_sigma_rad : options_.bearing_sigma_rad;
     r_[k] = Eigen::Vector2d(sr * sr, sb * sb).asDiagonal();
-    slots_[k] = slot_for(d.landmark_id);
+    if (options_.association == Association::kKnownId) slots_[k] = slot_for(d.landmark_id);
   }
   if (valid.empty()) return;
 
   // Which detections are new is the same for every particle only with known
   // association; decide per particle anyway.
   std::vector<bool> any_new(valid.size(), false);
+  new_slots_.assign(valid.size(), -1);
   for (Particle& p : particles_) {
+    if (options_.association == Association::kMaximumLikelihood) associate(p);
     update_particle(p, valid);
     for (std::size_t k = 0; k < valid.size(); ++k) {
       if (decision_[k] == Decision::kGated) ++gated_votes_[k];
@@ -196,6 +200,42 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
     }
   }
   resample_if_needed();
+}
+
+void FastSlam2::associate(const Particle& p) {
+  // Every (detection, mapped landmark) pair within the new-landmark gate, then
+  // the most likely pairs first, each detection and landmark used once per
+  // frame (two poles seen together are two landmarks).
+  struct Candidate {
+    double log_likelihood;
+    std::size_t k;
+    std::uint32_t slot;
+  };
+  std::vector<Candidate> candidates;
+  p.map.for_each([&](std::uint32_t slot, const Landmark& lm) {
+    if ((lm.mean - p.pose.mean.head<2>()).squaredNorm() < kMinLandmarkDistanceSq) return;
+    for (std::size_t k = 0; k < new_slots_.size(); ++k) {
+      const ObservationFit fit = fit_observation(p.pose, lm.mean, lm.cov, z_[k], r_[k]);
+      if (std::isfinite(fit.log_likelihood) && fit.mahalanobis2 <= new_landmark_d2_) {
+        candidates.push_back({fit.log_likelihood, k, slot});
+      }
+    }
+  });
+  std::sort(candidates.begin(), candidates.end(),
+            [](const Candidate& a, const Candidate& b) { return a.log_likelihood > b.log_likelihood; });
+  std::vector<bool> assigned(new_slots_.size(), false);
+  std::vector<std::uint32_t> used_slots;
+  for (const Candidate& c : candidates) {
+    if (assigned[c.k] || std::find(used_slots.begin(), used_slots.end(), c.slot) != used_slots.end()) continue;
+    assigned[c.k] = true;
+    used_slots.push_back(c.slot);
+    slots_[c.k] = c.slot;
+  }
+  for (std::size_t k = 0; k < new_slots_.size(); ++k) {
+    if (assigned[k]) continue;
+    if (new_slots_[k] < 0) new_slots_[k] = slot_for(next_unlabelled_id_++);
+    slots_[k] = static_cast<std::uint32_t>(new_slots_[k]);
+  }
 }
 
 void FastSlam2::update_particle(Particle& p, const std::vector<RangeBearing>& detections) {
@@ -266,7 +306,7 @@ void FastSlam2::update_particle(Particle& p, const std::vector<RangeBearing>& de
           update_landmark(x, z_[k], r_[k], lm.mean, lm.cov);
         } else {
           initialise_landmark(x, z_[k], r_[k], lm.mean, lm.cov);
-          lm.id = detections[k].landmark_id;
+          lm.id = id_of_slot_[slots_[k]];
         }
         ++lm.times_observed;
         break;
@@ -339,7 +379,7 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
     switch (decision_[k]) {
       case Decision::kNewDone: {
         Landmark& added = p.map.modify(slots_[k]);
-        added.id = detections[k].landmark_id;
+        added.id = id_of_slot_[slots_[k]];
         ++added.times_observed;
         decision_[k] = Decision::kNew;
         break;

@@ -42,6 +42,8 @@ void validate(const FilterOptions& o) {
           "must be finite and greater than min_range_m");
   require(o.gate_probability > 0.0 && o.gate_probability < 1.0, "gate_probability", o.gate_probability,
           "must be in (0, 1)");
+  require(o.new_landmark_probability > 0.0 && o.new_landmark_probability < 1.0, "new_landmark_probability",
+          o.new_landmark_probability, "must be in (0, 1)");
   require(o.gate_readmit_after >= 1, "gate_readmit_after", o.gate_readmit_after, "must be >= 1");
   require(o.resample_neff_fraction > 0.0 && o.resample_neff_fraction <= 1.0, "resample_neff_fraction",
           o.resample_neff_fraction, "must be in (0, 1]");
@@ -63,6 +65,10 @@ void validate(const FilterOptions& o) {
 double gate_mahalanobis2(const FilterOptions& o) {
   // Chi-square with 2 degrees of freedom: P(d2 <= x) = 1 - exp(-x / 2).
   return -2.0 * std::log(1.0 - o.gate_probability);
+}
+
+std::string to_string(Association association) {
+  return association == Association::kKnownId ? "known_id" : "maximum_likelihood";
 }
 
 std::string to_string(ResampleMode mode) {

@@ -40,6 +40,13 @@ FilterOptions read_filter_options(config::YamlReader& f) {
     o.gate_readmit_after = static_cast<int>(g.integer("readmit_after", 1, 1000000, o.gate_readmit_after));
     g.finish();
   }
+  if (f.has("association")) {
+    config::YamlReader a = f.child("association");
+    const std::string mode = a.choice("mode", {"known_id", "maximum_likelihood"}, to_string(o.association));
+    o.association = mode == "known_id" ? Association::kKnownId : Association::kMaximumLikelihood;
+    o.new_landmark_probability = a.number("new_landmark_probability", 0.5, 0.999999999, o.new_landmark_probability);
+    a.finish();
+  }
   if (f.has("resample")) {
     config::YamlReader r = f.child("resample");
     const std::string mode = r.choice("mode", {"effective_sample_size", "every_frame"}, to_string(o.resample_mode));

@@ -75,6 +75,10 @@ struct FilterCounters {
 // Same options, seed and input give bit-identical output. Thread-compatible.
 class FastSlam2 {
  public:
+  // Landmarks started by maximum-likelihood association get ids from here up
+  // (the camera's ids are at most 1,000,000).
+  static constexpr int kFirstUnlabelledId = 2000000;
+
   FastSlam2(const FilterOptions& options, const Pose2& initial_pose);
   // Every particle starts with this pose Gaussian (not sampled: the first
   // frame's proposal folds its observations into it), e.g. a restart whose
@@ -112,6 +116,9 @@ class FastSlam2 {
 
   void advance_to(double t_s);
   std::uint32_t slot_for(int landmark_id);
+  // Association::kMaximumLikelihood: slots_ for particle p (a mapped landmark,
+  // or a new slot shared by every particle that starts one for that detection).
+  void associate(const Particle& p);
   void update_particle(Particle& p, const std::vector<RangeBearing>& detections);
   void update_particle_joint(Particle& p, const std::vector<RangeBearing>& detections);
   void finish_joint(Particle& p);
@@ -137,6 +144,9 @@ class FastSlam2 {
   // Per-frame working memory (reused to avoid allocation).
   std::vector<Eigen::Vector2d> z_;
   std::vector<Eigen::Matrix2d> r_;
+  std::vector<std::int64_t> new_slots_;  // per detection of the frame, -1 until a particle needs it
+  int next_unlabelled_id_ = kFirstUnlabelledId;
+  double new_landmark_d2_ = 0.0;
   std::vector<std::uint32_t> slots_;
   std::vector<Decision> decision_;
   std::vector<Landmark*> landmarks_;

@@ -7,6 +7,14 @@
 
 namespace pixyslam::slam {
 
+// How a detection finds its landmark.
+enum class Association {
+  kKnownId,            // by the detection's landmark id (the Pixy colour code)
+  kMaximumLikelihood,  // ids ignored: per particle, the mapped landmark most likely
+                       // to have made it, or a new one when none is likely enough
+                       // (FastSLAM with unknown data association)
+};
+
 enum class ResampleMode {
   kEffectiveSampleSize,  // when N_eff < resample_neff_fraction * N
   kEveryFrame,           // after every observation frame (the seed paper)
@@ -60,6 +68,11 @@ struct FilterOptions {
   // is accepted anyway so that a drifted particle can recover.
   int gate_readmit_after = 3;
 
+  Association association = Association::kKnownId;
+  // kMaximumLikelihood: a detection starts a new landmark when no mapped one is
+  // within this chi-square (2 dof) quantile of its predicted observation.
+  double new_landmark_probability = 0.99;
+
   ResampleMode resample_mode = ResampleMode::kEffectiveSampleSize;
   double resample_neff_fraction = 0.667;
   DelayedSamplingOptions delayed_sampling;
@@ -71,5 +84,6 @@ void validate(const FilterOptions& options);
 double gate_mahalanobis2(const FilterOptions& options);
 
 std::string to_string(ResampleMode mode);
+std::string to_string(Association association);
 
 }  // namespace pixyslam::slam
