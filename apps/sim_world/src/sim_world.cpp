@@ -31,12 +31,52 @@ WorldOptions read_world_options(config::YamlReader& w) {
   o.min_range_m = w.number("min_range_m", 0.0, 100.0, o.min_range_m);
   o.max_range_m = w.number("max_range_m", 0.01, 1000.0, o.max_range_m);
   if (o.max_range_m <= o.min_range_m) w.fail("max_range_m", "must be greater than min_range_m");
+  o.detection_probability = w.number("detection_probability", 0.0, 1.0, o.detection_probability);
+  if (w.has("path")) {
+    for (config::YamlReader& leg : w.mapping_list("path")) {
+      PathLeg l;
+      l.length_m = leg.number("length_m", 0.001, 1000.0);
+      l.turn_rad = leg.number("turn_deg", -3600.0, 3600.0, 0.0) * M_PI / 180.0;
+      leg.finish();
+      o.path.push_back(l);
+    }
+  }
+  if (w.has("poles")) {
+    for (config::YamlReader& p : w.mapping_list("poles")) {
+      Pole pole;
+      pole.id = static_cast<int>(p.integer("id", 0, 1000000));
+      pole.x_m = p.number("x_m", -1000.0, 1000.0);
+      pole.y_m = p.number("y_m", -1000.0, 1000.0);
+      for (const Pole& other : o.poles) {
+        if (other.id == pole.id) p.fail("id", "pole " + std::to_string(pole.id) + " is given twice");
+      }
+      p.finish();
+      o.poles.push_back(pole);
+    }
+  }
+  if (w.has("initial_pose")) {
+    config::YamlReader pose = w.child("initial_pose");
+    o.initial_pose = slam::Pose2(pose.number("x_m", -1000.0, 1000.0, 0.0), pose.number("y_m", -1000.0, 1000.0, 0.0),
+                                 pose.number("theta_deg", -360.0, 360.0, 0.0) * M_PI / 180.0);
+    pose.finish();
+  }
   w.finish();
   return o;
 }
 
 LoopPath::LoopPath(const WorldOptions& o) {
   const double v = o.speed_mps;
+  if (!o.path.empty()) {
+    loops_ = false;
+    double t = 0.0;
+    for (const PathLeg& leg : o.path) {
+      const double duration = leg.length_m / v;
+      t += duration;
+      segments_.push_back({t, PathCommand{v, leg.turn_rad / duration}});
+    }
+    lap_time_s_ = t;
+    return;
+  }
   const double turn_time = (M_PI / 2.0) * o.corner_radius_m / v;
   const PathCommand straight{v, 0.0};
   const PathCommand turn{v, v / o.corner_radius_m};
@@ -51,6 +91,7 @@ LoopPath::LoopPath(const WorldOptions& o) {
 }
 
 PathCommand LoopPath::command_at(double t_s) const {
+  if (!loops_ && t_s >= lap_time_s_) return PathCommand{};  // the scripted path is over: stand still
   const double in_lap = std::fmod(std::max(t_s, 0.0), lap_time_s_);
   for (const auto& [end, cmd] : segments_) {
     if (in_lap < end) return cmd;
@@ -59,6 +100,7 @@ PathCommand LoopPath::command_at(double t_s) const {
 }
 
 std::vector<Pole> place_poles(const WorldOptions& o) {
+  if (!o.poles.empty()) return o.poles;
   // The path starts at (0, 0) heading +x; its rectangle spans x in [0, L] and
   // y in [0, W + 2R] with the corners rounded by R.
   const double l = o.length_m;
@@ -88,10 +130,13 @@ std::vector<Pole> place_poles(const WorldOptions& o) {
 WorldRun simulate(const WorldOptions& o) {
   WorldRun run;
   run.poles = place_poles(o);
-  run.initial_pose = slam::Pose2(0.0, 0.0, 0.0);
+  run.initial_pose = o.initial_pose;
+  run.frames_in_view.assign(run.poles.size(), 0);
+  run.frames_detected.assign(run.poles.size(), 0);
   const LoopPath path(o);
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
 
   const double odo_dt = 1.0 / o.odometry_rate_hz;
   const double cam_dt = 1.0 / o.camera_rate_hz;
@@ -110,10 +155,15 @@ WorldRun simulate(const WorldOptions& o) {
     }
     if (t + 1e-9 >= next_cam) {
       slam::ObservationFrame frame{t, {}};
-      for (const Pole& p : run.poles) {
+      for (std::size_t i = 0; i < run.poles.size(); ++i) {
+        const Pole& p = run.poles[i];
         const slam::PredictedObservation z = slam::predict_observation(pose, Eigen::Vector2d(p.x_m, p.y_m));
         if (z.z.x() < o.min_range_m || z.z.x() > o.max_range_m) continue;
         if (std::abs(z.z.y()) > 0.5 * o.field_of_view_rad) continue;
+        ++run.frames_in_view[i];
+        // Drawn only when misses are possible: worlds without them keep their random sequence.
+        if (o.detection_probability < 1.0 && uniform(rng) >= o.detection_probability) continue;
+        ++run.frames_detected[i];
         slam::RangeBearing d;
         d.landmark_id = p.id;
         d.range_m = z.z.x() + o.range_sigma_m * normal(rng);

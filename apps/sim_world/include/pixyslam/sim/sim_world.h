@@ -14,6 +14,19 @@ namespace pixyslam::sim {
 // Noise as in the seed paper: odometry samples carry v, w errors, camera frames
 // range and bearing errors; the camera sees poles inside its horizontal field of
 // view and range limits (no occlusion). Units SI, frame as slam::Pose2.
+// One leg of a scripted path: `length_m` driven at speed_mps along an arc that
+// turns the heading by `turn_rad` (0: straight; > 0 counter-clockwise).
+struct PathLeg {
+  double length_m = 0.0;
+  double turn_rad = 0.0;
+};
+
+struct Pole {
+  int id = 0;
+  double x_m = 0.0;
+  double y_m = 0.0;
+};
+
 struct WorldOptions {
   std::uint64_t seed = 7;
   double duration_s = 150.0;
@@ -29,6 +42,15 @@ struct WorldOptions {
   double pole_offset_m = 0.6;
   bool inner_poles = true;
   int first_landmark_id = 1;
+  // A scripted world instead (e.g. the seed paper's corner and corridor): when
+  // `path` is set the robot drives its legs once from initial_pose, then stands
+  // still; when `poles` is set they replace the generated ones.
+  std::vector<PathLeg> path;
+  std::vector<Pole> poles;
+  slam::Pose2 initial_pose = slam::Pose2::Zero();
+  // Chance that the camera reports a pole in view (the paper lost some to the
+  // carpet's colours); 1: always.
+  double detection_probability = 1.0;
   // Sensors.
   double odometry_rate_hz = 10.0;
   double camera_rate_hz = 5.0;
@@ -44,12 +66,6 @@ struct WorldOptions {
 // Reads a `world:` mapping; unknown keys and bad values throw config::ConfigError.
 WorldOptions read_world_options(config::YamlReader& world);
 
-struct Pole {
-  int id = 0;
-  double x_m = 0.0;
-  double y_m = 0.0;
-};
-
 struct WorldRun {
   slam::Pose2 initial_pose = slam::Pose2::Zero();
   std::vector<Pole> poles;
@@ -57,6 +73,10 @@ struct WorldRun {
   std::vector<slam::ObservationFrame> frames;   // noisy, at camera_rate_hz, frames with >= 1 pole
   std::vector<eval::TimedPose> truth;           // true pose at every odometry sample
   std::size_t pole_sightings = 0;
+  // Per pole (same order as poles): camera frames in which it was in view, and
+  // in which it was reported.
+  std::vector<int> frames_in_view;
+  std::vector<int> frames_detected;
 };
 
 // The true (v, w) command of the path at time t (piecewise constant).
@@ -65,6 +85,7 @@ struct PathCommand {
   double w_radps = 0.0;
 };
 
+// The rounded-rectangle loop, or the scripted path (driven once) when o.path is set.
 class LoopPath {
  public:
   explicit LoopPath(const WorldOptions& o);
@@ -74,6 +95,7 @@ class LoopPath {
  private:
   std::vector<std::pair<double, PathCommand>> segments_;  // (end time in lap, command)
   double lap_time_s_ = 0.0;
+  bool loops_ = true;
 };
 
 std::vector<Pole> place_poles(const WorldOptions& o);
