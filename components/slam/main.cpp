@@ -26,7 +26,9 @@ void write_outputs(const std::string& dir, const pixyslam::slam_node::EstimatorN
   }
   eval::write_trajectory_csv(dir + "/trajectory.csv", poses);
   std::vector<eval::LandmarkRow> rows;
-  for (const msg::LandmarkEstimate& l : node.latest_map_state().landmarks()) {
+  // A named copy: iterating over a member of the returned temporary would dangle.
+  const msg::MapState last = node.latest_map_state();
+  for (const msg::LandmarkEstimate& l : last.landmarks()) {
     rows.push_back({l.landmark_id(), l.x_m(), l.y_m(), l.cov_xx_m2(), l.cov_xy_m2(), l.cov_yy_m2()});
   }
   eval::write_landmarks_csv(dir + "/landmarks.csv", rows);
