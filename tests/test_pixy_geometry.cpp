@@ -88,6 +88,17 @@ TEST(PixyGeometry, AspectBoundsAreInclusive) {
   }
 }
 
+TEST(PixyGeometry, AspectToleranceForgivesOnePixelOfRounding) {
+  CameraModel c;
+  EXPECT_FALSE(aspect_ok(c, block(1, false, 160, 100, 8, 18)));  // 2.25: a 18 x 8.6 px pole rounded down
+  EXPECT_FALSE(aspect_ok(c, block(1, false, 160, 100, 10, 19)));  // 1.9
+  c.aspect_tolerance_px = 1;
+  EXPECT_TRUE(aspect_ok(c, block(1, false, 160, 100, 8, 18)));   // 17 / 8 = 2.125 is possible
+  EXPECT_TRUE(aspect_ok(c, block(1, false, 160, 100, 10, 19)));  // 20 / 10
+  EXPECT_FALSE(aspect_ok(c, block(1, false, 160, 100, 10, 30)));  // 29 / 11 = 2.6: still a wrong shape
+  EXPECT_FALSE(aspect_ok(c, block(1, false, 160, 100, 10, 12)));  // 13 / 9 = 1.4
+}
+
 TEST(PixyGeometry, SignatureNotation) {
   EXPECT_EQ(parse_signature("12"), std::optional<std::uint16_t>(012));
   EXPECT_EQ(parse_signature("012"), std::optional<std::uint16_t>(10));

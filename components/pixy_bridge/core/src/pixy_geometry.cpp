@@ -26,6 +26,7 @@ void validate(const CameraModel& c) {
           "min_height_to_width must be > 0");
   require(std::isfinite(c.max_height_to_width) && c.max_height_to_width >= c.min_height_to_width,
           "max_height_to_width must be >= min_height_to_width");
+  require(c.aspect_tolerance_px >= 0 && c.aspect_tolerance_px <= 10, "aspect_tolerance_px must be in [0, 10]");
   require(std::isfinite(c.range_sigma_fraction) && c.range_sigma_fraction > 0.0,
           "range_sigma_fraction must be > 0");
   require(std::isfinite(c.bearing_sigma_rad) && c.bearing_sigma_rad > 0.0, "bearing_sigma_rad must be > 0");
@@ -57,8 +58,11 @@ bool aspect_ok(const CameraModel& c, const PixyBlock& b) {
   if (b.width == 0 || b.height == 0) return false;
   // h_s / w_s within [2.0, 2.2] in the paper. A quotient of small integers is
   // correctly rounded, so a ratio exactly on a bound compares equal to it.
-  const double ratio = static_cast<double>(b.height) / static_cast<double>(b.width);
-  return ratio >= c.min_height_to_width && ratio <= c.max_height_to_width;
+  const double h = b.height, w = b.width, tol = c.aspect_tolerance_px;
+  // The highest and lowest ratio the block could have with its sides tol px off.
+  const double highest = (h + tol) / std::max(1.0, w - tol);
+  const double lowest = std::max(0.0, h - tol) / (w + tol);
+  return highest >= c.min_height_to_width && lowest <= c.max_height_to_width;
 }
 
 std::optional<std::uint16_t> parse_signature(std::string_view text) {

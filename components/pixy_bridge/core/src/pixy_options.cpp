@@ -52,6 +52,7 @@ PixyOptions read_pixy_options(config::YamlReader& p) {
   c.landmark_height_m = p.number("landmark_height_m", 1e-3, 100.0);
   c.min_height_to_width = p.number("min_height_to_width", 0.01, 100.0, c.min_height_to_width);
   c.max_height_to_width = p.number("max_height_to_width", 0.01, 100.0, c.max_height_to_width);
+  c.aspect_tolerance_px = static_cast<int>(p.integer("aspect_tolerance_px", 0, 10, c.aspect_tolerance_px));
   if (c.max_height_to_width < c.min_height_to_width) {
     p.fail("max_height_to_width", "must be >= min_height_to_width");
   }

@@ -69,6 +69,7 @@ std::string to_yaml(const PixyNodeOptions& o) {
      << "  landmark_height_m: " << yaml_number(c.landmark_height_m) << "\n"
      << "  min_height_to_width: " << yaml_number(c.min_height_to_width) << "\n"
      << "  max_height_to_width: " << yaml_number(c.max_height_to_width) << "\n"
+     << "  aspect_tolerance_px: " << c.aspect_tolerance_px << "\n"
      << "  range_sigma_fraction: " << yaml_number(c.range_sigma_fraction) << "\n"
      << "  range_sigma_floor_m: " << yaml_number(c.range_sigma_floor_m) << "\n"
      << "  block_height_sigma_px: " << yaml_number(c.block_height_sigma_px) << "\n"

@@ -28,6 +28,10 @@ struct CameraModel {
   // Accepted block height/width ratio, both bounds inclusive (paper: 2.0 to 2.2).
   double min_height_to_width = 2.0;
   double max_height_to_width = 2.2;
+  // Pixels of rounding the check forgives in width and height: 0 is the
+  // paper's exact check; a camera whose small blocks are whole-pixel boxes
+  // needs 1 (a 18 x 9 px pole is 2.0, 18 x 8 px 2.25).
+  int aspect_tolerance_px = 0;
 
   // Noise attached to every detection (see range_sigma_m below): a floor, a
   // fraction of the range, and the block height's pixel error through Eq. 5
