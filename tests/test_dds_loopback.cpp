@@ -59,7 +59,7 @@ TEST(DdsLoopback, EveryOdometryMessageArrivesInOrder) {
   EXPECT_EQ(reader.received(), static_cast<std::uint64_t>(kCount));
 }
 
-TEST(DdsLoopback, LateJoinerGetsTheLastMapState) {
+TEST(DdsLoopback, LateJoinerGetsTheRecentMapStatesEndingWithTheCurrent) {
   Participant sender(loopback_options(), "test_map_sender");
   Writer<msg::MapState> writer(sender);
   for (int i = 0; i < 3; ++i) {
@@ -77,8 +77,9 @@ TEST(DdsLoopback, LateJoinerGetsTheLastMapState) {
     cv.notify_all();
   });
   std::unique_lock<std::mutex> lock(mutex);
-  ASSERT_TRUE(cv.wait_for(lock, std::chrono::seconds(10), [&] { return !counts.empty(); }));
-  EXPECT_EQ(counts.front(), 102u);  // keep-last 1: only the current map
+  ASSERT_TRUE(cv.wait_for(lock, std::chrono::seconds(10), [&] { return !counts.empty() && counts.back() == 102u; }));
+  // Transient local, keep-last 32: the writer's recent states, in order, the current one last.
+  EXPECT_EQ(counts, (std::vector<std::uint32_t>{100u, 101u, 102u}));
 }
 
 TEST(DdsLoopback, MissingProfilesFileIsNamed) {
