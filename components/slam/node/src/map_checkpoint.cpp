@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -54,8 +53,9 @@ std::string to_yaml(const MapCheckpoint& c) {
   return out.str();
 }
 
-MapCheckpoint parse_map_checkpoint(const std::string& text, const std::string& origin) {
-  config::YamlReader root = config::YamlReader::from_string(text, origin);
+namespace {
+
+MapCheckpoint parse(config::YamlReader root) {
   MapCheckpoint c;
   root.integer("version", 1, 1);
   c.stamp_ns = static_cast<std::uint64_t>(root.integer("stamp_ns", 0, INT64_MAX));
@@ -92,13 +92,13 @@ MapCheckpoint parse_map_checkpoint(const std::string& text, const std::string& o
   return c;
 }
 
-MapCheckpoint read_map_checkpoint(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw config::ConfigError(path + ": cannot open the checkpoint file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_map_checkpoint(text.str(), path);
+}  // namespace
+
+MapCheckpoint parse_map_checkpoint(const std::string& text, const std::string& origin) {
+  return parse(config::YamlReader::from_string(text, origin));
 }
+
+MapCheckpoint read_map_checkpoint(const std::string& path) { return parse(config::YamlReader::from_file(path)); }
 
 void write_map_checkpoint(const std::string& path, const MapCheckpoint& checkpoint) {
   const std::string text = to_yaml(checkpoint);
