@@ -124,9 +124,10 @@ bool report_experiment(const Experiment& e, const slam::FilterOptions& filter, c
     const sim::Pole& p = poles[i];
     double sx = 0, sy = 0, se = 0, min_mag = 1e9, max_mag = -1e9;
     int found = 0;
+    long view_i = 0, det_i = 0;
     for (const RunOutcome& o : runs) {
-      in_view += o.world.frames_in_view[i];
-      detected += o.world.frames_detected[i];
+      view_i += o.world.frames_in_view[i];
+      det_i += o.world.frames_detected[i];
       for (const eval::LandmarkRow& l : o.result.landmarks) {
         if (l.id != p.id) continue;
         ++found;
@@ -139,11 +140,8 @@ bool report_experiment(const Experiment& e, const slam::FilterOptions& filter, c
         max_mag = std::max(max_mag, mag);
       }
     }
-    long view_i = 0, det_i = 0;
-    for (const RunOutcome& o : runs) {
-      view_i += o.world.frames_in_view[i];
-      det_i += o.world.frames_detected[i];
-    }
+    in_view += view_i;
+    detected += det_i;
     std::string paper_error = "-";
     double paper_error_m = -1.0;
     if (paper != kPaperTable1.end()) {
