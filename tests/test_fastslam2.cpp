@@ -290,6 +290,33 @@ TEST(FastSlam2, MaximumLikelihoodAssociationMapsEveryPoleWithoutPhantoms) {
   EXPECT_LT(unknown_sum, 1.5 * known_sum) << "ATE ids withheld " << unknown_sum / 3 << " m, known " << known_sum / 3;
 }
 
+// Ids withheld, a known landmark re-seen from an uncertain heading (spread
+// across the particles): particles near the true heading associate it, those
+// far off start a second landmark. A new landmark is weighted as a fit at the
+// gate boundary, so the associating particles must come out ahead, even with
+// noise so wide that every fit's likelihood density is below 1.
+TEST(FastSlam2, MaximumLikelihoodFavoursAssociatingOverStartingADuplicate) {
+  FilterOptions options;
+  options.particles = 50;
+  options.association = Association::kMaximumLikelihood;
+  options.new_landmark_probability = 0.99;
+  options.range_sigma_m = 1.0;
+  options.bearing_sigma_rad = 0.3;
+  options.resample_neff_fraction = 0.01;  // N_eff >= 1 > 0.5: never resample, so the weights stay
+  PoseGaussian start;
+  start.cov(2, 2) = 0.6 * 0.6;  // split into headings from about -1.4 to +1.4 rad
+  FastSlam2 filter(options, start);
+  filter.set_prior_map({{FastSlam2::kFirstUnlabelledId - 1, Eigen::Vector2d(3.0, 0.0), 0.01 * Eigen::Matrix2d::Identity(), 5}});
+  filter.add_observations({0.0, {{0, 3.0, 0.0, 0.0, 0.0}}});
+  int associating = 0;
+  for (const Particle& p : filter.particles()) associating += p.map.size() == 1 ? 1 : 0;
+  ASSERT_GT(associating, 0);
+  ASSERT_LT(associating, options.particles) << "every particle associated: the test sees no choice";
+  const std::vector<LandmarkEstimate> best = filter.landmarks_of_best();
+  ASSERT_EQ(best.size(), 1u) << "the best particle started a duplicate";
+  EXPECT_EQ(best[0].id, FastSlam2::kFirstUnlabelledId - 1);
+}
+
 void expect_finite(const PoseEstimate& e);
 
 // The camera is blind for 40 s (frames dropped) while odometry is noisy: the

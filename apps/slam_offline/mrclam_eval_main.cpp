@@ -66,8 +66,8 @@ int run(int argc, char** argv) {
     throw std::invalid_argument("--association must be known_id or maximum_likelihood");
   }
 
-  std::printf("%-6s %-5s %9s %9s %10s %10s %11s %11s %8s %8s\n", "robot", "seed", "ATE_m", "DR_ATE_m",
-              "head_deg", "DR_head", "lm_raw_m", "lm_align_m", "gated", "wall_s");
+  std::printf("%-6s %-5s %9s %9s %10s %10s %11s %11s %8s %5s %8s\n", "robot", "seed", "ATE_m", "DR_ATE_m",
+              "head_deg", "DR_head", "lm_raw_m", "lm_align_m", "gated", "map", "wall_s");
   bool all_better = true;
   double sum_ate = 0, sum_head = 0, sum_lm = 0, sum_lma = 0, sum_wall = 0;
   int runs = 0;
@@ -80,10 +80,11 @@ int run(int argc, char** argv) {
       const offline::RunResult res = offline::run_filter(options, input);
       const offline::Report rep = offline::evaluate(input, res);
       constexpr double kDeg = 180.0 / M_PI;
-      std::printf("%-6d %-5d %9.3f %9.3f %10.2f %10.2f %11.3f %11.3f %8llu %8.2f\n", robot, seed,
+      std::printf("%-6d %-5d %9.3f %9.3f %10.2f %10.2f %11.3f %11.3f %8llu %5zu %8.2f\n", robot, seed,
                   rep.filter.ate_rmse_m, rep.dead_reckoning.ate_rmse_m, rep.filter.heading_rmse_rad * kDeg,
                   rep.dead_reckoning.heading_rmse_rad * kDeg, rep.landmarks.rmse_m, rep.landmarks.rmse_aligned_m,
-                  static_cast<unsigned long long>(res.counters.observations_gated), res.wall_time_s);
+                  static_cast<unsigned long long>(res.counters.observations_gated), res.landmarks.size(),
+                  res.wall_time_s);
       std::fflush(stdout);
       robot_ate += rep.filter.ate_rmse_m;
       robot_dr += rep.dead_reckoning.ate_rmse_m;

@@ -155,6 +155,7 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
   z_.resize(n);
   r_.resize(n);
   slots_.resize(n);
+  new_log_likelihood_.resize(n);
   gated_votes_.assign(n, 0);
   std::vector<RangeBearing> valid;
   valid.reserve(n);
@@ -175,6 +176,7 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
     const double sb = d.bearing_sigma_rad > 0.0 ? d.bearing_sigma_rad : options_.bearing_sigma_rad;
     r_[k] = Eigen::Vector2d(sr * sr, sb * sb).asDiagonal();
     if (options_.association == Association::kKnownId) slots_[k] = slot_for(d.landmark_id);
+    new_log_likelihood_[k] = 0.0;  // associate() sets it per particle
   }
   if (valid.empty()) return;
 
@@ -232,6 +234,15 @@ void FastSlam2::associate(const Particle& p) {
     slots_[c.k] = c.slot;
   }
   for (std::size_t k = 0; k < new_slots_.size(); ++k) {
+    // A new landmark explains the detection with the likelihood of a fit at the
+    // gate boundary (Montemerlo's p0), spread by the particle's pose uncertainty
+    // as a landmark there would be: a particle that starts a duplicate then gains
+    // nothing over one that associates the detection with its old landmark.
+    const double heading = p.pose.mean.z() + z_[k].y();
+    const Eigen::Vector2d at = p.pose.mean.head<2>() + z_[k].x() * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+    const Eigen::Matrix<double, 2, 3> h = predict_observation(p.pose.mean, at).h_pose;
+    const Eigen::Matrix2d s0 = h * p.pose.cov * h.transpose() + r_[k];
+    new_log_likelihood_[k] = -0.5 * new_landmark_d2_ - std::log(2.0 * M_PI) - 0.5 * std::log(s0.determinant());
     if (assigned[k]) continue;
     if (new_slots_[k] < 0) new_slots_[k] = slot_for(next_unlabelled_id_++);
     slots_[k] = static_cast<std::uint32_t>(new_slots_[k]);
@@ -282,6 +293,9 @@ void FastSlam2::update_particle(Particle& p, const std::vector<RangeBearing>& de
     fold_into_proposal(proposal, fit);
   }
 
+  for (std::size_t k = 0; k < n; ++k) {
+    if (decision_[k] == Decision::kNew) log_w += new_log_likelihood_[k];
+  }
   const Pose2 x = sample_pose(proposal, rng_);
   p.pose.mean = x;
   p.pose.cov.setZero();
@@ -335,6 +349,9 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
     decision_[k] = Decision::kNewDone;
   }
   double log_w = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (decision_[k] == Decision::kNewDone) log_w += new_log_likelihood_[k];
+  }
   bool end_joint = false;
   for (std::size_t k = 0; k < n; ++k) {
     if (decision_[k] == Decision::kNewDone) continue;

@@ -148,6 +148,7 @@ class FastSlam2 {
   int next_unlabelled_id_ = kFirstUnlabelledId;
   double new_landmark_d2_ = 0.0;
   std::vector<std::uint32_t> slots_;
+  std::vector<double> new_log_likelihood_;  // per detection: log weight if it starts a landmark
   std::vector<Decision> decision_;
   std::vector<Landmark*> landmarks_;
   std::vector<int> gated_votes_;
