@@ -5,20 +5,24 @@
 # cleanly, the evaluator's ATE is under MAX_ATE (so MapState arrived and the
 # map is near the truth), and the log holds every message each publisher sent
 # (seq 1..N per topic, N = the publisher's own count).
-# The log is kept as KEEP_LOG when given (for the replay test).
-#   run_system_test.sh BIN_DIR CONFIG_DIR SIM_DURATION_S MAX_ATE_M [KEEP_LOG]
+# The log is kept as KEEP_LOG when given (for the replay test). LAUNCH names
+# another launch file of CONFIG_DIR (launch_sim_camera.yaml: the camera backend
+# on robot_sim's rendered images); with it 3/4 of the poles must be mapped, none
+# under a wrong id.
+#   [LAUNCH=FILE] run_system_test.sh BIN_DIR CONFIG_DIR SIM_DURATION_S MAX_ATE_M [KEEP_LOG]
 set -euo pipefail
 bin=$1 config=$2 duration=$3 max_ate=$4 keep_log=${5:-}
+launch=${LAUNCH:-launch_sim.yaml}
 work=$(mktemp -d /tmp/pixyslam_system_test.XXXXXX)
 trap 'rm -rf "$work"' EXIT
 cp -r "$config" "$work/config"
 domain=$((120 + $$ % 100))
 sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/config/*.yaml
 sed -i "s/^  duration_s: [0-9.]* /  duration_s: $duration /" "$work/config/robot_sim.yaml"
-sed -i "s/--max-ate, '0.10'/--max-ate, '$max_ate'/" "$work/config/launch_sim.yaml"
+sed -i "s/--max-ate, '0.10'/--max-ate, '$max_ate'/" "$work/config/$launch"
 
 status=0
-"$bin/pixyslam_launch" "$work/config/launch_sim.yaml" --run-dir "$work/run" > "$work/out.log" 2>&1 &
+"$bin/pixyslam_launch" "$work/config/$launch" --run-dir "$work/run" > "$work/out.log" 2>&1 &
 launcher=$!
 trap 'kill "$launcher" 2>/dev/null || true; rm -rf "$work"' EXIT
 trap 'exit 130' INT TERM  # a killed test still cleans up (the EXIT trap)
@@ -37,6 +41,17 @@ grep -v "robot_sim: t \|status: " "$work/out.log"
 if [[ $status -ne 0 ]]; then
   echo "FAIL: pixyslam_launch exited with $status"
   exit 1
+fi
+
+if [[ $launch != launch_sim.yaml ]]; then
+  # Most poles mapped in one lap, and none under a wrong id (one would be metres
+  # off its pole and lift the raw landmark RMSE far above 0.15 m).
+  mapped=$(grep -oE 'landmarks +[0-9]+ mapped of [0-9]+, RMSE [0-9.]+' "$work/out.log" | tail -1)
+  read -r got of rmse <<< "$(echo "$mapped" | grep -oE '[0-9.]+' | tr '\n' ' ')"
+  if [[ -z "$mapped" || $((4 * got)) -lt $((3 * of)) ]] || awk "BEGIN{exit !($rmse > 0.15)}"; then
+    echo "FAIL: landmarks: $mapped (want >= 3/4 of the poles, raw RMSE <= 0.15 m)"; exit 1
+  fi
+  echo "landmarks: $mapped m raw"
 fi
 
 # What each publisher says it sent (its final status line).

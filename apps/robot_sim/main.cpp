@@ -2,7 +2,7 @@
 // Pixy UART bytes into two pseudo-terminals and publishes GroundTruth.
 //   robot_sim --config config/robot_sim.yaml [--pixy-config config/pixy_bridge.yaml]
 //             [--encoder-config config/encoder_bridge.yaml] [--duration S]
-//             [--arduino-link PATH] [--pixy-link PATH]
+//             [--arduino-link PATH] [--pixy-link PATH] [--camera-video FIFO]
 // The bridge configs default to the files beside --config. Exits 0 when the
 // run's duration is over (or on SIGINT/SIGTERM).
 #include <cstdio>
@@ -17,10 +17,11 @@ int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
   return app::run_main("robot_sim", [&] {
-    const app::CommandLine args(argc, argv, {"config", "pixy-config", "encoder-config", "duration", "arduino-link", "pixy-link"});
+    const app::CommandLine args(argc, argv, {"config", "pixy-config", "encoder-config", "duration", "arduino-link", "pixy-link",
+                                                    "camera-video"});
     if (args.help()) {
       std::puts("usage: robot_sim --config FILE [--pixy-config FILE] [--encoder-config FILE] [--duration S]\n"
-                "                 [--arduino-link PATH] [--pixy-link PATH]");
+                "                 [--arduino-link PATH] [--pixy-link PATH] [--camera-video FIFO]");
       return 0;
     }
     const std::string config = args.get("config");
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
     c.run.duration_s = args.number("duration", c.run.duration_s);
     c.run.arduino_link = args.get("arduino-link", c.run.arduino_link);
     c.run.pixy_link = args.get("pixy-link", c.run.pixy_link);
+    c.run.camera_video = args.get("camera-video", c.run.camera_video);
     robot_sim::RobotSimNode node(c);
     node.run();
     return 0;

@@ -11,6 +11,12 @@
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/serial/pseudo_terminal.h"
+#ifdef PIXYSLAM_HAS_CAMERA
+#include <csignal>
+
+#include "camera_video_fifo.h"
+#include "pixyslam/camera/synthetic_camera.h"
+#endif
 
 namespace pixyslam::robot_sim {
 
@@ -34,6 +40,12 @@ RobotSimProcessConfig read_robot_sim_process_config(const std::string& sim_yaml,
   r.speed_factor = run.number("speed_factor", 0.1, 10.0, r.speed_factor);
   r.unplug_at_s = run.number("unplug_at_s", 0.0, 1e6, r.unplug_at_s);
   r.unplug_for_s = run.number("unplug_for_s", 0.01, 3600.0, r.unplug_for_s);
+  r.camera_video = run.text("camera_video", r.camera_video);
+#ifndef PIXYSLAM_HAS_CAMERA
+  if (!r.camera_video.empty()) {
+    run.fail("camera_video", "this robot_sim was built without the camera backend (PIXYSLAM_BUILD_CAMERA)");
+  }
+#endif
   run.finish();
   if (root.has("dds")) {
     config::YamlReader dds = root.child("dds");
@@ -62,7 +74,38 @@ struct RobotSimNode::Impl {
       l.y_m(pole.y_m);
       landmarks.push_back(l);
     }
+#ifdef PIXYSLAM_HAS_CAMERA
+    if (!c.run.camera_video.empty()) {
+      std::signal(SIGPIPE, SIG_IGN);  // a reader that leaves is an EPIPE, handled
+      const pixy::CameraModel& model = c.sim.pixy.camera;
+      camera_options.camera = model;
+      camera_options.pole_width_m = c.sim.hardware.pole_width_m;
+      for (const sim::Pole& pole : emulator.poles()) {
+        const std::optional<std::uint16_t> sig = emulator.signature_of(pole.id);
+        if (!sig || *sig < 8 || *sig >= 64) continue;  // two-tag colour codes are drawn
+        camera_poles.push_back({pole.id, pole.x_m, pole.y_m, *sig / 8, *sig % 8});
+      }
+      video = std::make_unique<CameraVideoFifo>(c.run.camera_video, model.image_width_px, model.image_height_px,
+                                                static_cast<int>(std::lround(c.sim.hardware.pixy_rate_hz)));
+    }
+#endif
   }
+
+#ifdef PIXYSLAM_HAS_CAMERA
+  void render_frames(const HardwareOutput& out) {
+    if (!video) return;
+    for (const PixyFrameRecord& f : out.frames) {
+      const cv::Mat image = camera::render_camera_image(slam::Pose2(f.pose.x_m, f.pose.y_m, f.pose.theta_rad),
+                                                        camera_poles, camera_options, detector, camera_rng);
+      video->write_frame(image);
+    }
+  }
+  camera::SyntheticCameraOptions camera_options;
+  camera::DetectorOptions detector = camera::default_detector_options();
+  std::vector<camera::SyntheticPole> camera_poles;
+  std::mt19937_64 camera_rng{7};
+  std::unique_ptr<CameraVideoFifo> video;
+#endif
 
   void plug_in() {
     arduino = std::make_unique<serial::PseudoTerminal>(config.run.arduino_link);
@@ -146,6 +189,9 @@ double RobotSimNode::run() {
     }
     s.write(s.arduino, out.arduino_bytes);
     s.write(s.pixy, out.pixy_bytes);
+#ifdef PIXYSLAM_HAS_CAMERA
+    s.render_frames(out);
+#endif
     for (const eval::TimedPose& pose : out.truth) {
       if (pose.t_s + 1e-9 < next_truth_s) continue;
       s.publish_truth(pose);
@@ -180,6 +226,14 @@ double RobotSimNode::run() {
                                                (s.arduino ? s.arduino->counters().dropped_bytes : 0) +
                                                (s.pixy ? s.pixy->counters().dropped_bytes : 0)),
                static_cast<unsigned long long>(s.unplugged_bytes));
+#ifdef PIXYSLAM_HAS_CAMERA
+  if (s.video) {
+    const CameraVideoFifo::Counters& v = s.video->counters();
+    std::fprintf(stderr, "robot_sim: camera video %s: %llu frames written, dropped %llu (no reader), %llu (pipe full)\n",
+                 s.video->path().c_str(), static_cast<unsigned long long>(v.frames_written),
+                 static_cast<unsigned long long>(v.dropped_no_reader), static_cast<unsigned long long>(v.dropped_pipe_full));
+  }
+#endif
   return t;
 }
 

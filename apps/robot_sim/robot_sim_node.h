@@ -23,6 +23,11 @@ struct RunOptions {
   // at the same links while the robot drives on; bytes meanwhile are lost.
   double unplug_at_s = 0.0;          // 0: never
   double unplug_for_s = 3.0;
+  // The synthetic camera (a build with the camera backend): every Pixy frame
+  // period is also rendered as an image of the poles (render_camera_image) and
+  // written as a YUV4MPEG2 stream into a FIFO at this path, for the pixy
+  // bridge's camera backend. Empty: off.
+  std::string camera_video;
 };
 
 struct RobotSimProcessConfig {

@@ -1,37 +1,81 @@
 // pixy_bridge: the Pixy's UART block stream (serial) -> one LandmarkObservation
-// per camera frame over DDS, until SIGINT/SIGTERM.
-//   pixy_bridge --config config/pixy_bridge.yaml [--device PATH] [--dds-config FILE]
-// --device overrides node.serial_device, --dds-config the Fast DDS XML profiles
+// per camera frame over DDS, until SIGINT/SIGTERM. With a `camera:` section it
+// reads a camera, video file or y4m stream instead and detects the colour codes
+// itself (a software Pixy, components/pixy_bridge/camera; docs/camera.md).
+//   pixy_bridge --config config/pixy_bridge.yaml [--device PATH] [--camera INPUT] [--dds-config FILE]
+// --device overrides node.serial_device (or camera.input), --camera selects the
+// camera backend reading INPUT (with the `camera:` settings, or the defaults),
+// --dds-config the Fast DDS XML profiles
 // file (dds.profiles_file). Prints the effective configuration to stdout, logs
 // to stderr. Exit status: 0 after a clean stop, 2 for a configuration or
 // command-line error, 1 for any other failure.
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <optional>
+#include <stdexcept>
+#include <string>
 
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/bridge/bridge_options.h"
 #include "pixyslam/pixy_node/pixy_node.h"
+#ifdef PIXYSLAM_HAS_CAMERA
+#include "pixyslam/camera/camera_byte_source.h"
+#endif
 
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();  // first: every thread inherits the blocked signals
-  constexpr const char* kUsage = "usage: pixy_bridge --config FILE [--device PATH] [--dds-config FILE]";
+  constexpr const char* kUsage =
+      "usage: pixy_bridge --config FILE [--device PATH] [--camera INPUT] [--dds-config FILE]";
 
   pixy_node::PixyNodeOptions options;
+  pixy_node::CameraSectionReader read_camera;
+#ifdef PIXYSLAM_HAS_CAMERA
+  std::optional<camera::CameraSourceOptions> camera_options;
+  read_camera = [&](config::YamlReader& section, const pixy_node::PixyNodeOptions& so_far) {
+    camera_options = camera::read_camera_source_options(section, so_far.pixy.camera.image_width_px,
+                                                        so_far.pixy.camera.image_height_px);
+  };
+#endif
   const std::optional<int> early_exit =
-      app::set_up("pixy_bridge", kUsage, argc, argv, {"config", "device", "dds-config"},
+      app::set_up("pixy_bridge", kUsage, argc, argv, {"config", "device", "camera", "dds-config"},
                   [&](const app::CommandLine& args) {
-                    options = pixy_node::read_pixy_node_options_file(args.get("config"));
+                    options = pixy_node::read_pixy_node_options_file(args.get("config"), read_camera);
+#ifdef PIXYSLAM_HAS_CAMERA
+                    if (args.has("camera") && !camera_options) {
+                      camera_options = camera::CameraSourceOptions{};
+                      camera_options->image_width_px = options.pixy.camera.image_width_px;
+                      camera_options->image_height_px = options.pixy.camera.image_height_px;
+                    }
+                    if (camera_options) {
+                      if (args.has("camera")) camera_options->input = args.get("camera");
+                      bridge::apply_command_line(args, camera_options->input, options.dds);
+                      return;
+                    }
+#else
+                    if (args.has("camera")) {
+                      throw std::invalid_argument("--camera: this pixy_bridge was built without the camera backend");
+                    }
+#endif
                     bridge::apply_command_line(args, options.serial_device, options.dds);
                   });
   if (early_exit) return *early_exit;
-  app::print_effective_configuration("pixy_bridge", pixy_node::to_yaml(options));
+  std::string effective = pixy_node::to_yaml(options);
+#ifdef PIXYSLAM_HAS_CAMERA
+  if (camera_options) effective += camera::to_yaml(*camera_options);
+#endif
+  app::print_effective_configuration("pixy_bridge", effective);
 
   return app::run_main("pixy_bridge", [&] {
-    pixy_node::PixyNode node(options);
+    std::unique_ptr<bridge::ByteSource> source;
+#ifdef PIXYSLAM_HAS_CAMERA
+    if (camera_options) source = std::make_unique<camera::CameraByteSource>(*camera_options, bridge::stderr_log("pixy_bridge"));
+#endif
+    if (!source) source = std::make_unique<bridge::SerialByteSource>(options.serial_device, options.baud);
+    pixy_node::PixyNode node(options, std::move(source), bridge::stderr_log("pixy_bridge"));
     node.start();
     while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
     }

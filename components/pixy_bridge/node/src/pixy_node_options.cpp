@@ -16,7 +16,8 @@ std::string baud_list() {
 
 }  // namespace
 
-PixyNodeOptions read_pixy_node_options(config::YamlReader& root, const std::string& config_dir) {
+PixyNodeOptions read_pixy_node_options(config::YamlReader& root, const std::string& config_dir,
+                                       const CameraSectionReader& read_camera) {
   PixyNodeOptions o;
   if (root.has("node")) {
     config::YamlReader node = root.child("node");
@@ -41,13 +42,21 @@ PixyNodeOptions read_pixy_node_options(config::YamlReader& root, const std::stri
     config::YamlReader dds = root.child("dds");
     o.dds = dds::read_dds_options(dds, config_dir);
   }
+  if (root.has("camera")) {
+    if (!read_camera) {
+      root.fail("camera", "this pixy_bridge was built without the camera backend "
+                          "(cmake -DPIXYSLAM_BUILD_CAMERA=ON, needs OpenCV)");
+    }
+    config::YamlReader camera = root.child("camera");
+    read_camera(camera, o);
+  }
   root.finish();
   return o;
 }
 
-PixyNodeOptions read_pixy_node_options_file(const std::string& path) {
+PixyNodeOptions read_pixy_node_options_file(const std::string& path, const CameraSectionReader& read_camera) {
   config::YamlReader root = config::YamlReader::from_file(path);
-  return read_pixy_node_options(root, app::folder_of(path));
+  return read_pixy_node_options(root, app::folder_of(path), read_camera);
 }
 
 std::string to_yaml(const PixyNodeOptions& o) {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "pixyslam/bridge/bridge_options.h"
@@ -21,11 +22,18 @@ struct PixyNodeOptions {
   dds::DdsOptions dds;     // `dds:`
 };
 
-// Reads `pixy:` (required), `node:` and `dds:` (optional) from the top level of
-// a file and calls root.finish(). `config_dir` resolves a relative
-// dds.profiles_file. Throws config::ConfigError naming the file and key path.
-PixyNodeOptions read_pixy_node_options(config::YamlReader& root, const std::string& config_dir);
-PixyNodeOptions read_pixy_node_options_file(const std::string& path);
+// Reads an optional `camera:` section (the OpenCV camera backend, which this
+// library does not depend on), given the options read so far.
+using CameraSectionReader = std::function<void(config::YamlReader& camera, const PixyNodeOptions& so_far)>;
+
+// Reads `pixy:` (required), `node:`, `dds:` and `camera:` (optional) from the
+// top level of a file and calls root.finish(). `config_dir` resolves a relative
+// dds.profiles_file. A `camera:` section without `read_camera` is an error
+// (a build without the camera backend). Throws config::ConfigError naming the
+// file and key path.
+PixyNodeOptions read_pixy_node_options(config::YamlReader& root, const std::string& config_dir,
+                                       const CameraSectionReader& read_camera = {});
+PixyNodeOptions read_pixy_node_options_file(const std::string& path, const CameraSectionReader& read_camera = {});
 
 // The effective configuration, in the layout read_pixy_node_options() reads.
 std::string to_yaml(const PixyNodeOptions& options);
