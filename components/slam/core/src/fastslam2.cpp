@@ -216,11 +216,22 @@ void FastSlam2::associate(const Particle& p) {
   std::vector<Candidate> candidates;
   p.map.for_each([&](std::uint32_t slot, const Landmark& lm) {
     if ((lm.mean - p.pose.mean.head<2>()).squaredNorm() < kMinLandmarkDistanceSq) return;
+    // A landmark in the particle's joint state moves with its pose: its fit
+    // must use their cross-covariance, or its predicted spread counts the pose
+    // uncertainty twice and an old landmark out-scores it.
+    const int joint_index = p.joint.active() ? p.joint.find(slot) : -1;
     for (std::size_t k = 0; k < new_slots_.size(); ++k) {
-      const ObservationFit fit = fit_observation(p.pose, lm.mean, lm.cov, z_[k], r_[k]);
-      if (std::isfinite(fit.log_likelihood) && fit.mahalanobis2 <= new_landmark_d2_) {
-        candidates.push_back({fit.log_likelihood, k, slot});
+      double m2 = 0.0, log_likelihood = 0.0;
+      if (joint_index >= 0) {
+        const JointFit fit = fit_observation(p.joint, joint_index, z_[k], r_[k]);
+        m2 = fit.mahalanobis2;
+        log_likelihood = fit.log_likelihood;
+      } else {
+        const ObservationFit fit = fit_observation(p.pose, lm.mean, lm.cov, z_[k], r_[k]);
+        m2 = fit.mahalanobis2;
+        log_likelihood = fit.log_likelihood;
       }
+      if (std::isfinite(log_likelihood) && m2 <= new_landmark_d2_) candidates.push_back({log_likelihood, k, slot});
     }
   });
   std::sort(candidates.begin(), candidates.end(),
