@@ -1,10 +1,13 @@
 // pixyslam_calibrate: camera and odometry calibration from measurements, as
 // YAML the bridges read (docs/calibration.md).
 //   pixyslam_calibrate camera --samples POLES.csv --config config/pixy_bridge.yaml [--out FILE]
+//   pixyslam_calibrate camera --images PHOTOS.csv --config config/pixy_bridge.yaml [--out FILE]
 //   pixyslam_calibrate odometry --straight REC=METRES[,REC=METRES...] --turn REC=DEGREES[,...]
 //                               --config config/encoder_bridge.yaml [--out FILE]
 // POLES.csv: distance_m,height_px[,x_px,bearing_rad] per pole seen at a known
-// place. REC: the Arduino's serial output captured during one straight run
+// place. PHOTOS.csv: image,distance_m[,bearing_rad] per photo of a pole at a
+// known place (camera backend builds): the colour-code detector measures the
+// block, with the config's `camera:` settings or the defaults. REC: the Arduino's serial output captured during one straight run
 // (METRES driven, measured) or one turn in place (DEGREES turned, > 0
 // counter-clockwise). --out: the config with the fitted keys replaced
 // (comments kept), checked by the bridge's own option reader.
@@ -22,13 +25,18 @@
 #include "pixyslam/config/yaml_text.h"
 #include "pixyslam/encoder/encoder_options.h"
 #include "pixyslam/pixy/pixy_options.h"
+#ifdef PIXYSLAM_HAS_CAMERA
+#include "pixyslam/calibration/pole_images.h"
+#include "pixyslam/camera/camera_byte_source.h"
+#endif
 
 namespace {
 
 using namespace pixyslam;
 
 constexpr const char* kUsage =
-    "usage: pixyslam_calibrate camera --samples POLES.csv --config PIXY_BRIDGE.yaml [--out FILE]\n"
+    "usage: pixyslam_calibrate camera (--samples POLES.csv | --images PHOTOS.csv) --config PIXY_BRIDGE.yaml\n"
+    "                                 [--out FILE]\n"
     "       pixyslam_calibrate odometry --straight REC=METRES[,...] --turn REC=DEGREES[,...]\n"
     "                                   --config ENCODER_BRIDGE.yaml [--out FILE]\n";
 
@@ -70,15 +78,39 @@ std::vector<calibration::OdometryRun> read_runs(const std::string& flag, const s
   return runs;
 }
 
-int camera(const app::CommandLine& args) {
-  const std::string samples_path = args.get("samples");
+// The pole samples of --samples, or measured in the photos of --images.
+std::vector<calibration::PoleSample> camera_samples(const app::CommandLine& args, config::YamlReader& root,
+                                                    const pixy::PixyOptions& pixy, std::string& source) {
+  if (args.has("samples") == args.has("images")) throw std::invalid_argument("give one of --samples and --images");
+  if (args.has("samples")) {
+    source = args.get("samples");
+    return calibration::parse_pole_samples(read_file(source), source);
+  }
+  source = args.get("images");
+#ifdef PIXYSLAM_HAS_CAMERA
+  camera::DetectorOptions detector = camera::default_detector_options();
+  if (root.has("camera")) {
+    config::YamlReader section = root.child("camera");
+    detector = camera::read_camera_source_options(section, pixy.camera.image_width_px, pixy.camera.image_height_px)
+                   .detector;
+  }
+  const auto images = calibration::parse_pole_images(read_file(source), source, app::folder_of(source));
+  return calibration::pole_samples_from_images(images, detector, pixy.camera, source);
+#else
+  (void)root;
+  (void)pixy;
+  throw std::invalid_argument("--images: this pixyslam_calibrate was built without the camera backend");
+#endif
+}
+
+int calibrate_camera(const app::CommandLine& args) {
   const std::string config_path = args.get("config");
   const std::string config_text = read_file(config_path);
   config::YamlReader root = config::YamlReader::from_string(config_text, config_path);
   config::YamlReader pixy_yaml = root.child("pixy");
   const pixy::PixyOptions pixy = pixy::read_pixy_options(pixy_yaml);
-  const std::vector<calibration::PoleSample> samples =
-      calibration::parse_pole_samples(read_file(samples_path), samples_path);
+  std::string samples_path;
+  const std::vector<calibration::PoleSample> samples = camera_samples(args, root, pixy, samples_path);
   const calibration::CameraFit fit = calibration::fit_camera(samples, pixy.camera);
   std::printf("camera calibration: %zu poles from %s (pole height %.3f m, S_h %.3f mm, I_h %d px)\n",
               samples.size(), samples_path.c_str(), pixy.camera.landmark_height_m, pixy.camera.sensor_height_mm,
@@ -162,8 +194,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   return app::run_main("pixyslam_calibrate", [&] {
-    const app::CommandLine args(argc - 1, argv + 1, command == "camera" ? std::set<std::string>{"samples", "config", "out"}
+    const app::CommandLine args(argc - 1, argv + 1, command == "camera" ? std::set<std::string>{"samples", "images", "config", "out"}
                                                                         : std::set<std::string>{"straight", "turn", "config", "out"});
-    return command == "camera" ? camera(args) : odometry(args);
+    return command == "camera" ? calibrate_camera(args) : odometry(args);
   });
 }

@@ -28,9 +28,8 @@ double rms(const std::vector<double>& v) {
 
 }  // namespace
 
-std::vector<PoleSample> parse_pole_samples(std::string_view text, const std::string& origin) {
-  std::vector<PoleSample> out;
-  std::vector<std::string> header;
+CsvTable read_csv(std::string_view text, const std::string& origin) {
+  CsvTable table;
   int line_number = 0;
   std::size_t begin = 0;
   while (begin < text.size()) {
@@ -40,50 +39,67 @@ std::vector<PoleSample> parse_pole_samples(std::string_view text, const std::str
     ++line_number;
     if (line.empty() || line[0] == '#') continue;
     std::vector<std::string> fields = config::split_comma_list(line);
-    const std::string where = origin + ":" + std::to_string(line_number) + ": ";
-    if (header.empty()) {
-      header = fields;
-      const bool two = header == std::vector<std::string>{"distance_m", "height_px"};
-      const bool four = header == std::vector<std::string>{"distance_m", "height_px", "x_px", "bearing_rad"};
-      if (!two && !four) {
-        throw config::ConfigError(where + "the header must be 'distance_m,height_px' or "
-                                  "'distance_m,height_px,x_px,bearing_rad'");
-      }
+    if (table.header.empty()) {
+      table.header = fields;
       continue;
     }
-    if (fields.size() != header.size()) {
-      throw config::ConfigError(where + std::to_string(header.size()) + " fields expected, got " +
+    if (fields.size() != table.header.size()) {
+      throw config::ConfigError(origin + ":" + std::to_string(line_number) + ": " +
+                                std::to_string(table.header.size()) + " fields expected, got " +
                                 std::to_string(fields.size()));
     }
-    std::vector<double> v;
-    for (std::size_t i = 0; i < fields.size(); ++i) {
-      std::size_t used = 0;
-      double x = 0.0;
-      try {
-        x = std::stod(fields[i], &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != fields[i].size() || !std::isfinite(x)) {
-        throw config::ConfigError(where + header[i] + " '" + fields[i] + "' is not a number");
-      }
-      v.push_back(x);
-    }
+    table.rows.push_back({line_number, std::move(fields)});
+  }
+  if (table.header.empty()) throw config::ConfigError(origin + ": no header line");
+  return table;
+}
+
+double csv_number(const CsvTable& table, const CsvRow& row, std::size_t column, const std::string& origin) {
+  const std::string& field = row.fields[column];
+  std::size_t used = 0;
+  double x = 0.0;
+  try {
+    x = std::stod(field, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != field.size() || !std::isfinite(x)) {
+    throw config::ConfigError(origin + ":" + std::to_string(row.line) + ": " + table.header[column] + " '" + field +
+                              "' is not a number");
+  }
+  return x;
+}
+
+void check_pole_sample(const PoleSample& s, const std::string& where) {
+  if (s.distance_m <= 0.0 || s.distance_m > 100.0) throw config::ConfigError(where + "distance_m must be in (0, 100]");
+  if (s.height_px <= 0.0 || s.height_px > 10000.0) throw config::ConfigError(where + "height_px must be in (0, 10000]");
+  if (s.has_bearing && std::abs(s.bearing_rad) >= M_PI / 2) {
+    throw config::ConfigError(where + "bearing_rad must be in (-pi/2, pi/2)");
+  }
+}
+
+std::vector<PoleSample> parse_pole_samples(std::string_view text, const std::string& origin) {
+  const CsvTable table = read_csv(text, origin);
+  const bool two = table.header == std::vector<std::string>{"distance_m", "height_px"};
+  const bool four = table.header == std::vector<std::string>{"distance_m", "height_px", "x_px", "bearing_rad"};
+  if (!two && !four) {
+    throw config::ConfigError(origin + ": the header must be 'distance_m,height_px' or "
+                              "'distance_m,height_px,x_px,bearing_rad'");
+  }
+  std::vector<PoleSample> out;
+  for (const CsvRow& row : table.rows) {
     PoleSample s;
-    s.distance_m = v[0];
-    s.height_px = v[1];
-    s.line = line_number;
-    if (s.distance_m <= 0.0 || s.distance_m > 100.0) throw config::ConfigError(where + "distance_m must be in (0, 100]");
-    if (s.height_px <= 0.0 || s.height_px > 10000.0) throw config::ConfigError(where + "height_px must be in (0, 10000]");
-    if (v.size() == 4) {
+    s.distance_m = csv_number(table, row, 0, origin);
+    s.height_px = csv_number(table, row, 1, origin);
+    s.line = row.line;
+    if (four) {
       s.has_bearing = true;
-      s.x_px = v[2];
-      s.bearing_rad = v[3];
-      if (std::abs(s.bearing_rad) >= M_PI / 2) throw config::ConfigError(where + "bearing_rad must be in (-pi/2, pi/2)");
+      s.x_px = csv_number(table, row, 2, origin);
+      s.bearing_rad = csv_number(table, row, 3, origin);
     }
+    check_pole_sample(s, origin + ":" + std::to_string(row.line) + ": ");
     out.push_back(s);
   }
-  if (header.empty()) throw config::ConfigError(origin + ": no header line");
   return out;
 }
 

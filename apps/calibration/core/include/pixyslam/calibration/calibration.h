@@ -22,8 +22,26 @@ struct PoleSample {
   int line = 0;  // in the CSV it came from
 };
 
-// CSV with a header: distance_m,height_px[,x_px,bearing_rad]; '#' comments and
-// blank lines skipped. config::ConfigError naming `origin`:line on a bad row.
+// A CSV file: a header line, then rows with as many comma-separated fields;
+// '#' comments and blank lines skipped. config::ConfigError naming
+// `origin`:line for a row of the wrong width, or a file without a header.
+struct CsvRow {
+  int line = 0;
+  std::vector<std::string> fields;
+};
+struct CsvTable {
+  std::vector<std::string> header;
+  std::vector<CsvRow> rows;
+};
+CsvTable read_csv(std::string_view text, const std::string& origin);
+// Field `column` of `row` as a finite number, else config::ConfigError naming
+// origin:line, the column's name and the text.
+double csv_number(const CsvTable& table, const CsvRow& row, std::size_t column, const std::string& origin);
+// Throws config::ConfigError (prefixed by `where`) for a distance outside (0, 100] m,
+// a height outside (0, 10000] px or a bearing outside (-pi/2, pi/2).
+void check_pole_sample(const PoleSample& sample, const std::string& where);
+
+// CSV with the header distance_m,height_px[,x_px,bearing_rad].
 std::vector<PoleSample> parse_pole_samples(std::string_view text, const std::string& origin);
 
 struct CameraFit {
