@@ -20,6 +20,7 @@ inline msg::Odometry odometry_msg(const slam::OdometrySample& s, double period_s
   m.v_mps(s.v_mps);
   m.w_radps(s.w_radps);
   m.period_s(period_s);
+  m.encoder_samples(s.measured ? 5 : 0);  // 5 Arduino samples per 10 Hz period, as the bridge reports
   return m;
 }
 

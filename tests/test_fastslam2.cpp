@@ -560,6 +560,26 @@ TEST(FastSlam2, ObservationAtZeroPredictedRangeKeepsTheEstimateFinite) {
   for (const Particle& p : f.particles()) EXPECT_FALSE(std::isnan(p.log_weight));
 }
 
+// An encoder that stops reporting (unplugged) sends periods without wheel
+// data: the motion is unknown, not zero, so the filter keeps driving on the
+// control it holds, and stops only control_timeout_s after the last measured one.
+TEST(FastSlam2, OdometryWithoutWheelDataKeepsTheHeldControlUntilItsTimeout) {
+  FilterOptions o;
+  o.particles = 20;
+  o.control_timeout_s = 2.0;
+  FastSlam2 f(o, Pose2::Zero());
+  f.add_odometry({0.0, 0.5, 0.0});
+  for (int k = 1; k <= 10; ++k) f.add_odometry({0.1 * k, 0.0, 0.0, false});  // 1 s without data
+  EXPECT_EQ(f.counters().odometry_no_data, 10u);
+  EXPECT_NEAR(f.pose_estimate().mean.x(), 0.5, 0.05) << "moved on at 0.5 m/s";
+  for (int k = 11; k <= 40; ++k) f.add_odometry({0.1 * k, 0.0, 0.0, false});  // the control expires at 2 s
+  EXPECT_NEAR(f.pose_estimate().mean.x(), 1.0, 0.05);
+  EXPECT_EQ(f.counters().control_timeouts, 1u);
+  f.add_odometry({4.1, 0.0, 0.0});  // measured: stopped
+  f.add_odometry({5.0, 0.0, 0.0});
+  EXPECT_NEAR(f.pose_estimate().mean.x(), 1.0, 0.05);
+}
+
 TEST(FastSlam2, OutOfOrderSamplesAreCountedAndAppliedAtFilterTime) {
   FilterOptions o;
   o.particles = 20;

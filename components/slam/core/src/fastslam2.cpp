@@ -131,6 +131,10 @@ void FastSlam2::add_odometry(const OdometrySample& sample) {
   }
   if (has_time_ && sample.t_s < time_s_) ++counters_.odometry_out_of_order;
   advance_to(sample.t_s);
+  if (!sample.measured) {
+    ++counters_.odometry_no_data;
+    return;
+  }
   control_ = sample;
   control_time_s_ = std::max(sample.t_s, time_s_);
 }

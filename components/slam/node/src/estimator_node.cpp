@@ -80,6 +80,7 @@ diagnostics::Snapshot EstimatorNode::diagnostics_snapshot() const {
                 {"samples_reordered", c.samples_reordered, false},
                 {"odometry_invalid", f.odometry_invalid, true},
                 {"odometry_out_of_order", f.odometry_out_of_order, true},
+                {"odometry_no_data", f.odometry_no_data, true},
                 {"control_timeouts", f.control_timeouts, false},
                 {"frames_invalid", f.frames_invalid, true},
                 {"frames_out_of_order", f.frames_out_of_order, true},

@@ -31,6 +31,7 @@ slam::OdometryInput to_odometry_input(const msg::Odometry& m, std::uint64_t epoc
   in.sample.t_s = to_seconds(m.header().stamp_ns(), epoch_ns);
   in.sample.v_mps = m.v_mps();
   in.sample.w_radps = m.w_radps();
+  in.sample.measured = m.encoder_samples() > 0;
   in.period_s = m.period_s();
   in.seq = m.header().seq();
   return in;

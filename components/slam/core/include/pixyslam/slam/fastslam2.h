@@ -49,6 +49,7 @@ struct FilterCounters {
   std::uint64_t odometry_samples = 0;
   std::uint64_t odometry_invalid = 0;  // non-finite, or faster than max_speed / max_turn_rate: dropped
   std::uint64_t odometry_out_of_order = 0;
+  std::uint64_t odometry_no_data = 0;  // samples without wheel data: the held control goes on
   std::uint64_t control_timeouts = 0;
   std::uint64_t frames = 0;
   std::uint64_t frames_invalid = 0;  // non-finite time: dropped with their detections

@@ -19,6 +19,10 @@ struct OdometrySample {
   double t_s = 0.0;
   double v_mps = 0.0;
   double w_radps = 0.0;
+  // false: no wheel data for the period (an unplugged or stalled encoder), so
+  // the motion is unknown, not zero; the filter keeps the control it holds
+  // (until control_timeout_s after the last measured sample).
+  bool measured = true;
 };
 
 // One detection of an identified landmark, in the robot frame. Sigmas <= 0 mean
