@@ -146,6 +146,19 @@ serial::ReadResult CameraByteSource::end_of_file() {
   return {serial::ReadStatus::kTimeout, 0};
 }
 
+bool CameraByteSource::file_frame_due(std::chrono::milliseconds timeout) {
+  if (!is_file_) return true;  // a camera or FIFO sets its own pace
+  // A file plays at file_fps, like a camera.
+  const auto now = std::chrono::steady_clock::now();
+  if (now < next_due_) {
+    std::this_thread::sleep_for(std::min<std::chrono::steady_clock::duration>(next_due_ - now, timeout));
+    if (std::chrono::steady_clock::now() < next_due_) return false;
+  }
+  next_due_ += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(1.0 / options_.file_fps));
+  return true;
+}
+
 serial::ReadResult CameraByteSource::next_y4m(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (y4m_frames_.empty()) {
@@ -167,16 +180,7 @@ serial::ReadResult CameraByteSource::next_y4m(std::chrono::milliseconds timeout)
     }
     y4m_.feed(chunk, static_cast<std::size_t>(n), [this](cv::Mat&& f) { y4m_frames_.push_back(std::move(f)); });
   }
-  if (is_file_) {
-    // A file plays at file_fps, like a camera.
-    const auto now = std::chrono::steady_clock::now();
-    if (now < next_due_) {
-      std::this_thread::sleep_for(std::min<std::chrono::steady_clock::duration>(next_due_ - now, timeout));
-      if (std::chrono::steady_clock::now() < next_due_) return {serial::ReadStatus::kTimeout, 0};
-    }
-    next_due_ += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(1.0 / options_.file_fps));
-  }
+  if (!file_frame_due(timeout)) return {serial::ReadStatus::kTimeout, 0};
   deliver(y4m_frames_.front());
   y4m_frames_.pop_front();
   return {serial::ReadStatus::kData, 0};
@@ -184,15 +188,7 @@ serial::ReadResult CameraByteSource::next_y4m(std::chrono::milliseconds timeout)
 
 serial::ReadResult CameraByteSource::next_video(std::chrono::milliseconds timeout) {
   if (ended_) return end_of_file();
-  if (is_file_) {
-    const auto now = std::chrono::steady_clock::now();
-    if (now < next_due_) {
-      std::this_thread::sleep_for(std::min<std::chrono::steady_clock::duration>(next_due_ - now, timeout));
-      if (std::chrono::steady_clock::now() < next_due_) return {serial::ReadStatus::kTimeout, 0};
-    }
-    next_due_ += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(1.0 / options_.file_fps));
-  }
+  if (!file_frame_due(timeout)) return {serial::ReadStatus::kTimeout, 0};
   cv::Mat frame;
   if (!capture_->read(frame) || frame.empty()) {
     if (is_file_) return end_of_file();

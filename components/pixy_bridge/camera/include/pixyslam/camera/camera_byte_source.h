@@ -65,6 +65,8 @@ class CameraByteSource final : public bridge::ByteSource {
   serial::ReadResult next_y4m(std::chrono::milliseconds timeout);
   serial::ReadResult next_video(std::chrono::milliseconds timeout);
   serial::ReadResult end_of_file();
+  // A file's next frame is due (waits up to `timeout` for it); always true for a live input.
+  bool file_frame_due(std::chrono::milliseconds timeout);
 
   CameraSourceOptions options_;
   bridge::LogFunction log_;
