@@ -41,6 +41,7 @@ CsvTable read_csv(std::string_view text, const std::string& origin) {
     std::vector<std::string> fields = config::split_comma_list(line);
     if (table.header.empty()) {
       table.header = fields;
+      table.header_line = line_number;
       continue;
     }
     if (fields.size() != table.header.size()) {
@@ -83,8 +84,8 @@ std::vector<PoleSample> parse_pole_samples(std::string_view text, const std::str
   const bool two = table.header == std::vector<std::string>{"distance_m", "height_px"};
   const bool four = table.header == std::vector<std::string>{"distance_m", "height_px", "x_px", "bearing_rad"};
   if (!two && !four) {
-    throw config::ConfigError(origin + ": the header must be 'distance_m,height_px' or "
-                              "'distance_m,height_px,x_px,bearing_rad'");
+    throw config::ConfigError(origin + ":" + std::to_string(table.header_line) +
+                              ": the header must be 'distance_m,height_px' or 'distance_m,height_px,x_px,bearing_rad'");
   }
   std::vector<PoleSample> out;
   for (const CsvRow& row : table.rows) {

@@ -14,7 +14,8 @@ std::vector<PoleImage> parse_pole_images(std::string_view text, const std::strin
   const bool two = table.header == std::vector<std::string>{"image", "distance_m"};
   const bool three = table.header == std::vector<std::string>{"image", "distance_m", "bearing_rad"};
   if (!two && !three) {
-    throw config::ConfigError(origin + ": the header must be 'image,distance_m' or 'image,distance_m,bearing_rad'");
+    throw config::ConfigError(origin + ":" + std::to_string(table.header_line) +
+                              ": the header must be 'image,distance_m' or 'image,distance_m,bearing_rad'");
   }
   std::vector<PoleImage> out;
   for (const CsvRow& row : table.rows) {

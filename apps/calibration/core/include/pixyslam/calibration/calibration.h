@@ -30,6 +30,7 @@ struct CsvRow {
   std::vector<std::string> fields;
 };
 struct CsvTable {
+  int header_line = 0;
   std::vector<std::string> header;
   std::vector<CsvRow> rows;
 };
