@@ -249,6 +249,8 @@ void FastSlam2::associate(const Particle& p) {
     slots_[c.k] = c.slot;
   }
   for (std::size_t k = 0; k < new_slots_.size(); ++k) {
+    new_log_likelihood_[k] = 0.0;
+    if (assigned[k]) continue;
     // A new landmark explains the detection with the likelihood of a fit at the
     // gate boundary (Montemerlo's p0), spread by the particle's pose uncertainty
     // as a landmark there would be: a particle that starts a duplicate then gains
@@ -258,7 +260,6 @@ void FastSlam2::associate(const Particle& p) {
     const Eigen::Matrix<double, 2, 3> h = predict_observation(p.pose.mean, at).h_pose;
     const Eigen::Matrix2d s0 = h * p.pose.cov * h.transpose() + r_[k];
     new_log_likelihood_[k] = -0.5 * new_landmark_d2_ - std::log(2.0 * M_PI) - 0.5 * std::log(s0.determinant());
-    if (assigned[k]) continue;
     if (new_slots_[k] < 0) new_slots_[k] = slot_for(next_unlabelled_id_++);
     slots_[k] = static_cast<std::uint32_t>(new_slots_[k]);
   }
