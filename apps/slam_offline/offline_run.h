@@ -58,11 +58,15 @@ namespace pixyslam::offline {
 // Measured on Dataset6 against Vicon, all five robots pooled (docs/mrclam.md):
 // - the camera's range behaves like depth along the optical axis with lens
 //   distortion: range_true = range / (range_scale * cos(bearing)^cos_exponent);
-// - the robots start to move about 0.15 s after a velocity command is logged.
+// - the robots start to move about 0.15 s after a velocity command is logged;
+// - they drive slower while turning: forward speed = commanded speed *
+//   (speed_scale - speed_loss_per_radps * |commanded turn rate|), at least 0.
 struct MrclamSensorModel {
   double range_scale = 1.0;
   double range_cos_bearing_exponent = 0.0;
   double odometry_delay_s = 0.0;
+  double speed_scale = 1.0;
+  double speed_loss_per_radps = 0.0;
 };
 // Reads the optional `mrclam:` mapping of a config file's root (defaults: ideal sensors).
 MrclamSensorModel read_mrclam_sensor_model(config::YamlReader& root);
