@@ -1,5 +1,6 @@
 #include "offline_run.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
