@@ -78,7 +78,7 @@ TEST(DdsLoopback, LateJoinerGetsTheRecentMapStatesEndingWithTheCurrent) {
   });
   std::unique_lock<std::mutex> lock(mutex);
   ASSERT_TRUE(cv.wait_for(lock, std::chrono::seconds(10), [&] { return !counts.empty() && counts.back() == 102u; }));
-  // Transient local, keep-last 32: the writer's recent states, in order, the current one last.
+  // Transient local, keep-last 256: the writer's recent states, in order, the current one last.
   EXPECT_EQ(counts, (std::vector<std::uint32_t>{100u, 101u, 102u}));
 }
 
