@@ -122,7 +122,6 @@ MrclamSensorModel read_mrclam_sensor_model(config::YamlReader& root) {
   m.range_scale = y.number("range_scale", 0.5, 2.0, m.range_scale);
   m.range_cos_bearing_exponent = y.number("range_cos_bearing_exponent", 0.0, 3.0, m.range_cos_bearing_exponent);
   m.odometry_delay_s = y.number("odometry_delay_s", -2.0, 2.0, m.odometry_delay_s);
-  m.measurement_delay_s = y.number("measurement_delay_s", -2.0, 2.0, m.measurement_delay_s);
   m.speed_scale = y.number("speed_scale", 0.5, 2.0, m.speed_scale);
   m.speed_loss_per_radps = y.number("speed_loss_per_radps", 0.0, 10.0, m.speed_loss_per_radps);
   y.finish();
@@ -145,7 +144,7 @@ RunInput mrclam_input(const mrclam::RobotData& d, const MrclamSensorModel& model
     in.odometry.push_back({o.t_s + model.odometry_delay_s, o.v_mps * speed_factor, o.w_radps});
   }
   for (const mrclam::MeasurementFrame& f : d.frames) {
-    slam::ObservationFrame frame{f.t_s - model.measurement_delay_s, {}};
+    slam::ObservationFrame frame{f.t_s, {}};
     for (const mrclam::Detection& det : f.detections) {
       slam::RangeBearing z;
       z.landmark_id = det.subject;

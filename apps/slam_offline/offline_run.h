@@ -59,14 +59,12 @@ namespace pixyslam::offline {
 // - the camera's range behaves like depth along the optical axis with lens
 //   distortion: range_true = range / (range_scale * cos(bearing)^cos_exponent);
 // - the robots start to move about 0.15 s after a velocity command is logged;
-// - a camera frame is stamped about 0.045 s after its image was taken;
 // - they drive slower while turning: forward speed = commanded speed *
 //   (speed_scale - speed_loss_per_radps * |commanded turn rate|), at least 0.
 struct MrclamSensorModel {
   double range_scale = 1.0;
   double range_cos_bearing_exponent = 0.0;
   double odometry_delay_s = 0.0;
-  double measurement_delay_s = 0.0;
   double speed_scale = 1.0;
   double speed_loss_per_radps = 0.0;
 };
