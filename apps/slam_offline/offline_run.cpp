@@ -4,6 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
+#include <limits>
+#include <stdexcept>
 
 #include "mrclam_dataset.h"
 #include "pixyslam/config/yaml_reader.h"
@@ -79,6 +82,72 @@ Report evaluate(const RunInput& input, const RunResult& result) {
     r.landmarks = eval::compare_landmarks(est, input.landmarks);
   }
   return r;
+}
+
+namespace {
+
+// The truth pose nearest to t (truth sorted by time, not empty).
+const eval::TimedPose& truth_at(const std::vector<eval::TimedPose>& truth, double t) {
+  auto it = std::lower_bound(truth.begin(), truth.end(), t,
+                             [](const eval::TimedPose& p, double time) { return p.t_s < time; });
+  if (it == truth.end()) return truth.back();
+  if (it != truth.begin() && t - std::prev(it)->t_s < it->t_s - t) --it;
+  return *it;
+}
+
+}  // namespace
+
+DataLimits data_limits(const RunInput& input) {
+  std::vector<eval::TimedPose> truth = input.truth;
+  std::sort(truth.begin(), truth.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  std::vector<double> frame_times;
+  for (const slam::ObservationFrame& f : input.frames) {
+    if (!f.detections.empty() && f.t_s >= input.start_time_s) frame_times.push_back(f.t_s);
+  }
+  std::sort(frame_times.begin(), frame_times.end());
+  if (truth.empty() || frame_times.empty()) {
+    throw std::invalid_argument("data_limits: needs ground truth and at least one camera frame");
+  }
+  // Dead reckoning from the start pose through time-ordered odometry and frames;
+  // `reset` puts the pose on the truth at every frame.
+  const auto drive = [&](bool reset, double until_s) {
+    std::vector<eval::TimedPose> path;
+    slam::Pose2 x = input.initial_pose;
+    slam::OdometrySample control{input.start_time_s, 0.0, 0.0};
+    double t = input.start_time_s;
+    const auto advance = [&](double to) {
+      if (to > t) x = slam::move(x, control.v_mps, control.w_radps, to - t);
+      t = std::max(t, to);
+    };
+    std::size_t i = 0, k = 0;
+    while (i < input.odometry.size() || k < frame_times.size()) {
+      if (k == frame_times.size() || (i < input.odometry.size() && input.odometry[i].t_s <= frame_times[k])) {
+        const slam::OdometrySample& s = input.odometry[i++];
+        advance(s.t_s);
+        control = s;
+      } else {
+        advance(frame_times[k++]);
+        if (reset) {
+          const eval::TimedPose& g = truth_at(truth, t);
+          x = slam::Pose2(g.x_m, g.y_m, g.theta_rad);
+        }
+      }
+      path.push_back({t, x.x(), x.y(), x.z()});
+      if (t >= until_s) break;
+    }
+    return path;
+  };
+  DataLimits limits;
+  limits.blind_drift = eval::compare_trajectory(drive(true, std::numeric_limits<double>::infinity()), truth);
+  const auto heading_error_at = [&](double at_s) {
+    const std::vector<eval::TimedPose> path = drive(false, at_s);
+    const eval::TimedPose& g = truth_at(truth, path.back().t_s);
+    return slam::wrap_angle(path.back().theta_rad - g.theta_rad);
+  };
+  limits.first_frame_t_s = frame_times.front() - input.start_time_s;
+  limits.heading_error_first_frame_rad = heading_error_at(frame_times.front());
+  limits.heading_error_30s_later_rad = heading_error_at(frame_times.front() + 30.0);
+  return limits;
 }
 
 void print_report(const std::string& title, const Report& r, const RunResult& res) {

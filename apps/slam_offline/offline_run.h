@@ -42,6 +42,22 @@ struct Report {
   eval::LandmarkErrors landmarks;
 };
 Report evaluate(const RunInput& input, const RunResult& result);
+
+// What the data leave to any online estimator (needs ground truth):
+// - blind_drift: dead reckoning through the run's odometry, reset to the ground
+//   truth at every camera frame: an estimator exact whenever it sees a landmark,
+//   so what remains is the drift between frames;
+// - the dead-reckoning heading error at the first frame and 30 s later: a map
+//   started then is rotated by it, and no later observation sees the rotation
+//   (only the start pose and the odometry up to then tie the map to the world).
+struct DataLimits {
+  eval::TrajectoryErrors blind_drift;
+  double first_frame_t_s = 0.0;  // since start_time_s
+  double heading_error_first_frame_rad = 0.0;
+  double heading_error_30s_later_rad = 0.0;
+};
+// Throws std::invalid_argument without truth or frames.
+DataLimits data_limits(const RunInput& input);
 void print_report(const std::string& title, const Report& report, const RunResult& result);
 
 }  // namespace pixyslam::offline
