@@ -3,6 +3,7 @@
 // (invalid and out-of-order samples), the Mahalanobis gate, and the importance
 // weights.
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -434,6 +435,16 @@ TEST(FastSlam2, ValidateNamesTheOffendingField) {
     o.delayed_sampling.max_landmarks = 0;
     EXPECT_NE(invalid_argument_of(o).find("delayed_sampling.max_landmarks"), std::string::npos);
   }
+  {
+    FilterOptions o;
+    o.anchor_frame.min_landmarks = 1;
+    EXPECT_NE(invalid_argument_of(o).find("anchor_frame.min_landmarks"), std::string::npos);
+  }
+  {
+    FilterOptions o;
+    o.anchor_frame.min_spread_m = 0.0;
+    EXPECT_NE(invalid_argument_of(o).find("anchor_frame.min_spread_m"), std::string::npos);
+  }
   // The constructor validates too.
   FilterOptions bad;
   bad.particles = 0;
@@ -777,6 +788,109 @@ TEST(FastSlam2, PriorMapIsSharedByAllParticlesAndUsed) {
   f.add_observations({0.1, {{11, 2.0, 0.0}, {12, 3.0, M_PI / 2}}});
   EXPECT_EQ(f.counters().observations_used, 2u);
   EXPECT_EQ(f.counters().observations_new_landmark, 0u);
+}
+
+// ------------------------------------------------------ output frame anchoring
+
+// Centroid offset and least-squares rotation from `now` onto `then` (same ids).
+struct RigidOffset {
+  Eigen::Vector2d translation = Eigen::Vector2d::Zero();
+  double rotation = 0.0;
+};
+RigidOffset rigid_offset(const std::vector<LandmarkEstimate>& now, const std::vector<LandmarkEstimate>& then) {
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> pairs;
+  for (const LandmarkEstimate& a : now) {
+    for (const LandmarkEstimate& b : then) {
+      if (a.id == b.id) pairs.push_back({a.mean, b.mean});
+    }
+  }
+  EXPECT_GE(pairs.size(), 2u);
+  Eigen::Vector2d ca = Eigen::Vector2d::Zero(), cb = Eigen::Vector2d::Zero();
+  for (const auto& [a, b] : pairs) {
+    ca += a;
+    cb += b;
+  }
+  ca /= static_cast<double>(pairs.size());
+  cb /= static_cast<double>(pairs.size());
+  double dot = 0.0, cross = 0.0;
+  for (const auto& [a, b] : pairs) {
+    dot += (a - ca).dot(b - cb);
+    cross += (a - ca).x() * (b - cb).y() - (a - ca).y() * (b - cb).x();
+  }
+  return {cb - ca, std::atan2(cross, dot)};
+}
+
+std::vector<LandmarkEstimate> with_ids(const std::vector<LandmarkEstimate>& all, const std::vector<int>& ids) {
+  std::vector<LandmarkEstimate> out;
+  for (const LandmarkEstimate& l : all) {
+    if (std::find(ids.begin(), ids.end(), l.id) != ids.end()) out.push_back(l);
+  }
+  return out;
+}
+
+TEST(AnchorFrame, OutputStaysOnTheFirstLandmarksWhileTheParticlesMove) {
+  sim::WorldOptions w;
+  w.duration_s = 60.0;
+  const sim::WorldRun run = sim::simulate(w);
+  FilterOptions o = options_for_world(w, 100, 5);
+  o.anchor_frame.enabled = true;
+  FastSlam2 f(o, run.initial_pose);
+  std::vector<LandmarkEstimate> anchored;
+  double largest_correction = 0.0;
+  int checked = 0;
+  feed(f, run, {}, [&] {
+    if (f.anchor_ids().empty()) {
+      // Until anchored the output is the particles' own frame.
+      EXPECT_EQ(f.output_rotation_rad(), 0.0);
+      EXPECT_TRUE(f.output_translation_m().isZero());
+      return;
+    }
+    const std::vector<LandmarkEstimate> now = with_ids(f.landmarks_mixture(), f.anchor_ids());
+    if (anchored.empty()) {
+      anchored = now;
+      return;
+    }
+    // In the output the anchors' mean positions keep their anchored centroid
+    // and least-squares orientation exactly ...
+    const RigidOffset off = rigid_offset(now, anchored);
+    EXPECT_LT(off.translation.norm(), 1e-9);
+    EXPECT_LT(std::abs(off.rotation), 1e-9);
+    ++checked;
+    // ... while in the particles' frame they have moved.
+    largest_correction = std::max(largest_correction, f.output_translation_m().norm());
+  });
+  ASSERT_GE(anchored.size(), 2u);
+  EXPECT_GT(checked, 100);
+  EXPECT_GT(largest_correction, 1e-4);
+  // The output pose is the particles' mean moved by the same transform.
+  const PoseEstimate e = f.pose_estimate();
+  EXPECT_NEAR(e.mean.z(), wrap_angle(e.mean.z()), 1e-12);
+  EXPECT_LT(rigid_offset(with_ids(f.landmarks_of_best(), f.anchor_ids()), anchored).translation.norm(), 0.05);
+}
+
+TEST(AnchorFrame, WaitsUntilTheLandmarksSpreadEnoughToFixARotation) {
+  FilterOptions o;
+  o.particles = 50;
+  o.anchor_frame.enabled = true;
+  o.anchor_frame.min_observations = 5;
+  o.anchor_frame.min_spread_m = 0.5;
+  FastSlam2 f(o, Pose2::Zero());
+  f.add_odometry({0.0, 0.0, 0.0});
+  // Two poles 0.2 m apart (spread 0.1 m): seen often, but they fix no rotation.
+  double t = 0.1;
+  for (int k = 0; k < 10; ++k, t += 0.1) {
+    f.add_observations({t, {{1, 2.0, 0.05}, {2, 2.01, -0.05}}});
+  }
+  EXPECT_TRUE(f.anchor_ids().empty());
+  // A third pole 2 m to the side: anchored once it has been seen 5 times.
+  for (int k = 0; k < 4; ++k, t += 0.1) f.add_observations({t, {{3, 2.0, M_PI / 2}}});
+  EXPECT_TRUE(f.anchor_ids().empty());
+  f.add_observations({t, {{3, 2.0, M_PI / 2}}});
+  EXPECT_EQ(f.anchor_ids(), (std::vector<int>{1, 2, 3}));
+  // A prior map replaces the frame: anchoring starts again.
+  f.set_prior_map({{7, Eigen::Vector2d(1.0, 0.0), Eigen::Matrix2d::Identity() * 1e-4, 9}});
+  EXPECT_TRUE(f.anchor_ids().empty());
+  EXPECT_EQ(f.output_rotation_rad(), 0.0);
 }
 
 }  // namespace

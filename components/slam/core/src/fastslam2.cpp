@@ -7,6 +7,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 
 #include "pixyslam/slam/observation_model.h"
 #include "pixyslam/slam/resampling.h"
@@ -47,6 +48,9 @@ Pose2 sample_pose(const PoseGaussian& g, std::mt19937_64& rng) {
 bool plausible_sigma(double sigma) {
   return std::isfinite(sigma) && (sigma <= 0.0 || (sigma >= 1e-6 && sigma <= 1e3));
 }
+
+// Landmarks at most considered as anchors (the first ones seen).
+constexpr std::size_t kMaxAnchors = 16;
 
 // Whether a pose covariance exceeds a heading sd or a position sd (worst direction).
 bool exceeds(const Eigen::Matrix3d& cov, double heading_sigma, double position_sigma) {
@@ -206,6 +210,7 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
     }
   }
   resample_if_needed();
+  update_output_frame();
 }
 
 void FastSlam2::associate(const Particle& p) {
@@ -458,16 +463,21 @@ void FastSlam2::finish_joint(Particle& p) {
   p.joint.clear();
 }
 
-void FastSlam2::resample_if_needed() {
+std::vector<double> FastSlam2::weights() const {
   std::vector<double> log_w(particles_.size());
   for (std::size_t i = 0; i < particles_.size(); ++i) log_w[i] = particles_[i].log_weight;
-  const std::vector<double> w = normalised_weights(log_w);
+  return normalised_weights(log_w);
+}
+
+void FastSlam2::resample_if_needed() {
+  const std::vector<double> w = weights();
   const double n_eff = effective_sample_size(w);
   const bool resample = options_.resample_mode == ResampleMode::kEveryFrame ||
                         n_eff < options_.resample_neff_fraction * static_cast<double>(particles_.size());
   if (!resample) {
     // Keep log weights bounded: shift so the best is 0.
-    const double max_log = *std::max_element(log_w.begin(), log_w.end());
+    double max_log = -std::numeric_limits<double>::infinity();
+    for (const Particle& p : particles_) max_log = std::max(max_log, p.log_weight);
     for (Particle& p : particles_) p.log_weight -= max_log;
     return;
   }
@@ -497,6 +507,10 @@ void FastSlam2::set_prior_map(const std::vector<LandmarkEstimate>& landmarks) {
     p.map = map;
     p.joint.clear();  // its landmarks belonged to the replaced map
   }
+  // The prior map is in the output frame: the particles' frame is that frame now.
+  anchors_.clear();
+  output_rotation_rad_ = 0.0;
+  output_translation_m_.setZero();
 }
 
 std::size_t FastSlam2::best_index() const {
@@ -511,9 +525,7 @@ PoseEstimate FastSlam2::pose_estimate() const {
   PoseEstimate e;
   e.t_s = time_s_;
   e.particles = static_cast<int>(particles_.size());
-  std::vector<double> log_w(particles_.size());
-  for (std::size_t i = 0; i < particles_.size(); ++i) log_w[i] = particles_[i].log_weight;
-  const std::vector<double> w = normalised_weights(log_w);
+  const std::vector<double> w = weights();
   e.effective_sample_size = effective_sample_size(w);
 
   double sx = 0, sy = 0, sc = 0, ss = 0;
@@ -530,22 +542,117 @@ PoseEstimate FastSlam2::pose_estimate() const {
     const Eigen::Vector3d d(m.x() - e.mean.x(), m.y() - e.mean.y(), wrap_angle(m.z() - e.mean.z()));
     e.cov += w[i] * (d * d.transpose() + particles_[i].pose.cov);
   }
-  e.best = particles_[best_index()].pose.mean;
+  e.best = to_output(particles_[best_index()].pose.mean);
+  e.mean = to_output(e.mean);
+  Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
+  r.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(output_rotation_rad_).toRotationMatrix();
+  e.cov = r * e.cov * r.transpose();
   return e;
+}
+
+Pose2 FastSlam2::to_output(const Pose2& pose) const {
+  const Eigen::Vector2d p = Eigen::Rotation2Dd(output_rotation_rad_) * pose.head<2>() + output_translation_m_;
+  return Pose2(p.x(), p.y(), wrap_angle(pose.z() + output_rotation_rad_));
+}
+
+LandmarkEstimate FastSlam2::to_output(const LandmarkEstimate& landmark) const {
+  const Eigen::Matrix2d r = Eigen::Rotation2Dd(output_rotation_rad_).toRotationMatrix();
+  LandmarkEstimate out = landmark;
+  out.mean = r * landmark.mean + output_translation_m_;
+  out.cov = r * landmark.cov * r.transpose();
+  return out;
+}
+
+std::vector<int> FastSlam2::anchor_ids() const {
+  std::vector<int> ids;
+  for (const Anchor& a : anchors_) ids.push_back(id_of_slot_[a.slot]);
+  return ids;
+}
+
+void FastSlam2::mean_positions(const std::vector<std::uint32_t>& slots, std::vector<Eigen::Vector2d>& means,
+                               std::vector<bool>& found) const {
+  const std::vector<double> w = weights();
+  std::vector<double> total(slots.size(), 0.0);
+  means.assign(slots.size(), Eigen::Vector2d::Zero());
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    for (std::size_t k = 0; k < slots.size(); ++k) {
+      if (const Landmark* lm = particles_[i].map.find(slots[k])) {
+        means[k] += w[i] * lm->mean;
+        total[k] += w[i];
+      }
+    }
+  }
+  found.assign(slots.size(), false);
+  for (std::size_t k = 0; k < slots.size(); ++k) {
+    if (total[k] <= 0.0) continue;
+    means[k] /= total[k];
+    found[k] = true;
+  }
+}
+
+void FastSlam2::update_output_frame() {
+  const AnchorFrameOptions& a = options_.anchor_frame;
+  if (!a.enabled) return;
+  std::vector<Eigen::Vector2d> means;
+  std::vector<bool> found;
+  if (anchors_.empty()) {
+    // Candidates: the first landmarks the best particle has seen often enough.
+    std::vector<std::uint32_t> slots;
+    particles_[best_index()].map.for_each([&](std::uint32_t slot, const Landmark& lm) {
+      if (lm.times_observed >= static_cast<std::uint32_t>(a.min_observations)) slots.push_back(slot);
+    });
+    std::sort(slots.begin(), slots.end());
+    if (slots.size() > kMaxAnchors) slots.resize(kMaxAnchors);
+    if (slots.size() < static_cast<std::size_t>(a.min_landmarks)) return;
+    mean_positions(slots, means, found);
+    Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& m : means) centroid += m;
+    centroid /= static_cast<double>(means.size());
+    double spread2 = 0.0;
+    for (const Eigen::Vector2d& m : means) spread2 += (m - centroid).squaredNorm();
+    if (spread2 / static_cast<double>(means.size()) < a.min_spread_m * a.min_spread_m) return;
+    for (std::size_t k = 0; k < slots.size(); ++k) {
+      anchors_.push_back({slots[k], to_output(LandmarkEstimate{0, means[k], Eigen::Matrix2d::Zero(), 0}).mean});
+    }
+    return;
+  }
+  // Least-squares rigid transform (2-D Procrustes) from the particles' current
+  // mean anchors onto the anchored positions.
+  std::vector<std::uint32_t> slots;
+  for (const Anchor& anchor : anchors_) slots.push_back(anchor.slot);
+  mean_positions(slots, means, found);
+  Eigen::Vector2d from_c = Eigen::Vector2d::Zero(), to_c = Eigen::Vector2d::Zero();
+  int n = 0;
+  for (std::size_t k = 0; k < slots.size(); ++k) {
+    if (!found[k]) continue;
+    from_c += means[k];
+    to_c += anchors_[k].position;
+    ++n;
+  }
+  if (n < 2) return;
+  from_c /= n;
+  to_c /= n;
+  double dot = 0.0, cross = 0.0;
+  for (std::size_t k = 0; k < slots.size(); ++k) {
+    if (!found[k]) continue;
+    const Eigen::Vector2d u = means[k] - from_c, v = anchors_[k].position - to_c;
+    dot += u.dot(v);
+    cross += u.x() * v.y() - u.y() * v.x();
+  }
+  output_rotation_rad_ = std::atan2(cross, dot);
+  output_translation_m_ = to_c - Eigen::Rotation2Dd(output_rotation_rad_) * from_c;
 }
 
 std::vector<LandmarkEstimate> FastSlam2::landmarks_of_best() const {
   std::vector<LandmarkEstimate> out;
   particles_[best_index()].map.for_each([&](std::uint32_t, const Landmark& lm) {
-    out.push_back({lm.id, lm.mean, lm.cov, lm.times_observed});
+    out.push_back(to_output(LandmarkEstimate{lm.id, lm.mean, lm.cov, lm.times_observed}));
   });
   return out;
 }
 
 std::vector<LandmarkEstimate> FastSlam2::landmarks_mixture() const {
-  std::vector<double> log_w(particles_.size());
-  for (std::size_t i = 0; i < particles_.size(); ++i) log_w[i] = particles_[i].log_weight;
-  const std::vector<double> w = normalised_weights(log_w);
+  const std::vector<double> w = weights();
   struct Sum {
     double weight = 0.0;
     Eigen::Vector2d m = Eigen::Vector2d::Zero();
@@ -567,7 +674,7 @@ std::vector<LandmarkEstimate> FastSlam2::landmarks_mixture() const {
     const Sum& s = sums[slot];
     if (s.weight <= 0.0) continue;
     const Eigen::Vector2d mean = s.m / s.weight;
-    out.push_back({id_of_slot_[slot], mean, s.second / s.weight - mean * mean.transpose(), s.times});
+    out.push_back(to_output(LandmarkEstimate{id_of_slot_[slot], mean, s.second / s.weight - mean * mean.transpose(), s.times}));
   }
   return out;
 }

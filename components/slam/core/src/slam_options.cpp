@@ -60,6 +60,12 @@ void validate(const FilterOptions& o) {
           "must be > 0 and <= enter_position_sigma_m");
   require(d.max_landmarks >= 1 && d.max_landmarks <= 1000, "delayed_sampling.max_landmarks", d.max_landmarks,
           "must be in [1, 1000]");
+  const AnchorFrameOptions& a = o.anchor_frame;
+  require(a.min_landmarks >= 2 && a.min_landmarks <= 64, "anchor_frame.min_landmarks", a.min_landmarks,
+          "must be in [2, 64] (a rotation needs two points)");
+  require(a.min_observations >= 1, "anchor_frame.min_observations", a.min_observations, "must be >= 1");
+  require(std::isfinite(a.min_spread_m) && a.min_spread_m > 0.0, "anchor_frame.min_spread_m", a.min_spread_m,
+          "must be a finite number > 0");
 }
 
 double gate_mahalanobis2(const FilterOptions& o) {

@@ -65,6 +65,15 @@ FilterOptions read_filter_options(config::YamlReader& f) {
     ds.max_landmarks = static_cast<int>(d.integer("max_landmarks", 1, 1000, ds.max_landmarks));
     d.finish();
   }
+  if (f.has("anchor_frame")) {
+    config::YamlReader a = f.child("anchor_frame");
+    AnchorFrameOptions& af = o.anchor_frame;
+    af.enabled = a.boolean("enabled", af.enabled);
+    af.min_landmarks = static_cast<int>(a.integer("min_landmarks", 2, 64, af.min_landmarks));
+    af.min_observations = static_cast<int>(a.integer("min_observations", 1, 1000000, af.min_observations));
+    af.min_spread_m = a.number("min_spread_m", 1e-3, 1000.0, af.min_spread_m);
+    a.finish();
+  }
   f.finish();
   try {
     validate(o);

@@ -98,6 +98,8 @@ class FastSlam2 {
   // localisation in a prior map, or a restart from a saved map. Replaces the maps.
   void set_prior_map(const std::vector<LandmarkEstimate>& landmarks);
 
+  // Outputs are in the anchored frame (FilterOptions::anchor_frame; without it
+  // the particles' own frame).
   PoseEstimate pose_estimate() const;
   // Landmarks of the highest-weight particle.
   std::vector<LandmarkEstimate> landmarks_of_best() const;
@@ -105,7 +107,14 @@ class FastSlam2 {
   // = mean covariance + spread of the means. O(M K).
   std::vector<LandmarkEstimate> landmarks_mixture() const;
 
+  // In the particles' own frame: to_output() moves a pose into the output frame.
   const std::vector<Particle>& particles() const { return particles_; }
+  Pose2 to_output(const Pose2& pose) const;
+  // Rigid transform from the particles' frame to the output frame (identity
+  // until anchored), and the anchored landmark ids (empty until anchored).
+  double output_rotation_rad() const { return output_rotation_rad_; }
+  const Eigen::Vector2d& output_translation_m() const { return output_translation_m_; }
+  std::vector<int> anchor_ids() const;
   const FilterCounters& counters() const { return counters_; }
   const FilterOptions& options() const { return options_; }
   double time_s() const { return time_s_; }
@@ -125,6 +134,15 @@ class FastSlam2 {
   void finish_joint(Particle& p);
   void resample_if_needed();
   std::size_t best_index() const;
+  std::vector<double> weights() const;  // normalised importance weights
+  // Anchors the output frame once the first landmarks pin it, then keeps the
+  // output transform up to date (AnchorFrameOptions).
+  void update_output_frame();
+  // Weighted mean position of each slot over the particles that map it; false
+  // where no particle does.
+  void mean_positions(const std::vector<std::uint32_t>& slots, std::vector<Eigen::Vector2d>& means,
+                      std::vector<bool>& found) const;
+  LandmarkEstimate to_output(const LandmarkEstimate& landmark) const;
 
   FilterOptions options_;
   double gate_d2_;
@@ -133,6 +151,14 @@ class FastSlam2 {
   std::vector<Particle> particles_;
   std::vector<Particle> scratch_;
   JointGaussian joint_backup_;  // state before a joint update, restored on breakdown
+
+  struct Anchor {
+    std::uint32_t slot;
+    Eigen::Vector2d position;  // in the output frame, fixed when anchored
+  };
+  std::vector<Anchor> anchors_;
+  double output_rotation_rad_ = 0.0;
+  Eigen::Vector2d output_translation_m_ = Eigen::Vector2d::Zero();
 
   bool has_time_ = false;
   double time_s_ = 0.0;

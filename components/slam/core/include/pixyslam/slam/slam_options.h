@@ -37,6 +37,24 @@ struct DelayedSamplingOptions {
   int max_landmarks = 16;
 };
 
+// Output frame anchoring. The map's frame is tied to the world only by the start
+// pose and the odometry up to the first landmarks; later observations are all
+// relative, so a rigid motion of the whole map and path is unobservable (a gauge
+// freedom). In a particle filter the particle set's consensus on that frame
+// still wanders as lineages die out: each run settles on a random frame near
+// the true one. With anchoring, once the first landmarks pin the frame (at
+// least min_landmarks, each observed min_observations times in the best
+// particle, spread at least min_spread_m RMS around their centroid), their
+// weighted mean positions are kept as anchors, and every output (poses,
+// landmarks) is moved by the rigid transform that puts the particles' current
+// mean anchors back on them (least squares). The particles are not changed.
+struct AnchorFrameOptions {
+  bool enabled = false;
+  int min_landmarks = 2;
+  int min_observations = 5;
+  double min_spread_m = 0.5;
+};
+
 // Everything that configures FastSlam2. Units in the names; validate() checks
 // ranges and throws std::invalid_argument naming the field.
 struct FilterOptions {
@@ -76,6 +94,7 @@ struct FilterOptions {
   ResampleMode resample_mode = ResampleMode::kEffectiveSampleSize;
   double resample_neff_fraction = 0.667;
   DelayedSamplingOptions delayed_sampling;
+  AnchorFrameOptions anchor_frame;
 };
 
 void validate(const FilterOptions& options);
