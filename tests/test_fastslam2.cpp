@@ -891,6 +891,14 @@ TEST(AnchorFrame, WaitsUntilTheLandmarksSpreadEnoughToFixARotation) {
   f.set_prior_map({{7, Eigen::Vector2d(1.0, 0.0), Eigen::Matrix2d::Identity() * 1e-4, 9}});
   EXPECT_TRUE(f.anchor_ids().empty());
   EXPECT_EQ(f.output_rotation_rad(), 0.0);
+
+  // Without ids a landmark slot is not the same pole in every particle: no anchors.
+  o.association = Association::kMaximumLikelihood;
+  FastSlam2 g(o, Pose2::Zero());
+  g.add_odometry({0.0, 0.0, 0.0});
+  for (int k = 0; k < 10; ++k) g.add_observations({0.1 * (k + 1), {{1, 2.0, 0.05}, {3, 2.0, M_PI / 2}}});
+  EXPECT_GE(g.landmarks_of_best().size(), 2u);
+  EXPECT_TRUE(g.anchor_ids().empty());
 }
 
 }  // namespace

@@ -592,7 +592,9 @@ void FastSlam2::mean_positions(const std::vector<std::uint32_t>& slots, std::vec
 
 void FastSlam2::update_output_frame() {
   const AnchorFrameOptions& a = options_.anchor_frame;
-  if (!a.enabled) return;
+  // With maximum-likelihood association a slot is not the same pole in every
+  // particle, so its mean over the particles is no anchor.
+  if (!a.enabled || options_.association != Association::kKnownId) return;
   std::vector<Eigen::Vector2d> means;
   std::vector<bool> found;
   if (anchors_.empty()) {

@@ -48,6 +48,8 @@ struct DelayedSamplingOptions {
 // weighted mean positions are kept as anchors, and every output (poses,
 // landmarks) is moved by the rigid transform that puts the particles' current
 // mean anchors back on them (least squares). The particles are not changed.
+// Known-id association only (with maximum likelihood a landmark slot is not the
+// same pole in every particle).
 struct AnchorFrameOptions {
   bool enabled = false;
   int min_landmarks = 2;
