@@ -68,6 +68,7 @@ int run(int argc, char** argv) {
 
   std::printf("%-6s %-5s %9s %9s %9s %10s %10s %11s %11s %8s %5s %8s\n", "robot", "seed", "ATE_m", "ATE_al_m", "DR_ATE_m",
               "head_deg", "DR_head", "lm_raw_m", "lm_align_m", "gated", "map", "wall_s");
+  constexpr double kDeg = 180.0 / M_PI;
   bool all_better = true;
   double sum_ate = 0, sum_ate_aligned = 0, sum_head = 0, sum_lm = 0, sum_lma = 0, sum_wall = 0;
   int runs = 0;
@@ -79,7 +80,6 @@ int run(int argc, char** argv) {
       options.seed = static_cast<std::uint64_t>(seed);
       const offline::RunResult res = offline::run_filter(options, input);
       const offline::Report rep = offline::evaluate(input, res);
-      constexpr double kDeg = 180.0 / M_PI;
       std::printf("%-6d %-5d %9.3f %9.3f %9.3f %10.2f %10.2f %11.3f %11.3f %8llu %5zu %8.2f\n", robot, seed,
                   rep.filter.ate_rmse_m, rep.filter.ate_rmse_aligned_m, rep.dead_reckoning.ate_rmse_m, rep.filter.heading_rmse_rad * kDeg,
                   rep.dead_reckoning.heading_rmse_rad * kDeg, rep.landmarks.rmse_m, rep.landmarks.rmse_aligned_m,
@@ -100,7 +100,6 @@ int run(int argc, char** argv) {
     if (!input.truth.empty() && robot_ate >= robot_dr) all_better = false;
     if (!input.truth.empty() && !input.frames.empty()) {
       const offline::DataLimits limits = offline::data_limits(input);
-      constexpr double kDeg = 180.0 / M_PI;
       std::printf("limits robot %d: dead reckoning reset to the truth at every frame: ATE %.3f m; "
                   "dead-reckoning heading error at the first frame (%.1f s) %.1f deg, 30 s later %.1f deg\n",
                   robot, limits.blind_drift.ate_rmse_m, limits.first_frame_t_s,

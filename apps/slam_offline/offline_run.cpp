@@ -110,7 +110,7 @@ DataLimits data_limits(const RunInput& input) {
   }
   // Dead reckoning from the start pose through time-ordered odometry and frames;
   // `reset` puts the pose on the truth at every frame.
-  const auto drive = [&](bool reset, double until_s) {
+  const auto drive = [&](bool reset) {
     std::vector<eval::TimedPose> path;
     slam::Pose2 x = input.initial_pose;
     slam::OdometrySample control{input.start_time_s, 0.0, 0.0};
@@ -133,16 +133,18 @@ DataLimits data_limits(const RunInput& input) {
         }
       }
       path.push_back({t, x.x(), x.y(), x.z()});
-      if (t >= until_s) break;
     }
     return path;
   };
   DataLimits limits;
-  limits.blind_drift = eval::compare_trajectory(drive(true, std::numeric_limits<double>::infinity()), truth);
+  limits.blind_drift = eval::compare_trajectory(drive(true), truth);
+  // Heading error of pure dead reckoning at its first step at or after at_s.
+  const std::vector<eval::TimedPose> dead_reckoning = drive(false);
   const auto heading_error_at = [&](double at_s) {
-    const std::vector<eval::TimedPose> path = drive(false, at_s);
-    const eval::TimedPose& g = truth_at(truth, path.back().t_s);
-    return slam::wrap_angle(path.back().theta_rad - g.theta_rad);
+    auto it = std::lower_bound(dead_reckoning.begin(), dead_reckoning.end(), at_s,
+                               [](const eval::TimedPose& p, double time) { return p.t_s < time; });
+    const eval::TimedPose& x = it == dead_reckoning.end() ? dead_reckoning.back() : *it;
+    return slam::wrap_angle(x.theta_rad - truth_at(truth, x.t_s).theta_rad);
   };
   limits.first_frame_t_s = frame_times.front() - input.start_time_s;
   limits.heading_error_first_frame_rad = heading_error_at(frame_times.front());

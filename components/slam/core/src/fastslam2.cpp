@@ -613,9 +613,8 @@ void FastSlam2::update_output_frame() {
     double spread2 = 0.0;
     for (const Eigen::Vector2d& m : means) spread2 += (m - centroid).squaredNorm();
     if (spread2 / static_cast<double>(means.size()) < a.min_spread_m * a.min_spread_m) return;
-    for (std::size_t k = 0; k < slots.size(); ++k) {
-      anchors_.push_back({slots[k], to_output(LandmarkEstimate{0, means[k], Eigen::Matrix2d::Zero(), 0}).mean});
-    }
+    // Until anchored the output frame is the particles' frame.
+    for (std::size_t k = 0; k < slots.size(); ++k) anchors_.push_back({slots[k], means[k]});
     return;
   }
   // Least-squares rigid transform (2-D Procrustes) from the particles' current
