@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "pixyslam/dds/endpoints.h"
+#include "raw_sample_writer.h"
 
 namespace pixyslam::dds {
 namespace {
@@ -57,6 +58,61 @@ TEST(DdsLoopback, EveryOdometryMessageArrivesInOrder) {
   }
   EXPECT_EQ(reader.lost(), 0u);
   EXPECT_EQ(reader.received(), static_cast<std::uint64_t>(kCount));
+}
+
+// A valid Odometry as the bytes DataWriter::write puts on the wire.
+std::vector<std::uint8_t> odometry_bytes(std::uint64_t seq) {
+  msg::Odometry m;
+  m.header().seq(seq);
+  m.header().robot_id("hostile");
+  m.v_mps(0.25);
+  return test_support::wire_bytes(m);
+}
+
+TEST(DdsLoopback, MalformedSamplesAreCountedAndDroppedAndTheReaderGoesOn) {
+  Participant sender(loopback_options(), "test_hostile_sender");
+  Participant receiver(loopback_options(), "test_receiver");
+  std::mutex mutex;
+  std::condition_variable cv;
+  std::vector<msg::Odometry> got;
+  Reader<msg::Odometry> reader(receiver, [&](const msg::Odometry& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    got.push_back(m);
+    cv.notify_all();
+  });
+  test_support::RawSampleWriter<msg::Odometry> hostile(sender);
+  ASSERT_TRUE(hostile.wait_for_readers(1, std::chrono::seconds(10)));
+
+  const std::vector<std::vector<std::uint8_t>> bad = test_support::malformed_payloads(odometry_bytes(1));
+  for (const auto& bytes : bad) ASSERT_TRUE(hostile.write(bytes));
+  ASSERT_TRUE(hostile.write(odometry_bytes(1)));             // a valid one after them
+  ASSERT_TRUE(hostile.write(odometry_bytes(1ull << 40)));   // hostile seq: a jump, not lost messages
+  ASSERT_TRUE(hostile.write(odometry_bytes((1ull << 40) + 3)));  // then 2 really lost
+  std::unique_lock<std::mutex> lock(mutex);
+  ASSERT_TRUE(cv.wait_for(lock, std::chrono::seconds(10), [&] { return got.size() == 3; })) << got.size();
+  EXPECT_DOUBLE_EQ(got[0].v_mps(), 0.25);
+  EXPECT_EQ(got[0].header().robot_id(), "hostile");
+  EXPECT_EQ(reader.malformed(), bad.size());
+  EXPECT_EQ(reader.seq_jumps(), 1u);
+  EXPECT_EQ(reader.lost(), 2u);
+  EXPECT_EQ(reader.received(), 3u);
+}
+
+TEST(SeqTracker, CountsGapsTheWriterCouldHaveMadeAndJumpsItCouldNot) {
+  SeqTracker t;
+  EXPECT_EQ(t.update(1, 0.0).lost, 0u);
+  EXPECT_EQ(t.update(5, 0.0).lost, 3u);           // 2, 3, 4 lost
+  const SeqTracker::Result jump = t.update(5 + 2 * SeqTracker::kSlack, 0.01);
+  EXPECT_TRUE(jump.jump);                         // 2000 in 10 ms: more than 10 kHz + slack
+  EXPECT_EQ(jump.lost, 0u);
+  const std::uint64_t base = 5 + 2 * SeqTracker::kSlack;
+  const SeqTracker::Result outage = t.update(base + 20001, 2.0);  // 20,000 in 2 s: plausible
+  EXPECT_FALSE(outage.jump);
+  EXPECT_EQ(outage.lost, 20000u);
+  EXPECT_EQ(t.update(3, 0.1).lost, 0u);           // restarted writer: nothing lost
+  EXPECT_EQ(t.update(4, 0.1).lost, 0u);
+  EXPECT_TRUE(t.update(~0ull, 0.1).jump);         // the top of the range
+  EXPECT_EQ(t.update(~0ull, 0.1).lost, 0u);       // a repeat
 }
 
 TEST(DdsLoopback, LateJoinerGetsTheRecentMapStatesEndingWithTheCurrent) {

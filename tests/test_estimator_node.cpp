@@ -16,6 +16,7 @@
 #include "pixyslam/sim/sim_world.h"
 #include "pixyslam/slam_node/estimator_node.h"
 #include "pixyslam/slam_node/map_state_conversions.h"
+#include "raw_sample_writer.h"
 #include "sim_sensor_messages.h"
 
 namespace pixyslam::slam_node {
@@ -284,6 +285,47 @@ TEST(EstimatorNode, ReportsRejectedInputOnTheDiagnosticsTopic) {
   EXPECT_EQ(reports.back().level(), 0);
   EXPECT_EQ(counter(reports.back(), "odometry_received"), 3);
   EXPECT_EQ(counter(reports.back(), "odometry_invalid"), 1);
+}
+
+// Any participant can send any bytes: samples that do not decode are counted
+// per topic (diagnostics), dropped, and the filter goes on with the good ones.
+TEST(EstimatorNode, MalformedSamplesAreCountedAndTheFilterGoesOn) {
+  EstimatorOptions options = test_options();
+  EstimatorNode node(options);
+  node.start();
+  dds::Participant hostile(options.dds, "test_hostile");
+  test_support::RawSampleWriter<msg::Odometry> bad_odometry(hostile);
+  test_support::RawSampleWriter<msg::LandmarkObservation> bad_frames(hostile);
+  dds::Participant sensors(options.dds, "test_sensors");
+  dds::Writer<msg::Odometry> odometry_writer(sensors);
+  ASSERT_TRUE(bad_odometry.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(bad_frames.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
+
+  const std::uint64_t base_ns = dds::now_ns();
+  slam::OdometrySample good;
+  good.v_mps = 0.1;
+  const auto bad_o = test_support::malformed_payloads(
+      test_support::wire_bytes(test_support::odometry_msg(good, 0.1, base_ns)));
+  const auto bad_f = test_support::malformed_payloads(test_support::wire_bytes(msg::LandmarkObservation()));
+  for (const auto& b : bad_o) ASSERT_TRUE(bad_odometry.write(b));
+  for (const auto& b : bad_f) ASSERT_TRUE(bad_frames.write(b));
+  for (int i = 0; i < 5; ++i) {
+    good.t_s = 0.1 * i;
+    msg::Odometry m = test_support::odometry_msg(good, 0.1, to_stamp_ns(good.t_s, base_ns));
+    ASSERT_TRUE(odometry_writer.publish(m));
+  }
+  ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (node.counters().steps < 5 && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  const EstimatorCounters c = node.counters();
+  node.stop();
+  EXPECT_EQ(c.odometry_received, 5u);
+  EXPECT_EQ(c.odometry_malformed, bad_o.size());
+  EXPECT_EQ(c.observations_malformed, bad_f.size());
+  EXPECT_GE(c.steps, 5u);
 }
 
 TEST(EstimatorOptions, ShippedConfigIsValid) {

@@ -565,7 +565,7 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
     EXPECT_EQ(t.received, count) << topic;
     EXPECT_EQ(t.written, count) << topic;
     EXPECT_EQ(t.dropped, 0u) << topic;
-    EXPECT_EQ(t.seq_gaps, 0u) << topic;
+    EXPECT_EQ(t.reader.seq_gaps, 0u) << topic;
   }
   EXPECT_EQ(c.file.messages, 670u);
   EXPECT_GT(c.file.chunks, 1u);

@@ -328,6 +328,11 @@ int run_echo(const dds::DdsOptions& options, const EchoRequest& request, std::os
       }
       out.flush();
     }
+    const std::uint64_t malformed = reader.malformed() + reader.callback_errors();
+    if (malformed > 0) {
+      std::fprintf(stderr, "pixyslam_spy: echo %s: %llu malformed samples dropped\n", request.topic.c_str(),
+                   static_cast<unsigned long long>(malformed));
+    }
     if (request.count > 0 && printed < request.count) {
       std::fprintf(stderr, "pixyslam_spy: echo %s: %zu of %zu samples received\n", request.topic.c_str(), printed,
                    request.count);

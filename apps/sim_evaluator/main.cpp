@@ -38,10 +38,14 @@ struct Received {
 
 template <class Message>
 void print_topic(const dds::Reader<Message>& reader) {
-  std::printf("  %-32s %8llu received, %llu lost (sequence gaps)\n",
-              std::string(dds::MessageTraits<Message>::topic).c_str(),
-              static_cast<unsigned long long>(reader.received()),
-              static_cast<unsigned long long>(reader.lost()));
+  std::printf("  %-32s %8llu received, %llu lost (sequence gaps)", std::string(dds::MessageTraits<Message>::topic).c_str(),
+              static_cast<unsigned long long>(reader.received()), static_cast<unsigned long long>(reader.lost()));
+  const std::uint64_t malformed = reader.malformed() + reader.callback_errors();
+  if (malformed > 0 || reader.seq_jumps() > 0) {
+    std::printf(", %llu malformed (dropped), %llu seq jumps", static_cast<unsigned long long>(malformed),
+                static_cast<unsigned long long>(reader.seq_jumps()));
+  }
+  std::printf("\n");
 }
 
 int run(const app::CommandLine& args) {

@@ -52,10 +52,14 @@ int main(int argc, char** argv) {
     node.stop();
     const logger_node::LoggerCounters c = node.counters();
     for (const logger_node::TopicCounters& t : c.topics) {
-      std::fprintf(stderr, "logger: %s: received %llu, written %llu, dropped %llu, seq gaps %llu\n",
+      std::fprintf(stderr,
+                   "logger: %s: received %llu, written %llu, dropped %llu, seq gaps %llu, malformed %llu, "
+                   "seq jumps %llu\n",
                    t.topic.c_str(), static_cast<unsigned long long>(t.received),
                    static_cast<unsigned long long>(t.written), static_cast<unsigned long long>(t.dropped),
-                   static_cast<unsigned long long>(t.seq_gaps));
+                   static_cast<unsigned long long>(t.reader.seq_gaps),
+                   static_cast<unsigned long long>(t.reader.malformed),
+                   static_cast<unsigned long long>(t.reader.seq_jumps));
     }
     for (const logger_node::LoggedFile& f : c.files) {
       std::fprintf(stderr, "logger: file %s: %llu messages, %llu chunks, %llu bytes\n", f.path.c_str(),

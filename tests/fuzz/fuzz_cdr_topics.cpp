@@ -1,7 +1,10 @@
 // libFuzzer target: arbitrary bytes as a received DDS sample of each topic.
-// The first byte picks the topic; the rest is the payload (encapsulation header
-// and CDR), decoded with the generated type exactly as a DataReader would. A
-// sample that decodes goes on as the estimator would take it: Odometry and
+// The first byte picks the topic (PIXYSLAM_FUZZ_TOPIC pins one: 0 odometry, 1
+// landmark_observation, 2 map_state, 3 ground_truth, 4 diagnostics); the rest is the
+// payload (encapsulation header and CDR). It goes through the readers' own
+// GuardedPubSubType::deserialize exactly as Fast DDS hands it over (no
+// pre-check of the encapsulation), which must never throw; then through the
+// log tools' strict decoder. A sample that decodes goes on as the estimator would take it: Odometry and
 // LandmarkObservation through the node's conversions into a FastSLAM 2.0
 // filter, whose estimate must stay finite whatever the values (NaN, inf,
 // negative ranges, time going backwards or jumping).
@@ -12,7 +15,13 @@
 #include <string>
 #include <vector>
 
+#include <cstdlib>
+#include <cstring>
+
+#include <fastdds/rtps/common/SerializedPayload.h>
+
 #include "fuzz_common.h"
+#include "pixyslam/dds/guarded_type.h"
 #include "pixyslam/logger_node/cdr_payload.h"
 #include "pixyslam/slam/fastslam2.h"
 #include "pixyslam/slam_node/map_state_conversions.h"
@@ -38,6 +47,27 @@ pixyslam::slam::FilterOptions small_filter(bool delayed) {
   return o;
 }
 
+// What a DataReader does with the bytes: the guarded deserialize. It may
+// refuse them, never throw (an exception would abort the fuzzer).
+template <class Message>
+void reader_decode(const std::vector<std::uint8_t>& bytes) {
+  pixyslam::dds::GuardedPubSubType<Message> type;
+  eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<std::uint32_t>(bytes.size()));
+  if (!bytes.empty()) std::memcpy(payload.data, bytes.data(), bytes.size());
+  payload.length = static_cast<std::uint32_t>(bytes.size());
+  Message message;
+  const bool ok = type.deserialize(&payload, &message);
+  FUZZ_CHECK(type.malformed() == (ok ? 0u : 1u));
+}
+
+int pinned_topic() {
+  static const int topic = [] {
+    const char* v = std::getenv("PIXYSLAM_FUZZ_TOPIC");
+    return v != nullptr ? std::atoi(v) : -1;
+  }();
+  return topic;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -48,7 +78,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // with delayed sampling on or off.
   pixyslam::slam::FastSlam2 filter(small_filter((data[0] & 0x10) != 0), pixyslam::slam::Pose2::Zero());
   const std::uint64_t epoch_ns = 1'000'000'000ull;
-  switch (data[0] & 0x07) {
+  const int topic = pinned_topic() >= 0 ? pinned_topic() : (data[0] & 0x07);
+  switch (topic) {
+    case 0: reader_decode<pixyslam::msg::Odometry>(payload); break;
+    case 1: reader_decode<pixyslam::msg::LandmarkObservation>(payload); break;
+    case 2: reader_decode<pixyslam::msg::MapState>(payload); break;
+    case 4: reader_decode<pixyslam::msg::Diagnostics>(payload); break;
+    default: reader_decode<pixyslam::msg::GroundTruth>(payload); break;
+  }
+  switch (topic) {
     case 0: {
       pixyslam::msg::Odometry m;
       if (!from_cdr(payload, m, error)) return 0;

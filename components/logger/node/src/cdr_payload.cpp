@@ -45,6 +45,9 @@ bool deserialize_payload(fdds::TopicDataType& type, const std::uint8_t* data, st
   } catch (const std::exception& e) {
     error = std::string("CDR not valid: ") + e.what();
     return false;
+  } catch (...) {
+    error = "CDR not valid";
+    return false;
   }
   return true;
 }

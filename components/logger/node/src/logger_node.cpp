@@ -20,7 +20,7 @@ namespace detail {
 class Subscription {
  public:
   virtual ~Subscription() = default;
-  virtual std::uint64_t lost() const = 0;
+  virtual ReaderCounts reader_counts() const = 0;
 
  protected:
   static void deliver(LoggerNode& node, std::size_t topic, std::uint64_t seq, std::uint64_t stamp_ns,
@@ -35,7 +35,9 @@ class TypedSubscription final : public Subscription {
   TypedSubscription(dds::Participant& participant, LoggerNode& node, std::size_t topic)
       : node_(node), topic_(topic), reader_(participant, [this](const Message& m) { on_sample(m); }) {}
 
-  std::uint64_t lost() const override { return reader_.lost(); }
+  ReaderCounts reader_counts() const override {
+    return {reader_.lost(), reader_.malformed() + reader_.callback_errors(), reader_.seq_jumps()};
+  }
 
  private:
   // On a Fast DDS thread, one sample at a time per reader (type_ is ours alone).
@@ -109,7 +111,9 @@ diagnostics::Snapshot LoggerNode::diagnostics_snapshot() const {
     const std::string name = t.topic.substr(t.topic.find('/') + 1);
     s.counters.push_back({name + "_written", t.written, false});
     s.counters.push_back({name + "_dropped", t.dropped, true});
-    s.counters.push_back({name + "_seq_gaps", t.seq_gaps, true});
+    s.counters.push_back({name + "_seq_gaps", t.reader.seq_gaps, true});
+    s.counters.push_back({name + "_malformed", t.reader.malformed, true});
+    s.counters.push_back({name + "_seq_jumps", t.reader.seq_jumps, true});
   }
   s.counters.push_back({"files", c.files.size(), false});
   s.counters.push_back({"bytes_written", c.file.bytes_written, false});
@@ -206,11 +210,11 @@ void LoggerNode::stop() {
   {
     // Unsubscribe first: after this no callback runs, so the queue is final.
     std::lock_guard<std::mutex> lock(subscriptions_mutex_);
-    std::vector<std::uint64_t> lost;
-    for (const auto& s : subscriptions_) lost.push_back(s->lost());
+    std::vector<ReaderCounts> counts;
+    for (const auto& s : subscriptions_) counts.push_back(s->reader_counts());
     subscriptions_.clear();
     std::lock_guard<std::mutex> queue_lock(mutex_);
-    for (std::size_t i = 0; i < lost.size(); ++i) topics_[i].seq_gaps = lost[i];
+    for (std::size_t i = 0; i < counts.size(); ++i) topics_[i].reader = counts[i];
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -352,15 +356,15 @@ void LoggerNode::record_error(const std::string& what) {
 }
 
 LoggerCounters LoggerNode::counters() const {
-  std::vector<std::uint64_t> lost;
+  std::vector<ReaderCounts> counts;
   {
     std::lock_guard<std::mutex> lock(subscriptions_mutex_);
-    for (const auto& s : subscriptions_) lost.push_back(s->lost());
+    for (const auto& s : subscriptions_) counts.push_back(s->reader_counts());
   }
   std::lock_guard<std::mutex> lock(mutex_);
   LoggerCounters c = totals_;
   c.topics = topics_;
-  for (std::size_t i = 0; i < lost.size() && i < c.topics.size(); ++i) c.topics[i].seq_gaps = lost[i];
+  for (std::size_t i = 0; i < counts.size() && i < c.topics.size(); ++i) c.topics[i].reader = counts[i];
   return c;
 }
 
@@ -374,7 +378,8 @@ std::string LoggerNode::counters_text() const {
   std::ostringstream os;
   for (const TopicCounters& t : c.topics) {
     os << t.topic << ": received " << t.received << ", written " << t.written << ", dropped " << t.dropped
-       << ", seq gaps " << t.seq_gaps << "\n";
+       << ", seq gaps " << t.reader.seq_gaps << ", malformed " << t.reader.malformed << ", seq jumps "
+       << t.reader.seq_jumps << "\n";
   }
   return os.str();
 }

@@ -75,6 +75,9 @@ diagnostics::Snapshot EstimatorNode::diagnostics_snapshot() const {
                 {"odometry_lost", c.odometry_lost, true},
                 {"observations_received", c.observations_received, false},
                 {"observations_lost", c.observations_lost, true},
+                {"odometry_malformed", c.odometry_malformed, true},
+                {"observations_malformed", c.observations_malformed, true},
+                {"seq_jumps", c.seq_jumps, true},
                 {"steps", c.steps, false},
                 {"samples_late", c.samples_late, true},
                 {"samples_reordered", c.samples_reordered, false},
@@ -111,6 +114,9 @@ EstimatorCounters EstimatorNode::counters() const {
   c.observations_received = observation_reader_->received();
   c.odometry_lost = odometry_reader_->lost();
   c.observations_lost = observation_reader_->lost();
+  c.odometry_malformed = odometry_reader_->malformed() + odometry_reader_->callback_errors();
+  c.observations_malformed = observation_reader_->malformed() + observation_reader_->callback_errors();
+  c.seq_jumps = odometry_reader_->seq_jumps() + observation_reader_->seq_jumps();
   c.samples_late = queue_.counters().late;
   c.samples_reordered = queue_.counters().reordered;
   return c;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -20,6 +21,7 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include "pixyslam/dds/guarded_type.h"
 #include "pixyslam/dds/participant.h"
 #include "pixyslam/dds/topics.h"
 
@@ -29,9 +31,42 @@ namespace detail {
 template <class Message>
 eprosima::fastdds::dds::TypeSupport type_support() {
   MessageTraits<Message>::register_type_object();
-  return eprosima::fastdds::dds::TypeSupport(new typename MessageTraits<Message>::PubSubType());
+  return eprosima::fastdds::dds::TypeSupport(new GuardedPubSubType<Message>());
 }
 }  // namespace detail
+
+// Per-writer sequence accounting that no writer can poison: a gap larger than
+// the writer could have published since its previous sample (at most
+// kMaxRateHz, plus kSlack) is a jump (a restarted, replayed or hostile writer),
+// counted once, not as millions of lost messages; a seq that goes back is a
+// restart. Not thread-safe (one per reader listener).
+class SeqTracker {
+ public:
+  static constexpr double kMaxRateHz = 10000.0;
+  static constexpr std::uint64_t kSlack = 1000;
+
+  struct Result {
+    std::uint64_t lost = 0;
+    bool jump = false;
+  };
+  Result update(std::uint64_t seq, double elapsed_s) {
+    Result r;
+    if (seq > last_ && seq - last_ > 1) {
+      const std::uint64_t gap = seq - last_ - 1;
+      const double plausible = kMaxRateHz * std::max(0.0, elapsed_s) + static_cast<double>(kSlack);
+      if (static_cast<double>(gap) > plausible) {
+        r.jump = true;
+      } else {
+        r.lost = gap;
+      }
+    }
+    last_ = seq;
+    return r;
+  }
+
+ private:
+  std::uint64_t last_ = 0;
+};
 
 // Publishes Message on its topic with the XML data_writer profile named like
 // the topic. publish() fills the header's seq (1, 2, ...) and robot_id; the
@@ -104,8 +139,11 @@ class Writer {
 
 // Receives Message from its topic (XML data_reader profile named like the
 // topic) and calls `on_message` for every valid sample, on a Fast DDS thread:
-// keep the callback short (enqueue). Counts samples, and per matched writer the
-// header seq numbers skipped (lost messages).
+// keep the callback short (enqueue). Counts samples, per matched writer the
+// header seq numbers skipped (lost messages) and implausible jumps
+// (SeqTracker), and samples that did not decode (GuardedPubSubType). No
+// exception leaves the listener: one thrown by the callback is counted in
+// callback_errors() and the sample dropped.
 template <class Message>
 class Reader : private eprosima::fastdds::dds::DataReaderListener {
  public:
@@ -121,6 +159,7 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
                                "': is there a data_reader profile of that name in '" +
                                participant.options().profiles_file + "'?");
     }
+    type_ = reader_->type();
   }
   ~Reader() override {
     reader_->set_listener(nullptr);
@@ -131,6 +170,13 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
 
   std::uint64_t received() const { return received_.load(); }
   std::uint64_t lost() const { return lost_.load(); }  // seq numbers skipped
+  std::uint64_t seq_jumps() const { return seq_jumps_.load(); }
+  // Samples of this topic that did not decode, in this participant.
+  std::uint64_t malformed() const {
+    const auto* guarded = dynamic_cast<const GuardedPubSubType<Message>*>(type_.get());
+    return guarded != nullptr ? guarded->malformed() : 0;
+  }
+  std::uint64_t callback_errors() const { return callback_errors_.load(); }
   int matched_writers() const {
     eprosima::fastdds::dds::SubscriptionMatchedStatus status;
     reader_->get_subscription_matched_status(status);
@@ -141,24 +187,51 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
  private:
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
     eprosima::fastdds::dds::SampleInfo info;
-    while (reader->take_next_sample(&sample_, &info) == ReturnCode_t::RETCODE_OK) {
+    for (;;) {
+      try {
+        if (reader->take_next_sample(&sample_, &info) != ReturnCode_t::RETCODE_OK) return;
+      } catch (...) {  // the guarded type does not throw; this is the last line
+        ++callback_errors_;
+        return;
+      }
       if (!info.valid_data) continue;
-      const std::uint64_t seq = sample_.header().seq();
-      std::uint64_t& last = last_seq_[info.publication_handle];
-      if (seq > last + 1) lost_ += seq - last - 1;
-      last = seq;
+      const auto now = std::chrono::steady_clock::now();
+      WriterSeq& writer = writers_[info.publication_handle];
+      if (!writer.seen) {
+        writer.seen = true;
+        writer.last = created_;
+      }
+      const SeqTracker::Result seq =
+          writer.seq.update(sample_.header().seq(), std::chrono::duration<double>(now - writer.last).count());
+      writer.last = now;
+      lost_ += seq.lost;
+      if (seq.jump) ++seq_jumps_;
       ++received_;
-      on_message_(sample_);
+      try {
+        on_message_(sample_);
+      } catch (...) {
+        ++callback_errors_;
+      }
     }
   }
+
+  struct WriterSeq {
+    bool seen = false;
+    std::chrono::steady_clock::time_point last;
+    SeqTracker seq;
+  };
 
   Participant& participant_;
   Callback on_message_;
   eprosima::fastdds::dds::DataReader* reader_ = nullptr;
+  eprosima::fastdds::dds::TypeSupport type_;
   Message sample_;
-  std::map<eprosima::fastdds::dds::InstanceHandle_t, std::uint64_t> last_seq_;
+  const std::chrono::steady_clock::time_point created_ = std::chrono::steady_clock::now();
+  std::map<eprosima::fastdds::dds::InstanceHandle_t, WriterSeq> writers_;
   std::atomic<std::uint64_t> received_{0};
   std::atomic<std::uint64_t> lost_{0};
+  std::atomic<std::uint64_t> seq_jumps_{0};
+  std::atomic<std::uint64_t> callback_errors_{0};
 };
 
 }  // namespace pixyslam::dds

@@ -23,6 +23,13 @@ namespace detail {
 class Subscription;
 }  // namespace detail
 
+// What a topic's DDS reader saw, since construction.
+struct ReaderCounts {
+  std::uint64_t seq_gaps = 0;   // header seq numbers skipped, per DDS writer (lost before us)
+  std::uint64_t malformed = 0;  // samples that did not decode (dropped, never written)
+  std::uint64_t seq_jumps = 0;  // implausible seq jumps (restarted or hostile writer)
+};
+
 // Per recorded topic, since construction.
 struct TopicCounters {
   std::string topic;
@@ -30,7 +37,7 @@ struct TopicCounters {
   std::uint64_t received = 0;    // samples DDS delivered
   std::uint64_t written = 0;     // MCAP messages written
   std::uint64_t dropped = 0;     // received but not written (queue full, write failure, stopped)
-  std::uint64_t seq_gaps = 0;    // header seq numbers skipped, per DDS writer (lost before us)
+  ReaderCounts reader;
 };
 
 // One MCAP file of the recording.

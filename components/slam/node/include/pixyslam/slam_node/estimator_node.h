@@ -29,6 +29,9 @@ struct EstimatorCounters {
   std::uint64_t observations_received = 0;
   std::uint64_t odometry_lost = 0;       // seq gaps seen by the readers
   std::uint64_t observations_lost = 0;
+  std::uint64_t odometry_malformed = 0;  // samples that did not decode (dropped)
+  std::uint64_t observations_malformed = 0;
+  std::uint64_t seq_jumps = 0;           // implausible seq jumps (restart, hostile writer)
   std::uint64_t steps = 0;               // filter steps (= MapStates published)
   std::uint64_t map_states_published = 0;
   std::uint64_t samples_late = 0;
