@@ -1,23 +1,33 @@
 // mrclam_eval: the accuracy table of the FastSLAM core on MRCLAM, one parameter
 // set for every robot, several seeds per robot.
 //   mrclam_eval --dataset DIR --config FILE [--robots 1,2,3,4,5] [--seeds 1,2,3]
-//               [--association known_id|maximum_likelihood]
+//               [--association known_id|maximum_likelihood] [--segments SECONDS]
 // --association maximum_likelihood withholds the landmark ids from the filter
 // (the landmark columns then match nothing by id; ATE and heading still count).
+// Every run also reports the pose NEES against the truth (3 dof, ideal mean 3).
+// --segments SECONDS adds, per robot with ground truth and seed, runs restarted
+// from the ground-truth pose every SECONDS s (each start keeping at least SECONDS
+// s of truth after it), each running to the end of the robot's data: one line
+// per segment, then count, mean, median, p90 and worst ATE and heading RMSE and
+// the pooled NEES per robot and over all segments (docs/mrclam.md).
 // Exit codes: 0 done, 77 dataset folder absent (skip), 1 error,
 // 3 a robot's mean ATE is not better than dead reckoning.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mrclam_dataset.h"
 #include "offline_run.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/slam/slam_options_yaml.h"
+#include "segment_eval.h"
 
 namespace {
 
@@ -36,9 +46,85 @@ std::vector<int> parse_list(const std::string& text) {
   return out;
 }
 
+constexpr const char* kUsage =
+    "usage: mrclam_eval --dataset DIR --config FILE [--robots 1,2] [--seeds 1,2] "
+    "[--association known_id|maximum_likelihood] [--segments SECONDS]";
+
+double parse_seconds(const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !(v > 0.0) || !std::isfinite(v)) {
+    throw std::invalid_argument("--segments needs a positive number of seconds, not '" + text + "'");
+  }
+  return v;
+}
+
+// One restarted run of --segments.
+struct Segment {
+  int robot = 0;
+  int seed = 0;
+  double start_s = 0.0;   // since the robot's first truth pose
+  double length_s = 0.0;  // to the end of its trajectory
+  eval::TrajectoryErrors errors;
+  offline::NeesStats nees;
+};
+
+void print_nees(const char* label, const offline::NeesStats& n) {
+  std::printf("%s NEES mean %.2f (ideal 3), %.1f %% inside [%.4f, %.4f] (ideal 95), %.1f %% below %.4f "
+              "(ideal 97.5); %zu steps, %zu singular skipped\n",
+              label, n.mean(), 100.0 * n.fraction_inside(), offline::kNees3Lower95, offline::kNees3Upper95,
+              100.0 * n.fraction_below_upper(), offline::kNees3Upper95, n.steps, n.singular);
+}
+
+// count, mean, median, p90, worst of ATE and heading, and the pooled NEES.
+void print_segment_summary(const std::string& label, const std::vector<Segment>& segments) {
+  constexpr double kDeg = 180.0 / M_PI;
+  std::vector<double> ate, heading;
+  offline::NeesStats nees;
+  for (const Segment& s : segments) {
+    ate.push_back(s.errors.ate_rmse_m);
+    heading.push_back(s.errors.heading_rmse_rad * kDeg);
+    nees.merge(s.nees);
+  }
+  const offline::Summary a = offline::summarize(ate), h = offline::summarize(heading);
+  std::printf("%s: %zu segments, ATE mean %.3f median %.3f p90 %.3f worst %.3f m; "
+              "heading RMSE mean %.2f median %.2f p90 %.2f worst %.2f deg\n",
+              label.c_str(), a.count, a.mean, a.median, a.p90, a.max, h.mean, h.median, h.p90, h.max);
+  print_nees((label + ":").c_str(), nees);
+}
+
+// The runs of one robot and seed restarted from the truth every every_s seconds.
+std::vector<Segment> run_segments(const slam::FilterOptions& options, const offline::RunInput& input, int robot,
+                                  double every_s) {
+  std::vector<eval::TimedPose> truth = input.truth;
+  std::stable_sort(truth.begin(), truth.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  std::vector<Segment> out;
+  for (double start : offline::segment_starts(truth, every_s)) {
+    const offline::RunResult res = offline::run_filter(options, offline::restart_at_truth(input, start));
+    if (res.trajectory.empty()) continue;
+    Segment s;
+    s.robot = robot;
+    s.seed = static_cast<int>(options.seed);
+    s.start_s = start - truth.front().t_s;
+    s.length_s = res.trajectory.back().t_s - start;
+    s.errors = eval::compare_trajectory(res.trajectory, truth);
+    s.nees = offline::trajectory_nees(res.trajectory, res.covariance, truth);
+    out.push_back(s);
+  }
+  return out;
+}
+
 int run(int argc, char** argv) {
   std::string dataset, config_path, association;
   std::vector<int> robots{1, 2, 3, 4, 5}, seeds{1, 2, 3};
+  double segment_every_s = 0.0;  // 0: no segments
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      std::printf("%s\n", kUsage);
+      return 0;
+    }
+  }
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i], value = argv[i + 1];
     if (key == "--dataset") dataset = value;
@@ -46,11 +132,10 @@ int run(int argc, char** argv) {
     else if (key == "--robots") robots = parse_list(value);
     else if (key == "--seeds") seeds = parse_list(value);
     else if (key == "--association") association = value;
-    else throw std::invalid_argument("unknown argument '" + key + "'");
+    else if (key == "--segments") segment_every_s = parse_seconds(value);
+    else throw std::invalid_argument("unknown argument '" + key + "'\n" + kUsage);
   }
-  if (argc % 2 == 0 || dataset.empty() || config_path.empty()) {
-    throw std::invalid_argument("usage: mrclam_eval --dataset DIR --config FILE [--robots 1,2] [--seeds 1,2]");
-  }
+  if (argc % 2 == 0 || dataset.empty() || config_path.empty()) throw std::invalid_argument(kUsage);
   if (!std::filesystem::is_directory(dataset)) {
     std::printf("SKIP: dataset folder %s not found\n", dataset.c_str());
     return 77;
@@ -66,25 +151,30 @@ int run(int argc, char** argv) {
     throw std::invalid_argument("--association must be known_id or maximum_likelihood");
   }
 
-  std::printf("%-6s %-5s %9s %9s %9s %10s %10s %11s %11s %8s %5s %8s\n", "robot", "seed", "ATE_m", "ATE_al_m", "DR_ATE_m",
-              "head_deg", "DR_head", "lm_raw_m", "lm_align_m", "gated", "map", "wall_s");
+  std::printf("%-6s %-5s %9s %9s %9s %10s %10s %11s %11s %8s %5s %8s %7s %6s %6s\n", "robot", "seed", "ATE_m",
+              "ATE_al_m", "DR_ATE_m", "head_deg", "DR_head", "lm_raw_m", "lm_align_m", "gated", "map", "wall_s",
+              "NEES", "in95%", "<ub%");
   constexpr double kDeg = 180.0 / M_PI;
   bool all_better = true;
   double sum_ate = 0, sum_ate_aligned = 0, sum_head = 0, sum_lm = 0, sum_lma = 0, sum_wall = 0;
   int runs = 0;
+  offline::NeesStats nees_all;
+  std::vector<std::pair<int, offline::RunInput>> inputs;  // kept for the segments
   for (int robot : robots) {
     const mrclam::RobotData data = mrclam::load_robot(dataset, robot);
     const offline::RunInput input = offline::mrclam_input(data, model);
+    if (segment_every_s > 0.0) inputs.emplace_back(robot, input);
     double robot_ate = 0, robot_dr = 0;
     for (int seed : seeds) {
       options.seed = static_cast<std::uint64_t>(seed);
       const offline::RunResult res = offline::run_filter(options, input);
       const offline::Report rep = offline::evaluate(input, res);
-      std::printf("%-6d %-5d %9.3f %9.3f %9.3f %10.2f %10.2f %11.3f %11.3f %8llu %5zu %8.2f\n", robot, seed,
-                  rep.filter.ate_rmse_m, rep.filter.ate_rmse_aligned_m, rep.dead_reckoning.ate_rmse_m, rep.filter.heading_rmse_rad * kDeg,
-                  rep.dead_reckoning.heading_rmse_rad * kDeg, rep.landmarks.rmse_m, rep.landmarks.rmse_aligned_m,
-                  static_cast<unsigned long long>(res.counters.observations_gated), res.landmarks.size(),
-                  res.wall_time_s);
+      std::printf("%-6d %-5d %9.3f %9.3f %9.3f %10.2f %10.2f %11.3f %11.3f %8llu %5zu %8.2f %7.2f %6.1f %6.1f\n",
+                  robot, seed, rep.filter.ate_rmse_m, rep.filter.ate_rmse_aligned_m, rep.dead_reckoning.ate_rmse_m,
+                  rep.filter.heading_rmse_rad * kDeg, rep.dead_reckoning.heading_rmse_rad * kDeg, rep.landmarks.rmse_m,
+                  rep.landmarks.rmse_aligned_m, static_cast<unsigned long long>(res.counters.observations_gated),
+                  res.landmarks.size(), res.wall_time_s, rep.nees.mean(), 100.0 * rep.nees.fraction_inside(),
+                  100.0 * rep.nees.fraction_below_upper());
       std::fflush(stdout);
       robot_ate += rep.filter.ate_rmse_m;
       robot_dr += rep.dead_reckoning.ate_rmse_m;
@@ -94,6 +184,7 @@ int run(int argc, char** argv) {
       sum_lm += rep.landmarks.rmse_m;
       sum_lma += rep.landmarks.rmse_aligned_m;
       sum_wall += res.wall_time_s;
+      nees_all.merge(rep.nees);
       ++runs;
     }
     // Without robot ground truth (Dataset1, Dataset2) only the map is scored.
@@ -109,6 +200,42 @@ int run(int argc, char** argv) {
   std::printf("MEAN over %d runs: ATE %.3f m (%.3f m after SE(2) alignment), heading %.2f deg, landmarks %.3f m raw / "
               "%.3f m aligned, %.2f s per run\n",
               runs, sum_ate / runs, sum_ate_aligned / runs, sum_head / runs, sum_lm / runs, sum_lma / runs, sum_wall / runs);
+  if (nees_all.steps + nees_all.singular > 0) print_nees("POOLED over the full runs: pose", nees_all);
+
+  if (segment_every_s > 0.0) {
+    std::printf("\nSEGMENTS: restarted from the ground truth every %.0f s, each to the end of the robot's data\n",
+                segment_every_s);
+    std::printf("%-7s %-5s %-5s %8s %9s %9s %9s %7s %6s %6s\n", "segment", "robot", "seed", "start_s", "length_s",
+                "ATE_m", "head_deg", "NEES", "in95%", "<ub%");
+    std::vector<Segment> all;
+    for (const auto& [robot, input] : inputs) {
+      if (input.truth.empty()) {
+        std::printf("robot %d: no ground truth, no segments\n", robot);
+        continue;
+      }
+      std::vector<Segment> of_robot;
+      for (int seed : seeds) {
+        options.seed = static_cast<std::uint64_t>(seed);
+        for (const Segment& g : run_segments(options, input, robot, segment_every_s)) {
+          std::printf("%-7zu %-5d %-5d %8.1f %9.1f %9.3f %9.2f %7.2f %6.1f %6.1f\n", all.size() + of_robot.size() + 1,
+                      g.robot, g.seed, g.start_s, g.length_s, g.errors.ate_rmse_m, g.errors.heading_rmse_rad * kDeg,
+                      g.nees.mean(), 100.0 * g.nees.fraction_inside(), 100.0 * g.nees.fraction_below_upper());
+          std::fflush(stdout);
+          of_robot.push_back(g);
+        }
+      }
+      print_segment_summary("segments robot " + std::to_string(robot), of_robot);
+      all.insert(all.end(), of_robot.begin(), of_robot.end());
+    }
+    if (!all.empty()) {
+      print_segment_summary("SEGMENTS all robots", all);
+      const Segment& worst = *std::max_element(all.begin(), all.end(), [](const Segment& a, const Segment& b) {
+        return a.errors.ate_rmse_m < b.errors.ate_rmse_m;
+      });
+      std::printf("worst segment: robot %d seed %d start %.1f s: ATE %.3f m, heading RMSE %.2f deg\n", worst.robot,
+                  worst.seed, worst.start_s, worst.errors.ate_rmse_m, worst.errors.heading_rmse_rad * kDeg);
+    }
+  }
   if (!all_better) {
     std::printf("FAIL: some robot's mean ATE is not better than dead reckoning\n");
     return 3;

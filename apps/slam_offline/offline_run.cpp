@@ -24,6 +24,7 @@ RunResult run_filter(const slam::FilterOptions& options, const RunInput& input) 
   auto record = [&](double t) {
     const slam::PoseEstimate e = filter.pose_estimate();
     result.trajectory.push_back({t, e.mean.x(), e.mean.y(), e.mean.z()});
+    result.covariance.push_back(e.cov);
     result.dead_reckoning.push_back(
         {t, dead_reckoning.mean.x(), dead_reckoning.mean.y(), dead_reckoning.mean.z()});
   };
@@ -68,12 +69,22 @@ RunResult run_filter(const slam::FilterOptions& options, const RunInput& input) 
   return result;
 }
 
+namespace {
+
+std::vector<eval::TimedPose> sorted_by_time(std::vector<eval::TimedPose> poses) {
+  std::stable_sort(poses.begin(), poses.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  return poses;
+}
+
+}  // namespace
+
 Report evaluate(const RunInput& input, const RunResult& result) {
   Report r;
   if (!input.truth.empty() && !result.trajectory.empty()) {
     r.has_truth = true;
     r.filter = eval::compare_trajectory(result.trajectory, input.truth);
     r.dead_reckoning = eval::compare_trajectory(result.dead_reckoning, input.truth);
+    r.nees = trajectory_nees(result.trajectory, result.covariance, sorted_by_time(input.truth));
   }
   if (!input.landmarks.empty() && !result.landmarks.empty()) {
     r.has_landmarks = true;
@@ -162,6 +173,10 @@ void print_report(const std::string& title, const Report& r, const RunResult& re
                 r.dead_reckoning.heading_rmse_rad * kDeg);
     std::printf("pose ATE after SE(2) alignment %.3f m, max position error %.3f m, %zu truth samples\n",
                 r.filter.ate_rmse_aligned_m, r.filter.max_position_error_m, r.filter.samples);
+    std::printf("pose NEES (3 dof)      mean %.2f (ideal 3), %.1f %% inside [%.4f, %.4f] (ideal 95), %.1f %% below "
+                "%.4f (ideal 97.5), %zu steps, %zu singular skipped\n",
+                r.nees.mean(), 100.0 * r.nees.fraction_inside(), kNees3Lower95, kNees3Upper95,
+                100.0 * r.nees.fraction_below_upper(), kNees3Upper95, r.nees.steps, r.nees.singular);
   } else {
     std::printf("no robot ground truth: pose error not evaluated\n");
   }
@@ -180,6 +195,16 @@ void print_report(const std::string& title, const Report& r, const RunResult& re
               static_cast<unsigned long long>(c.odometry_samples), static_cast<unsigned long long>(c.frames),
               static_cast<unsigned long long>(c.resamples), res.final_effective_sample_size);
   std::printf("wall time              %.2f s\n", res.wall_time_s);
+}
+
+RunInput restart_at_truth(const RunInput& input, double start_s) {
+  const std::optional<eval::TimedPose> g =
+      interpolate_pose(sorted_by_time(input.truth), start_s, std::numeric_limits<double>::infinity());
+  if (!g) throw std::invalid_argument("restart_at_truth: no ground truth at the start time");
+  RunInput restarted = input;
+  restarted.initial_pose = slam::Pose2(g->x_m, g->y_m, g->theta_rad);
+  restarted.start_time_s = start_s;
+  return restarted;
 }
 
 }  // namespace pixyslam::offline

@@ -6,6 +6,7 @@
 #include "pixyslam/eval/csv_io.h"
 #include "pixyslam/eval/trajectory_metrics.h"
 #include "pixyslam/slam/fastslam2.h"
+#include "segment_eval.h"
 
 namespace pixyslam::offline {
 
@@ -22,6 +23,7 @@ struct RunInput {
 
 struct RunResult {
   std::vector<eval::TimedPose> trajectory;        // after every filter step
+  std::vector<Eigen::Matrix3d> covariance;        // pose covariance, one per trajectory step
   std::vector<eval::TimedPose> dead_reckoning;    // odometry alone, same steps
   std::vector<eval::LandmarkRow> landmarks;       // best particle
   slam::FilterCounters counters;
@@ -38,6 +40,7 @@ struct Report {
   bool has_truth = false;
   eval::TrajectoryErrors filter;
   eval::TrajectoryErrors dead_reckoning;
+  NeesStats nees;  // pose NEES of the filter against the truth
   bool has_landmarks = false;
   eval::LandmarkErrors landmarks;
 };
@@ -59,6 +62,11 @@ struct DataLimits {
 // Throws std::invalid_argument without truth or frames.
 DataLimits data_limits(const RunInput& input);
 void print_report(const std::string& title, const Report& report, const RunResult& result);
+
+// The run restarted at start_s from the truth pose then (interpolated): what a
+// segment of mrclam_eval --segments runs, from start_s to the end of the input.
+// Throws std::invalid_argument when the truth does not cover start_s.
+RunInput restart_at_truth(const RunInput& input, double start_s);
 
 }  // namespace pixyslam::offline
 
