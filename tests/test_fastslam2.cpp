@@ -366,6 +366,49 @@ TEST(FastSlam2, DelayedSamplingThroughACameraGap) {
   EXPECT_LT(ate_delayed, ate_plain) << "delayed " << ate_delayed / 5 << " m vs plain " << ate_plain / 5 << " m";
 }
 
+// Odometry is composed and applied to the particles at the next frame;
+// pose_estimate() in between expands its sums from the last frame's moments.
+// It must equal the estimate of the same particles moved one by one
+// (particles() moves them), with and without joint (delayed-sampling) states.
+TEST(FastSlam2, EstimateBetweenFramesEqualsTheMovedParticles) {
+  for (const bool delayed : {false, true}) {
+    sim::WorldOptions w;
+    sim::WorldRun run = noisy_world(301, 0.1, 0.15, w);
+    std::vector<ObservationFrame> kept;
+    for (const ObservationFrame& f : run.frames) {
+      if (f.t_s < 10.0 || f.t_s > 30.0) kept.push_back(f);
+    }
+    run.frames = kept;
+    FilterOptions o = options_for_world(w, 50, 3);
+    o.delayed_sampling.enabled = delayed;
+    FastSlam2 f(o, run.initial_pose);
+    double worst_mean = 0.0, worst_cov = 0.0;
+    int compared = 0, with_joint = 0;
+    feed(f, run, [&](std::size_t i) {
+      if (i % 7 != 0) return;
+      const PoseEstimate lazy = f.pose_estimate();
+      std::vector<Pose2> lazy_poses;
+      for (std::size_t k = 0; k < f.particle_count(); ++k) lazy_poses.push_back(f.particle_pose(k));
+      bool joint = false;
+      for (const Particle& p : f.particles()) joint = joint || p.joint.active();  // moves them
+      with_joint += joint ? 1 : 0;
+      const PoseEstimate moved = f.pose_estimate();
+      for (std::size_t k = 0; k < f.particle_count(); ++k) {
+        EXPECT_LT((lazy_poses[k] - f.particles()[k].pose.mean).head<2>().norm(), 1e-9);
+      }
+      worst_mean = std::max(worst_mean, (lazy.mean.head<2>() - moved.mean.head<2>()).norm());
+      worst_mean = std::max(worst_mean, std::abs(wrap_angle(lazy.mean.z() - moved.mean.z())));
+      worst_cov = std::max(worst_cov, (lazy.cov - moved.cov).norm() / std::max(1e-12, moved.cov.norm()));
+      EXPECT_EQ(lazy.effective_sample_size, moved.effective_sample_size);
+      ++compared;
+    });
+    EXPECT_GT(compared, 50);
+    if (delayed) EXPECT_GT(with_joint, 5);
+    EXPECT_LT(worst_mean, 1e-9) << "delayed " << delayed;
+    EXPECT_LT(worst_cov, 1e-9) << "delayed " << delayed;
+  }
+}
+
 // ------------------------------------------------------- (c) option validation
 
 std::string invalid_argument_of(const FilterOptions& o) {

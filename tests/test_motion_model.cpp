@@ -1,6 +1,7 @@
 // Tests of the unicycle motion model: exact motions, the quarter-circle limit,
 // and the propagated covariance against Monte Carlo sampling.
 
+#include <array>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -232,6 +233,49 @@ TEST(MotionModel, StandingStillAddsOnlyTimeNoise) {
   EXPECT_NEAR(g.cov(1, 1), 0.0, 1e-15);
   EXPECT_NEAR(g.cov(2, 2), 0.04 * 2.0, 1e-15);
   EXPECT_EQ(g.mean, Pose2(0.0, 0.0, 0.0));
+}
+
+// The composed motion is propagate() step by step, rotated into any heading.
+TEST(ComposedMotion, EqualsStepByStepPropagationFromAnyPose) {
+  MotionNoise noise;
+  noise.v_sigma_m_per_sqrt_s = 0.02;
+  noise.w_sigma_rad_per_sqrt_s = 0.05;
+  noise.rotation_sigma_per_sqrt_rad = 0.1;
+  noise.distance_sigma_per_sqrt_m = 0.03;
+  std::mt19937_64 prng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  ComposedMotion composed;
+  std::vector<std::array<double, 3>> steps;
+  for (int k = 0; k < 40; ++k) {
+    steps.push_back({0.4 * u(prng), 1.2 * u(prng), 0.015 * (2.0 + u(prng))});
+    composed.add(steps.back()[0], steps.back()[1], steps.back()[2], noise);
+  }
+  for (const double heading : {0.0, 1.0, -2.5, 3.1}) {
+    PoseGaussian stepwise{Pose2(1.5, -0.7, heading), Eigen::Matrix3d::Zero()};
+    stepwise.cov << 0.04, 0.01, 0.002, 0.01, 0.09, -0.003, 0.002, -0.003, 0.01;
+    PoseGaussian at_once = stepwise;
+    for (const auto& s : steps) propagate(stepwise, s[0], s[1], s[2], noise);
+    composed.apply(at_once);
+    EXPECT_LT((at_once.mean.head<2>() - stepwise.mean.head<2>()).norm(), 1e-12) << heading;
+    EXPECT_NEAR(wrap_angle(at_once.mean.z() - stepwise.mean.z()), 0.0, 1e-12) << heading;
+    EXPECT_LT((at_once.cov - stepwise.cov).norm(), 1e-12) << heading << "\n" << at_once.cov << "\n" << stepwise.cov;
+  }
+  // The weighted sum of the rotated noise from the sums of cos, sin and their products.
+  const std::vector<double> headings = {0.3, -1.2, 2.9}, weights = {0.5, 0.2, 0.3};
+  Eigen::Matrix3d direct = Eigen::Matrix3d::Zero();
+  double c = 0, s = 0, cc = 0, ss = 0, cs = 0;
+  for (std::size_t i = 0; i < headings.size(); ++i) {
+    const double ci = std::cos(headings[i]), si = std::sin(headings[i]);
+    direct += weights[i] * composed.noise(ci, si);
+    c += weights[i] * ci;
+    s += weights[i] * si;
+    cc += weights[i] * ci * ci;
+    ss += weights[i] * si * si;
+    cs += weights[i] * ci * si;
+  }
+  EXPECT_LT((composed.mean_noise(c, s, cc, ss, cs) - direct).norm(), 1e-15);
+  composed.clear();
+  EXPECT_TRUE(composed.empty());
 }
 
 }  // namespace

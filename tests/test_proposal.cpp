@@ -268,7 +268,7 @@ TEST(Proposal, FoldHandlesRankDeficientMotionCovariance) {
 }
 
 // Unweighted sample mean and covariance of the particles' poses.
-void particle_spread(const FastSlam2& f, Eigen::Vector3d& mean, Eigen::Matrix3d& cov) {
+void particle_spread(FastSlam2& f, Eigen::Vector3d& mean, Eigen::Matrix3d& cov) {
   mean.setZero();
   for (const Particle& p : f.particles()) mean += p.pose.mean;
   mean /= static_cast<double>(f.particles().size());

@@ -79,7 +79,10 @@ FastSlam2::FastSlam2(const FilterOptions& options, const PoseGaussian& initial_p
   p.pose.mean.z() = wrap_angle(p.pose.mean.z());
   particles_.assign(static_cast<std::size_t>(options_.particles), p);
   const double heading_var = initial_pose.cov(2, 2);
-  if (heading_var <= kMaxLinearHeadingSigma * kMaxLinearHeadingSigma) return;
+  if (heading_var <= kMaxLinearHeadingSigma * kMaxLinearHeadingSigma) {
+    refresh_caches();
+    return;
+  }
   // A wide heading: the range-bearing proposal is linear only for small heading
   // errors, so the heading is split across the particles at the quantiles of
   // its marginal and each particle keeps the position conditioned on its heading.
@@ -97,6 +100,80 @@ FastSlam2::FastSlam2(const FilterOptions& options, const PoseGaussian& initial_p
     g.mean.z() = wrap_angle(initial_pose.mean.z() + offset);
     g.cov = cov;
   }
+  refresh_caches();
+}
+
+void FastSlam2::move_particles() {
+  if (pending_.empty()) return;
+  for (Particle& p : particles_) {
+    if (p.joint.active()) {
+      p.joint.apply_motion(pending_);
+      p.pose = p.joint.pose();
+    } else {
+      pending_.apply(p.pose);
+    }
+  }
+  pending_.clear();
+  refresh_caches();
+}
+
+void FastSlam2::refresh_caches() {
+  const std::size_t n = particles_.size();
+  heading_cs_.resize(n);
+  std::vector<double> log_w(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    heading_cs_[i] = Eigen::Vector2d(std::cos(particles_[i].pose.mean.z()), std::sin(particles_[i].pose.mean.z()));
+    log_w[i] = particles_[i].log_weight;
+  }
+  weights_ = normalised_weights(log_w);
+  // The weighted moments pose_estimate() expands its sums into.
+  Moments m;
+  m.effective_sample_size = effective_sample_size(weights_);
+  m.best = best_index();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double w = weights_[i];
+    m.x += w * particles_[i].pose.mean.x();
+    m.y += w * particles_[i].pose.mean.y();
+    m.c += w * heading_cs_[i].x();
+    m.s += w * heading_cs_[i].y();
+  }
+  m.heading = std::atan2(m.s, m.c);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double w = weights_[i];
+    const Pose2& pose = particles_[i].pose.mean;
+    const double x = pose.x() - m.x, y = pose.y() - m.y;
+    const double c = heading_cs_[i].x(), s = heading_cs_[i].y();
+    const double t = wrap_angle(pose.z() - m.heading);
+    m.xx += w * x * x;
+    m.xy += w * x * y;
+    m.yy += w * y * y;
+    m.xc += w * x * c;
+    m.xs += w * x * s;
+    m.yc += w * y * c;
+    m.ys += w * y * s;
+    m.cc += w * c * c;
+    m.ss += w * s * s;
+    m.cs += w * c * s;
+    m.t += w * t;
+    m.tt += w * t * t;
+    m.xt += w * x * t;
+    m.yt += w * y * t;
+    m.ct += w * c * t;
+    m.st += w * s * t;
+    const Eigen::Matrix3d& p = particles_[i].pose.cov;
+    m.p += w * p;
+    m.cp3 += (w * c) * p.col(2);
+    m.sp3 += (w * s) * p.col(2);
+    m.pcc += w * p(2, 2) * c * c;
+    m.pss += w * p(2, 2) * s * s;
+    m.pcs += w * p(2, 2) * c * s;
+  }
+  moments_ = std::move(m);
+}
+
+Pose2 FastSlam2::particle_pose(std::size_t i) const {
+  if (pending_.empty()) return particles_[i].pose.mean;
+  return pending_.moved_mean(particles_[i].pose.mean, heading_cs_[i].x(), heading_cs_[i].y());
 }
 
 void FastSlam2::advance_to(double t_s) {
@@ -110,15 +187,7 @@ void FastSlam2::advance_to(double t_s) {
   const double control_end = control_time_s_ + options_.control_timeout_s;
   const double moving_until = std::min(t_s, control_end);
   if (moving_until > time_s_ && (control_.v_mps != 0.0 || control_.w_radps != 0.0)) {
-    const double dt = moving_until - time_s_;
-    for (Particle& p : particles_) {
-      if (p.joint.active()) {
-        p.joint.propagate(control_.v_mps, control_.w_radps, dt, options_.motion);
-        p.pose = p.joint.pose();
-      } else {
-        propagate(p.pose, control_.v_mps, control_.w_radps, dt, options_.motion);
-      }
-    }
+    pending_.add(control_.v_mps, control_.w_radps, moving_until - time_s_, options_.motion);
   }
   if (t_s > control_end && time_s_ <= control_end && (control_.v_mps != 0.0 || control_.w_radps != 0.0)) {
     ++counters_.control_timeouts;
@@ -158,6 +227,7 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
   }
   if (has_time_ && frame.t_s < time_s_) ++counters_.frames_out_of_order;
   advance_to(frame.t_s);
+  move_particles();
 
   const std::size_t n = frame.detections.size();
   z_.resize(n);
@@ -210,6 +280,7 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
     }
   }
   resample_if_needed();
+  refresh_caches();
   update_output_frame();
 }
 
@@ -463,14 +534,10 @@ void FastSlam2::finish_joint(Particle& p) {
   p.joint.clear();
 }
 
-std::vector<double> FastSlam2::weights() const {
+void FastSlam2::resample_if_needed() {
   std::vector<double> log_w(particles_.size());
   for (std::size_t i = 0; i < particles_.size(); ++i) log_w[i] = particles_[i].log_weight;
-  return normalised_weights(log_w);
-}
-
-void FastSlam2::resample_if_needed() {
-  const std::vector<double> w = weights();
+  const std::vector<double> w = normalised_weights(log_w);
   const double n_eff = effective_sample_size(w);
   const bool resample = options_.resample_mode == ResampleMode::kEveryFrame ||
                         n_eff < options_.resample_neff_fraction * static_cast<double>(particles_.size());
@@ -522,27 +589,49 @@ std::size_t FastSlam2::best_index() const {
 }
 
 PoseEstimate FastSlam2::pose_estimate() const {
+  // From the particle moments of the last frame (refresh_caches) and the
+  // odometry since (pending_): a particle's position is x_i + R_i delta, its
+  // heading theta_i + rotation, so every sum over the particles expands into
+  // weighted sums of x_i, cos theta_i, sin theta_i and their products.
+  const Moments& m = moments_;
+  const Eigen::Vector2d delta = pending_.displacement();
+  const double a = delta.x(), b = delta.y();
   PoseEstimate e;
   e.t_s = time_s_;
   e.particles = static_cast<int>(particles_.size());
-  const std::vector<double> w = weights();
-  e.effective_sample_size = effective_sample_size(w);
-
-  double sx = 0, sy = 0, sc = 0, ss = 0;
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    const Pose2& m = particles_[i].pose.mean;
-    sx += w[i] * m.x();
-    sy += w[i] * m.y();
-    sc += w[i] * std::cos(m.z());
-    ss += w[i] * std::sin(m.z());
-  }
-  e.mean = Pose2(sx, sy, std::atan2(ss, sc));
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    const Pose2& m = particles_[i].pose.mean;
-    const Eigen::Vector3d d(m.x() - e.mean.x(), m.y() - e.mean.y(), wrap_angle(m.z() - e.mean.z()));
-    e.cov += w[i] * (d * d.transpose() + particles_[i].pose.cov);
-  }
-  e.best = to_output(particles_[best_index()].pose.mean);
+  e.effective_sample_size = m.effective_sample_size;
+  const Eigen::Vector2d mean_xy(m.x + m.c * a - m.s * b, m.y + m.s * a + m.c * b);
+  e.mean = Pose2(mean_xy.x(), mean_xy.y(), wrap_angle(m.heading + pending_.rotation()));
+  // Positions relative to m.x, m.y: sum w p p^T - pbar pbar^T.
+  const Eigen::Vector2d mean_rel = mean_xy - Eigen::Vector2d(m.x, m.y);
+  Eigen::Matrix2d pp;
+  pp(0, 0) = m.xx + 2.0 * (a * m.xc - b * m.xs) + (m.cc * a * a - 2.0 * m.cs * a * b + m.ss * b * b);
+  pp(1, 1) = m.yy + 2.0 * (a * m.ys + b * m.yc) + (m.ss * a * a + 2.0 * m.cs * a * b + m.cc * b * b);
+  pp(0, 1) = m.xy + (a * m.xs + b * m.xc) + (a * m.yc - b * m.ys) + (m.cs * (a * a - b * b) + (m.cc - m.ss) * a * b);
+  pp(1, 0) = pp(0, 1);
+  e.cov.topLeftCorner<2, 2>() = pp - mean_rel * mean_rel.transpose();
+  // Heading differences to the mean heading do not depend on the pending rotation.
+  const Eigen::Vector2d pt(m.xt + a * m.ct - b * m.st, m.yt + a * m.st + b * m.ct);
+  e.cov.block<2, 1>(0, 2) = pt - mean_rel * m.t;
+  e.cov.block<1, 2>(2, 0) = e.cov.block<2, 1>(0, 2).transpose();
+  e.cov(2, 2) = m.tt;
+  // sum w F_i P_i F_i^T, F_i = I + u_i e3^T with u_i = R_i (-b, a, 0):
+  // P_i + u_i p3_i^T + p3_i u_i^T + P_i(2,2) u_i u_i^T.
+  const double g0 = -b, g1 = a;
+  Eigen::Matrix<double, 2, 3> up3;
+  up3.row(0) = g0 * m.cp3.transpose() - g1 * m.sp3.transpose();
+  up3.row(1) = g0 * m.sp3.transpose() + g1 * m.cp3.transpose();
+  Eigen::Matrix3d fpf = m.p;
+  fpf.topRows<2>() += up3;
+  fpf.leftCols<2>() += up3.transpose();
+  fpf(0, 0) += m.pcc * g0 * g0 - 2.0 * m.pcs * g0 * g1 + m.pss * g1 * g1;
+  fpf(1, 1) += m.pss * g0 * g0 + 2.0 * m.pcs * g0 * g1 + m.pcc * g1 * g1;
+  const double off = m.pcs * (g0 * g0 - g1 * g1) + (m.pcc - m.pss) * g0 * g1;
+  fpf(0, 1) += off;
+  fpf(1, 0) += off;
+  e.cov += fpf;
+  if (!pending_.empty()) e.cov += pending_.mean_noise(m.c, m.s, m.cc, m.ss, m.cs);
+  e.best = to_output(particle_pose(m.best));
   e.mean = to_output(e.mean);
   Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
   r.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(output_rotation_rad_).toRotationMatrix();
@@ -571,7 +660,7 @@ std::vector<int> FastSlam2::anchor_ids() const {
 
 void FastSlam2::mean_positions(const std::vector<std::uint32_t>& slots, std::vector<Eigen::Vector2d>& means,
                                std::vector<bool>& found) const {
-  const std::vector<double> w = weights();
+  const std::vector<double>& w = weights();
   std::vector<double> total(slots.size(), 0.0);
   means.assign(slots.size(), Eigen::Vector2d::Zero());
   for (std::size_t i = 0; i < particles_.size(); ++i) {
@@ -653,7 +742,7 @@ std::vector<LandmarkEstimate> FastSlam2::landmarks_of_best() const {
 }
 
 std::vector<LandmarkEstimate> FastSlam2::landmarks_mixture() const {
-  const std::vector<double> w = weights();
+  const std::vector<double>& w = weights();
   struct Sum {
     double weight = 0.0;
     Eigen::Vector2d m = Eigen::Vector2d::Zero();

@@ -17,7 +17,11 @@ constexpr double kMaxVariance = 1e6;
 // A frame correction beyond this is not folded back into the motion Jacobian.
 constexpr double kRelineariseDistance = 0.25;  // m
 
-void symmetrise(Eigen::MatrixXd& m) { m = 0.5 * (m + m.transpose()).eval(); }
+void symmetrise(Eigen::MatrixXd& m) {
+  for (Eigen::Index c = 1; c < m.cols(); ++c) {
+    for (Eigen::Index r = 0; r < c; ++r) m(r, c) = m(c, r) = 0.5 * (m(r, c) + m(c, r));
+  }
+}
 
 // Grows the state by one landmark block, zero-filled; returns its index.
 int append_block(JointGaussian& g, std::uint32_t slot) {
@@ -35,7 +39,8 @@ int append_block(JointGaussian& g, std::uint32_t slot) {
 }  // namespace
 
 bool JointGaussian::healthy() const {
-  if (!mean.allFinite() || !cov.allFinite()) return false;
+  // A NaN or infinity anywhere makes the sum non-finite.
+  if (!std::isfinite(mean.sum()) || !std::isfinite(cov.sum())) return false;
   for (Eigen::Index i = 0; i < cov.rows(); ++i) {
     if (cov(i, i) < 0.0 || cov(i, i) > kMaxVariance) return false;
   }
@@ -95,6 +100,20 @@ void JointGaussian::propagate(double v_mps, double w_radps, double dt_s, const M
   mean.head<3>() = step.mean;
 }
 
+void JointGaussian::apply_motion(const ComposedMotion& motion) {
+  if (motion.empty()) return;
+  const double c = std::cos(mean(2));
+  const double s = std::sin(mean(2));
+  const Eigen::Matrix3d f = motion.jacobian(c, s);
+  const Eigen::Index m = mean.size() - 3;
+  cov.topLeftCorner<3, 3>() = f * cov.topLeftCorner<3, 3>() * f.transpose() + motion.noise(c, s);
+  if (m > 0) {
+    cov.topRightCorner(3, m) = (f * cov.topRightCorner(3, m)).eval();
+    cov.bottomLeftCorner(m, 3) = cov.topRightCorner(3, m).transpose();
+  }
+  mean.head<3>() = motion.moved_mean(mean.head<3>(), c, s);
+}
+
 int JointGaussian::add_known(std::uint32_t slot, const Eigen::Vector2d& landmark_mean,
                              const Eigen::Matrix2d& landmark_cov) {
   const int i = append_block(*this, slot);
@@ -148,13 +167,20 @@ JointFit fit_observation(const JointGaussian& g, int index, const Eigen::Vector2
 void apply_observation(JointGaussian& g, const JointFit& fit) {
   const Eigen::Index j = 3 + 2 * fit.index;
   // P H^T touches only the pose and landmark columns of H.
-  const Eigen::MatrixXd pht =
+  using Columns2 = Eigen::Matrix<double, Eigen::Dynamic, 2>;
+  const Columns2 pht =
       g.cov.leftCols<3>() * fit.h_pose.transpose() + g.cov.middleCols<2>(j) * fit.h_landmark.transpose();
-  const Eigen::MatrixXd k = pht * fit.s.inverse();
-  g.mean += k * fit.innovation;
+  const Columns2 k = pht * fit.s.inverse();
+  g.mean.noalias() += k * fit.innovation;
   g.mean(2) = wrap_angle(g.mean(2));
-  g.cov -= k * pht.transpose();
-  symmetrise(g.cov);
+  // P -= K (P H^T)^T: a symmetric rank-2 update, computed on the lower
+  // triangle and mirrored (keeps P exactly symmetric).
+  const Eigen::Index n = g.cov.rows();
+  for (Eigen::Index c = 0; c < n; ++c) {
+    const double p0 = pht(c, 0), p1 = pht(c, 1);
+    for (Eigen::Index r = c; r < n; ++r) g.cov(r, c) -= k(r, 0) * p0 + k(r, 1) * p1;
+  }
+  g.cov.triangularView<Eigen::StrictlyUpper>() = g.cov.transpose();
 }
 
 std::vector<ConditionedLandmark> condition_on_pose(const JointGaussian& g, const Pose2& pose) {

@@ -45,4 +45,55 @@ void propagate(PoseGaussian& g, double v_mps, double w_radps, double dt_s, const
   g.mean = step.mean;
 }
 
+void ComposedMotion::add(double v_mps, double w_radps, double dt_s, const MotionNoise& noise) {
+  if (dt_s <= 0.0) return;
+  const MotionStep step = motion_step(local_, v_mps, w_radps, dt_s, noise);
+  q_ = step.f * q_ * step.f.transpose() + step.q;
+  local_ = step.mean;
+  ++steps_;
+}
+
+Pose2 ComposedMotion::moved_mean(const Pose2& pose, double c, double s) const {
+  return Pose2(pose.x() + c * local_.x() - s * local_.y(), pose.y() + s * local_.x() + c * local_.y(),
+               wrap_angle(pose.z() + local_.z()));
+}
+
+Eigen::Matrix3d ComposedMotion::jacobian(double c, double s) const {
+  Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
+  f(0, 2) = -(s * local_.x() + c * local_.y());
+  f(1, 2) = c * local_.x() - s * local_.y();
+  return f;
+}
+
+Eigen::Matrix3d ComposedMotion::noise(double c, double s) const {
+  Eigen::Matrix3d b = Eigen::Matrix3d::Identity();
+  b(0, 0) = c;
+  b(0, 1) = -s;
+  b(1, 0) = s;
+  b(1, 1) = c;
+  return b * q_ * b.transpose();
+}
+
+Eigen::Matrix3d ComposedMotion::mean_noise(double c, double s, double cc, double ss, double cs) const {
+  // B q B^T with B = diag(R, 1): the xy block is R q_xy R^T, the x-theta column R q_xt.
+  const double a = q_(0, 0), b = q_(0, 1), d = q_(1, 1), e = q_(0, 2), f = q_(1, 2);
+  Eigen::Matrix3d out;
+  out(0, 0) = cc * a - 2.0 * cs * b + ss * d;
+  out(1, 1) = ss * a + 2.0 * cs * b + cc * d;
+  out(0, 1) = out(1, 0) = cs * (a - d) + (cc - ss) * b;
+  out(0, 2) = out(2, 0) = c * e - s * f;
+  out(1, 2) = out(2, 1) = s * e + c * f;
+  out(2, 2) = q_(2, 2);
+  return out;
+}
+
+void ComposedMotion::apply(PoseGaussian& g) const {
+  if (empty()) return;
+  const double c = std::cos(g.mean.z());
+  const double s = std::sin(g.mean.z());
+  const Eigen::Matrix3d f = jacobian(c, s);
+  g.cov = f * g.cov * f.transpose() + noise(c, s);
+  g.mean = moved_mean(g.mean, c, s);
+}
+
 }  // namespace pixyslam::slam

@@ -70,11 +70,11 @@ void fill_map_state(const slam::FastSlam2& filter, const StepInfo& info, int max
   out.effective_sample_size(estimate.effective_sample_size);
   out.particle_count(static_cast<std::uint32_t>(estimate.particles));
 
-  const auto& particles = filter.particles();
+  const std::size_t count = filter.particle_count();
   out.particle_poses().clear();
-  const std::size_t wanted = std::min<std::size_t>(particles.size(), static_cast<std::size_t>(std::max(0, max_particle_poses)));
+  const std::size_t wanted = std::min<std::size_t>(count, static_cast<std::size_t>(std::max(0, max_particle_poses)));
   for (std::size_t k = 0; k < wanted; ++k) {
-    out.particle_poses().push_back(to_pose(filter.to_output(particles[k * particles.size() / wanted].pose.mean)));
+    out.particle_poses().push_back(to_pose(filter.to_output(filter.particle_pose(k * count / wanted))));
   }
 
   out.landmarks().clear();

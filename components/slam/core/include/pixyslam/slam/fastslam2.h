@@ -108,7 +108,15 @@ class FastSlam2 {
   std::vector<LandmarkEstimate> landmarks_mixture() const;
 
   // In the particles' own frame: to_output() moves a pose into the output frame.
-  const std::vector<Particle>& particles() const { return particles_; }
+  // Odometry is composed and applied to the particles at the next frame
+  // (ComposedMotion); particles() applies it first, particle_pose() reads the
+  // moved pose without changing the particles.
+  const std::vector<Particle>& particles() {
+    move_particles();
+    return particles_;
+  }
+  std::size_t particle_count() const { return particles_.size(); }
+  Pose2 particle_pose(std::size_t i) const;
   Pose2 to_output(const Pose2& pose) const;
   // Rigid transform from the particles' frame to the output frame (identity
   // until anchored), and the anchored landmark ids (empty until anchored).
@@ -125,6 +133,10 @@ class FastSlam2 {
   enum class Decision : std::uint8_t { kUsed, kGated, kNew, kInvalid, kNewDone };
 
   void advance_to(double t_s);
+  // Applies the odometry composed since the last frame to every particle.
+  void move_particles();
+  // cos and sin of each particle's heading (for pending_), and weights_.
+  void refresh_caches();
   std::uint32_t slot_for(int landmark_id);
   // Association::kMaximumLikelihood: slots_ for particle p (a mapped landmark,
   // or a new slot shared by every particle that starts one for that detection).
@@ -134,7 +146,7 @@ class FastSlam2 {
   void finish_joint(Particle& p);
   void resample_if_needed();
   std::size_t best_index() const;
-  std::vector<double> weights() const;  // normalised importance weights
+  const std::vector<double>& weights() const { return weights_; }  // normalised importance weights
   // Anchors the output frame once the first landmarks pin it, then keeps the
   // output transform up to date (AnchorFrameOptions).
   void update_output_frame();
@@ -150,6 +162,24 @@ class FastSlam2 {
   LandmarkMapPool pool_;  // declared before particles_: outlives their maps
   std::vector<Particle> particles_;
   std::vector<Particle> scratch_;
+  ComposedMotion pending_;                   // odometry not yet applied to the particles
+  std::vector<Eigen::Vector2d> heading_cs_;  // per particle: cos, sin of its heading
+  std::vector<double> weights_;              // normalised importance weights
+  // Weighted particle moments at the last frame (positions relative to x, y;
+  // t: heading minus the mean heading), for pose_estimate() in O(1).
+  struct Moments {
+    double x = 0, y = 0, c = 0, s = 0, heading = 0;
+    double xx = 0, xy = 0, yy = 0, xc = 0, xs = 0, yc = 0, ys = 0, cc = 0, ss = 0, cs = 0;
+    double t = 0, tt = 0, xt = 0, yt = 0, ct = 0, st = 0;
+    // The particles' own pose covariances P_i: sum w P_i, sum w cos P_i e3,
+    // sum w sin P_i e3, sum w P_i(2,2) {cos^2, sin^2, cos sin}.
+    Eigen::Matrix3d p = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d cp3 = Eigen::Vector3d::Zero(), sp3 = Eigen::Vector3d::Zero();
+    double pcc = 0, pss = 0, pcs = 0;
+    double effective_sample_size = 0;
+    std::size_t best = 0;
+  };
+  Moments moments_;
   JointGaussian joint_backup_;  // state before a joint update, restored on breakdown
 
   struct Anchor {

@@ -48,6 +48,8 @@ struct JointGaussian {
   void clear();
   // Pose block moved through motion_step(); cross-covariances multiplied by F.
   void propagate(double v_mps, double w_radps, double dt_s, const MotionNoise& noise);
+  // The same for several steps at once (ComposedMotion): one 3 x n product.
+  void apply_motion(const ComposedMotion& motion);
   // Brackets the observations of one frame. end_frame() re-linearises the motion
   // Jacobian at the predicted pose: with c the position correction of the frame,
   // P <- Fc P Fc^T, Fc = I + [0 0 -c_y; 0 0 c_x; 0 0 0] (the unicycle Jacobians

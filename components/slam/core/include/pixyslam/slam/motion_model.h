@@ -45,4 +45,41 @@ MotionStep motion_step(const Pose2& pose, double v_mps, double w_radps, double d
 // F cov F^T + V Q V^T with F = d move / d pose and V = d move / d (d, a).
 void propagate(PoseGaussian& g, double v_mps, double w_radps, double dt_s, const MotionNoise& noise);
 
+// Several motion steps composed once for every pose. A step depends on the
+// heading only through a rotation, so the steps are integrated in the frame of
+// the start heading (one sin/cos per step, shared by all particles) and then
+// applied to any pose by rotating: for a pose of heading theta with
+// B = diag(R(theta), 1) and the composed displacement delta = R(theta) local.xy,
+//   mean <- (x, y) + delta, theta + local.theta;
+//   F = I + [0 0 -delta_y; 0 0 delta_x; 0 0 0]  (the step Jacobians are
+//       unipotent and multiply by adding their displacements);
+//   cov <- F cov F^T + B q B^T, q the steps' noise accumulated in that frame
+//       (q <- F_k q F_k^T + Q_k).
+// Exactly the result of propagate() step by step, up to rounding.
+class ComposedMotion {
+ public:
+  void add(double v_mps, double w_radps, double dt_s, const MotionNoise& noise);
+  bool empty() const { return steps_ == 0; }
+  void clear() { *this = ComposedMotion(); }
+  double rotation() const { return local_.z(); }
+  // The composed displacement in the start heading's frame.
+  Eigen::Vector2d displacement() const { return local_.head<2>(); }
+
+  // The moved mean of a pose whose heading has cos c and sin s.
+  Pose2 moved_mean(const Pose2& pose, double c, double s) const;
+  // F above for that heading.
+  Eigen::Matrix3d jacobian(double c, double s) const;
+  // B q B^T above for that heading.
+  Eigen::Matrix3d noise(double c, double s) const;
+  void apply(PoseGaussian& g) const;
+  // sum_i w_i noise(c_i, s_i) from the weighted sums of c, s, c^2, s^2 and c s
+  // (the weights summing to 1).
+  Eigen::Matrix3d mean_noise(double c, double s, double cc, double ss, double cs) const;
+
+ private:
+  Pose2 local_ = Pose2::Zero();  // displacement and rotation in the start heading's frame
+  Eigen::Matrix3d q_ = Eigen::Matrix3d::Zero();
+  int steps_ = 0;
+};
+
 }  // namespace pixyslam::slam
