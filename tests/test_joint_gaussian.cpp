@@ -54,7 +54,7 @@ TEST(JointGaussian, KnownLandmarkGivesTheFastSlam2ProposalAndLikelihood) {
   EXPECT_NEAR(joint.log_likelihood, plain.log_likelihood, 1e-12);
   EXPECT_NEAR(joint.mahalanobis2, plain.mahalanobis2, 1e-12);
 
-  apply_observation(g, joint);
+  ASSERT_TRUE(apply_observation(g, joint));
   PoseGaussian proposal = pose;
   fold_into_proposal(proposal, plain);
   const PoseGaussian marginal = g.pose();
@@ -131,7 +131,7 @@ TEST(JointGaussian, RelativeObservationsLeaveTheAbsoluteHeadingUncertain) {
       z += Eigen::Vector2d(0.05 * n01(prng), 0.02 * n01(prng));
       const JointFit fit = fit_observation(g, k, z, r);
       ASSERT_TRUE(std::isfinite(fit.mahalanobis2));
-      apply_observation(g, fit);
+      ASSERT_TRUE(apply_observation(g, fit));
     }
     g.end_frame();
     ASSERT_TRUE(g.healthy()) << "step " << step;
@@ -156,8 +156,8 @@ TEST(JointGaussian, LoopClosureCorrectsThePoseAndTheLandmarksSeenFromIt) {
     g.begin_frame();
     int ia = g.find(1);
     if (ia < 0) ia = g.add_known(1, a, 1e-4 * Eigen::Matrix2d::Identity());
-    apply_observation(g, fit_observation(g, ia, observe(truth, a), r));
-    apply_observation(g, fit_observation(g, ib, observe(truth, b), r));
+    ASSERT_TRUE(apply_observation(g, fit_observation(g, ia, observe(truth, a), r)));
+    ASSERT_TRUE(apply_observation(g, fit_observation(g, ib, observe(truth, b), r)));
     g.end_frame();
   }
   EXPECT_LT(std::abs(wrap_angle(g.mean(2) - truth.z())), 0.03) << g.mean.transpose();
@@ -176,6 +176,32 @@ TEST(JointGaussian, HealthRejectsNonFiniteAndNegativeVariances) {
   EXPECT_FALSE(g.healthy());
   g.clear();
   EXPECT_FALSE(g.active());
+}
+
+TEST(JointGaussian, AnUpdateThatWouldBreakTheStateIsRefusedAndChangesNothing) {
+  const PoseGaussian pose = pose_gaussian(Pose2(1.0, 2.0, 0.3), Eigen::Vector3d(0.04, 0.02, 0.01));
+  const Eigen::Vector2d lm(3.5, 3.0);
+  const Eigen::Matrix2d lm_cov = Eigen::Vector2d(0.05, 0.03).asDiagonal();
+  JointGaussian g;
+  g.begin(pose);
+  g.begin_frame();
+  const int i = g.add_known(7, lm, lm_cov);
+  const Eigen::Vector2d z(2.6, -0.05);
+  JointFit fit = fit_observation(g, i, z, noise(0.1, 0.03));
+  const JointGaussian before = g;
+  // An innovation covariance far smaller than H P H^T makes the gain overshoot:
+  // the variances would go negative.
+  fit.s = 1e-3 * fit.s;
+  EXPECT_FALSE(apply_observation(g, fit));
+  EXPECT_EQ(g.mean, before.mean);
+  EXPECT_EQ(g.cov, before.cov);
+  fit.s = Eigen::Matrix2d::Zero();  // S^-1 not finite
+  EXPECT_FALSE(apply_observation(g, fit));
+  EXPECT_EQ(g.cov, before.cov);
+  fit = fit_observation(g, i, z, noise(0.1, 0.03));
+  EXPECT_TRUE(apply_observation(g, fit));
+  EXPECT_TRUE(g.healthy());
+  EXPECT_LT(g.cov(0, 0), before.cov(0, 0));
 }
 
 }  // namespace

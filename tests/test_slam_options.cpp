@@ -73,7 +73,9 @@ TEST(SlamOptionsYaml, FullConfigRoundTripsEveryValue) {
       "    enter_position_sigma_m: 0.4\n"
       "    exit_heading_sigma_rad: 0.03\n"
       "    exit_position_sigma_m: 0.07\n"
-      "    max_landmarks: 24\n");
+      "    max_landmarks: 24\n"
+      "  frame_uncertainty:\n"
+      "    enabled: true\n");
   // then each value arrives in its field.
   const FilterOptions d;
   EXPECT_EQ(o.particles, 321);
@@ -105,6 +107,8 @@ TEST(SlamOptionsYaml, FullConfigRoundTripsEveryValue) {
   EXPECT_DOUBLE_EQ(o.delayed_sampling.exit_heading_sigma_rad, 0.03);
   EXPECT_DOUBLE_EQ(o.delayed_sampling.exit_position_sigma_m, 0.07);
   EXPECT_EQ(o.delayed_sampling.max_landmarks, 24);
+  EXPECT_TRUE(o.frame_uncertainty);
+  EXPECT_NE(o.frame_uncertainty, d.frame_uncertainty);
   EXPECT_NO_THROW(validate(o));
 }
 

@@ -33,6 +33,10 @@ RunResult run_filter(const slam::FilterOptions& options, const RunInput& input) 
     dr_time = std::max(dr_time, t);
   };
 
+  const std::size_t steps = input.odometry.size() + input.frames.size();
+  result.trajectory.reserve(steps);
+  result.covariance.reserve(steps);
+  result.dead_reckoning.reserve(steps);
   const auto start = std::chrono::steady_clock::now();
   filter.add_odometry(control);  // sets the filter's clock to the start time
   std::size_t i = 0;

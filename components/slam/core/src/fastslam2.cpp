@@ -430,7 +430,7 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
     ++counters_.delayed_sampling_starts;
   }
   JointGaussian& g = p.joint;
-  joint_backup_ = g;
+  const PoseGaussian before = g.pose();
   g.begin_frame();
   const std::size_t n = detections.size();
   decision_.assign(n, Decision::kNew);
@@ -470,18 +470,28 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
       }
       continue;
     }
+    if (!apply_observation(g, fit)) {
+      // Numerical breakdown: the observation is dropped and the particle goes
+      // back to plain FastSLAM 2.0 after this frame.
+      ++counters_.joint_breakdowns;
+      decision_[k] = Decision::kInvalid;
+      end_joint = true;
+      continue;
+    }
     decision_[k] = Decision::kUsed;
     log_w += fit.log_likelihood;
-    apply_observation(g, fit);
   }
   g.end_frame();
   if (!g.healthy()) {
-    // Numerical breakdown: the frame is dropped for this particle, which goes
-    // back to plain FastSLAM 2.0 from its state before the frame.
-    g = joint_backup_;
+    // A breakdown no single update showed (a first sighting from a wild pose):
+    // the frame is dropped for this particle, which goes on in plain FastSLAM
+    // 2.0 from its pose before the frame and the map's marginals (this frame
+    // has not written to the map yet).
+    ++counters_.joint_breakdowns;
     decision_.assign(n, Decision::kInvalid);
-    p.pose = g.pose();
-    finish_joint(p);
+    g.clear();
+    p.pose.mean = sample_pose(before, rng_);
+    p.pose.cov.setZero();
     return;
   }
   for (std::size_t k = 0; k < n; ++k) {
@@ -576,6 +586,8 @@ void FastSlam2::set_prior_map(const std::vector<LandmarkEstimate>& landmarks) {
   }
   // The prior map is in the output frame: the particles' frame is that frame now.
   anchors_.clear();
+  frame_ = FrameUncertainty();
+  frame_.pinned = true;  // the prior map's own uncertainty is in its landmarks
   output_rotation_rad_ = 0.0;
   output_translation_m_.setZero();
 }
@@ -588,7 +600,35 @@ std::size_t FastSlam2::best_index() const {
   return best;
 }
 
+// The smallest covariance (in the positive semi-definite order) at least `a`
+// that is also at least `b`'s excess over it: a + positive part of (b - a).
+Eigen::Matrix3d psd_max(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(b - a);
+  const Eigen::Vector3d positive = eig.eigenvalues().cwiseMax(0.0);
+  if (positive.isZero(0.0)) return a;
+  return a + eig.eigenvectors() * positive.asDiagonal() * eig.eigenvectors().transpose();
+}
+
 PoseEstimate FastSlam2::pose_estimate() const {
+  PoseEstimate e = particle_frame_estimate();
+  if (frame_.started) {
+    // The frame's covariance moved from its pivot to the current position: a
+    // frame rotation d theta moves the pose by d theta x (p - pivot).
+    Eigen::Matrix3d j = Eigen::Matrix3d::Identity();
+    j(0, 2) = -(e.mean.y() - frame_.pivot.y());
+    j(1, 2) = e.mean.x() - frame_.pivot.x();
+    e.cov = psd_max(e.cov, j * frame_.cov * j.transpose());
+  }
+  e.best = to_output(e.best);
+  e.mean = to_output(e.mean);
+  Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
+  r.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(output_rotation_rad_).toRotationMatrix();
+  e.cov = r * e.cov * r.transpose();
+  return e;
+}
+
+PoseEstimate FastSlam2::particle_frame_estimate() const {
   // From the particle moments of the last frame (refresh_caches) and the
   // odometry since (pending_): a particle's position is x_i + R_i delta, its
   // heading theta_i + rotation, so every sum over the particles expands into
@@ -631,11 +671,7 @@ PoseEstimate FastSlam2::pose_estimate() const {
   fpf(1, 0) += off;
   e.cov += fpf;
   if (!pending_.empty()) e.cov += pending_.mean_noise(m.c, m.s, m.cc, m.ss, m.cs);
-  e.best = to_output(particle_pose(m.best));
-  e.mean = to_output(e.mean);
-  Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
-  r.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(output_rotation_rad_).toRotationMatrix();
-  e.cov = r * e.cov * r.transpose();
+  e.best = particle_pose(m.best);
   return e;
 }
 
@@ -679,7 +715,48 @@ void FastSlam2::mean_positions(const std::vector<std::uint32_t>& slots, std::vec
   }
 }
 
+bool FastSlam2::frame_pinned(std::vector<std::uint32_t>* anchor_slots) const {
+  const AnchorFrameOptions& a = options_.anchor_frame;
+  // Candidates: the first landmarks the best particle has seen often enough.
+  std::vector<std::uint32_t> slots;
+  particles_[best_index()].map.for_each([&](std::uint32_t slot, const Landmark& lm) {
+    if (lm.times_observed >= static_cast<std::uint32_t>(a.min_observations)) slots.push_back(slot);
+  });
+  std::sort(slots.begin(), slots.end());
+  if (slots.size() > kMaxAnchors) slots.resize(kMaxAnchors);
+  if (slots.size() < static_cast<std::size_t>(a.min_landmarks)) return false;
+  std::vector<Eigen::Vector2d> means;
+  std::vector<bool> found;
+  mean_positions(slots, means, found);
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& m : means) centroid += m;
+  centroid /= static_cast<double>(means.size());
+  double spread2 = 0.0;
+  for (const Eigen::Vector2d& m : means) spread2 += (m - centroid).squaredNorm();
+  if (spread2 / static_cast<double>(means.size()) < a.min_spread_m * a.min_spread_m) return false;
+  if (anchor_slots != nullptr) *anchor_slots = std::move(slots);
+  return true;
+}
+
+void FastSlam2::track_frame_uncertainty() {
+  // With maximum-likelihood association the first landmarks are not the same
+  // poles in every particle; a prior map (set_prior_map) gives the frame.
+  if (!options_.frame_uncertainty || frame_.pinned || options_.association != Association::kKnownId) return;
+  if (!frame_.started) {
+    if (particles_[best_index()].map.size() == 0) return;
+    frame_.started = true;
+    frame_.pivot = particle_frame_estimate().mean.head<2>();
+  }
+  const PoseEstimate e = particle_frame_estimate();
+  Eigen::Matrix3d j = Eigen::Matrix3d::Identity();  // from the current position back to the pivot
+  j(0, 2) = e.mean.y() - frame_.pivot.y();
+  j(1, 2) = -(e.mean.x() - frame_.pivot.x());
+  frame_.cov = psd_max(frame_.cov, j * e.cov * j.transpose());
+  frame_.pinned = frame_pinned(nullptr);
+}
+
 void FastSlam2::update_output_frame() {
+  track_frame_uncertainty();
   const AnchorFrameOptions& a = options_.anchor_frame;
   // With maximum-likelihood association a slot is not the same pole in every
   // particle, so its mean over the particles is no anchor.
@@ -687,21 +764,9 @@ void FastSlam2::update_output_frame() {
   std::vector<Eigen::Vector2d> means;
   std::vector<bool> found;
   if (anchors_.empty()) {
-    // Candidates: the first landmarks the best particle has seen often enough.
     std::vector<std::uint32_t> slots;
-    particles_[best_index()].map.for_each([&](std::uint32_t slot, const Landmark& lm) {
-      if (lm.times_observed >= static_cast<std::uint32_t>(a.min_observations)) slots.push_back(slot);
-    });
-    std::sort(slots.begin(), slots.end());
-    if (slots.size() > kMaxAnchors) slots.resize(kMaxAnchors);
-    if (slots.size() < static_cast<std::size_t>(a.min_landmarks)) return;
+    if (!frame_pinned(&slots)) return;
     mean_positions(slots, means, found);
-    Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
-    for (const Eigen::Vector2d& m : means) centroid += m;
-    centroid /= static_cast<double>(means.size());
-    double spread2 = 0.0;
-    for (const Eigen::Vector2d& m : means) spread2 += (m - centroid).squaredNorm();
-    if (spread2 / static_cast<double>(means.size()) < a.min_spread_m * a.min_spread_m) return;
     // Until anchored the output frame is the particles' frame.
     for (std::size_t k = 0; k < slots.size(); ++k) anchors_.push_back({slots[k], means[k]});
     return;

@@ -1,6 +1,7 @@
 #include "pixyslam/slam/joint_gaussian.h"
 
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -16,12 +17,6 @@ constexpr double kMinLandmarkVariance = 1e-10;  // (10 um)^2
 constexpr double kMaxVariance = 1e6;
 // A frame correction beyond this is not folded back into the motion Jacobian.
 constexpr double kRelineariseDistance = 0.25;  // m
-
-void symmetrise(Eigen::MatrixXd& m) {
-  for (Eigen::Index c = 1; c < m.cols(); ++c) {
-    for (Eigen::Index r = 0; r < c; ++r) m(r, c) = m(c, r) = 0.5 * (m(r, c) + m(c, r));
-  }
-}
 
 // Grows the state by one landmark block, zero-filled; returns its index.
 int append_block(JointGaussian& g, std::uint32_t slot) {
@@ -39,8 +34,10 @@ int append_block(JointGaussian& g, std::uint32_t slot) {
 }  // namespace
 
 bool JointGaussian::healthy() const {
-  // A NaN or infinity anywhere makes the sum non-finite.
-  if (!std::isfinite(mean.sum()) || !std::isfinite(cov.sum())) return false;
+  // A NaN or infinity in the mean or on the diagonal makes its sum non-finite.
+  // Off the diagonal a covariance is bounded by its variances, and an update
+  // that makes an entry non-finite makes its row's variance non-finite too.
+  if (!std::isfinite(mean.sum()) || !std::isfinite(cov.diagonal().sum())) return false;
   for (Eigen::Index i = 0; i < cov.rows(); ++i) {
     if (cov(i, i) < 0.0 || cov(i, i) > kMaxVariance) return false;
   }
@@ -81,11 +78,12 @@ void JointGaussian::end_frame() {
   // pose: inflating by a metre-sized correction would wreck the covariance.
   const Eigen::Vector2d c = mean.head<2>() - frame_pose.head<2>();
   if (c.norm() > kRelineariseDistance) return;
-  Eigen::Matrix3d fc = Eigen::Matrix3d::Identity();
-  fc(0, 2) = -c.y();
-  fc(1, 2) = c.x();
-  cov.topRows<3>() = (fc * cov.topRows<3>()).eval();
-  cov.leftCols<3>() = (cov.leftCols<3>() * fc.transpose()).eval();
+  // Fc P Fc^T in place: rows 0 and 1 gain multiples of row 2, then the same
+  // for the columns.
+  cov.row(0) -= c.y() * cov.row(2);
+  cov.row(1) += c.x() * cov.row(2);
+  cov.col(0) -= c.y() * cov.col(2);
+  cov.col(1) += c.x() * cov.col(2);
 }
 
 void JointGaussian::propagate(double v_mps, double w_radps, double dt_s, const MotionNoise& noise) {
@@ -164,23 +162,38 @@ JointFit fit_observation(const JointGaussian& g, int index, const Eigen::Vector2
   return fit;
 }
 
-void apply_observation(JointGaussian& g, const JointFit& fit) {
+bool apply_observation(JointGaussian& g, const JointFit& fit) {
   const Eigen::Index j = 3 + 2 * fit.index;
+  const Eigen::Index n = g.cov.rows();
+  // Scratch without an allocation per update: P H^T, K and K nu.
+  thread_local std::vector<double> scratch;
+  scratch.resize(static_cast<std::size_t>(5 * n));
+  using Columns2 = Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 2>>;
+  Columns2 pht(scratch.data(), n, 2);
+  Columns2 k(scratch.data() + 2 * n, n, 2);
+  Eigen::Map<Eigen::VectorXd> step(scratch.data() + 4 * n, n);
   // P H^T touches only the pose and landmark columns of H.
-  using Columns2 = Eigen::Matrix<double, Eigen::Dynamic, 2>;
-  const Columns2 pht =
-      g.cov.leftCols<3>() * fit.h_pose.transpose() + g.cov.middleCols<2>(j) * fit.h_landmark.transpose();
-  const Columns2 k = pht * fit.s.inverse();
-  g.mean.noalias() += k * fit.innovation;
+  pht.noalias() = g.cov.leftCols<3>() * fit.h_pose.transpose();
+  pht.noalias() += g.cov.middleCols<2>(j) * fit.h_landmark.transpose();
+  k.noalias() = pht * fit.s.inverse();
+  step.noalias() = k * fit.innovation;
+  // Checked before anything changes (O(n)): the state after the update must be
+  // healthy() (finite, variances in [0, kMaxVariance]).
+  if (!std::isfinite(step.sum()) || !std::isfinite(k.sum())) return false;
+  for (Eigen::Index r = 0; r < n; ++r) {
+    const double v = g.cov(r, r) - (k(r, 0) * pht(r, 0) + k(r, 1) * pht(r, 1));
+    if (!(v >= 0.0 && v <= kMaxVariance)) return false;
+  }
+  g.mean += step;
   g.mean(2) = wrap_angle(g.mean(2));
   // P -= K (P H^T)^T: a symmetric rank-2 update, computed on the lower
   // triangle and mirrored (keeps P exactly symmetric).
-  const Eigen::Index n = g.cov.rows();
   for (Eigen::Index c = 0; c < n; ++c) {
     const double p0 = pht(c, 0), p1 = pht(c, 1);
     for (Eigen::Index r = c; r < n; ++r) g.cov(r, c) -= k(r, 0) * p0 + k(r, 1) * p1;
   }
   g.cov.triangularView<Eigen::StrictlyUpper>() = g.cov.transpose();
+  return true;
 }
 
 std::vector<ConditionedLandmark> condition_on_pose(const JointGaussian& g, const Pose2& pose) {

@@ -74,6 +74,11 @@ FilterOptions read_filter_options(config::YamlReader& f) {
     af.min_spread_m = a.number("min_spread_m", 1e-3, 1000.0, af.min_spread_m);
     a.finish();
   }
+  if (f.has("frame_uncertainty")) {
+    config::YamlReader u = f.child("frame_uncertainty");
+    o.frame_uncertainty = u.boolean("enabled", o.frame_uncertainty);
+    u.finish();
+  }
   f.finish();
   try {
     validate(o);

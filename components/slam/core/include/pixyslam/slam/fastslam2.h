@@ -60,6 +60,7 @@ struct FilterCounters {
   std::uint64_t observations_invalid = 0;
   std::uint64_t resamples = 0;
   std::uint64_t delayed_sampling_starts = 0;  // particle-frames that began a joint state
+  std::uint64_t joint_breakdowns = 0;  // joint-state updates refused as numerically broken
 };
 
 // FastSLAM 2.0 (Montemerlo, Thrun, Koller, Wegbreit 2003) with known data
@@ -150,6 +151,12 @@ class FastSlam2 {
   // Anchors the output frame once the first landmarks pin it, then keeps the
   // output transform up to date (AnchorFrameOptions).
   void update_output_frame();
+  // FilterOptions::frame_uncertainty: the frame covariance from the first
+  // mapped landmark until the frame is pinned.
+  void track_frame_uncertainty();
+  bool frame_pinned(std::vector<std::uint32_t>* slots) const;
+  // The pose estimate in the particles' frame (before to_output).
+  PoseEstimate particle_frame_estimate() const;
   // Weighted mean position of each slot over the particles that map it; false
   // where no particle does.
   void mean_positions(const std::vector<std::uint32_t>& slots, std::vector<Eigen::Vector2d>& means,
@@ -180,13 +187,18 @@ class FastSlam2 {
     std::size_t best = 0;
   };
   Moments moments_;
-  JointGaussian joint_backup_;  // state before a joint update, restored on breakdown
 
   struct Anchor {
     std::uint32_t slot;
     Eigen::Vector2d position;  // in the output frame, fixed when anchored
   };
   std::vector<Anchor> anchors_;
+  struct FrameUncertainty {
+    bool started = false, pinned = false;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();  // pose covariance, pivot at `pivot`
+    Eigen::Vector2d pivot = Eigen::Vector2d::Zero();
+  };
+  FrameUncertainty frame_;
   double output_rotation_rad_ = 0.0;
   Eigen::Vector2d output_translation_m_ = Eigen::Vector2d::Zero();
 

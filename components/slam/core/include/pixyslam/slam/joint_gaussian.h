@@ -77,8 +77,9 @@ struct JointFit {
   double log_likelihood = 0.0;
 };
 JointFit fit_observation(const JointGaussian& g, int index, const Eigen::Vector2d& z, const Eigen::Matrix2d& r);
-// EKF update with a fit: K = P H^T S^-1, mean += K nu, P -= K S K^T.
-void apply_observation(JointGaussian& g, const JointFit& fit);
+// EKF update with a fit: K = P H^T S^-1, mean += K nu, P -= K S K^T. Returns
+// false and leaves g unchanged when the result would not be healthy().
+[[nodiscard]] bool apply_observation(JointGaussian& g, const JointFit& fit);
 
 // The landmarks given a pose drawn from the state's pose marginal: mean_i +
 // P_ix Pxx^-1 (x - mean_x), covariance P_ii - P_ix Pxx^-1 P_xi. The landmarks'

@@ -97,6 +97,14 @@ struct FilterOptions {
   double resample_neff_fraction = 0.667;
   DelayedSamplingOptions delayed_sampling;
   AnchorFrameOptions anchor_frame;
+  // The map's frame (where the map is and how it is turned in the world) is
+  // only as good as the pose when the first landmarks were mapped: later
+  // observations are relative and cannot reduce that uncertainty, but
+  // resampling loses it from the particle spread. When enabled, the output pose
+  // covariance never falls below the pose covariance from the first mapped
+  // landmark until the frame is pinned (anchor_frame's thresholds), moved to the
+  // current position. The estimates themselves are unchanged.
+  bool frame_uncertainty = false;
 };
 
 void validate(const FilterOptions& options);
