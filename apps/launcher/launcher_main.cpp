@@ -7,7 +7,10 @@
 // With a deployment, only the host's share of the processes runs, with the
 // deployment's DDS settings, and DDS liveliness of every process on the
 // domain is reported ([health] lines; docs/deployment.md).
+// SIGINT, SIGTERM and SIGHUP stop the run in order; the children get SIGTERM
+// from the kernel if the launcher dies any other way (SIGKILL).
 // Exit code 0 only if every process ended cleanly.
+#include <signal.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -177,6 +180,9 @@ int run(const std::string& launch_file, const app::CommandLine& args) {
 
 int main(int argc, char** argv) {
   app::StopSignal::install();
+  // Output to a closed terminal or SSH pipe must not kill the launcher before
+  // it has stopped its children (they get the default back).
+  signal(SIGPIPE, SIG_IGN);
   try {
     if (argc < 2 || argv[1][0] == '-') {
       std::fprintf(stderr,

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -10,6 +11,8 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <thread>
 
@@ -33,11 +36,50 @@ struct ProcessGroup::Child {
 };
 
 ProcessGroup::ProcessGroup(std::string bin_dir, std::FILE* out)
-    : bin_dir_(std::move(bin_dir)), out_(out) {}
+    : bin_dir_(std::move(bin_dir)), out_(out) {
+  // Descendants orphaned while the group runs (a child's child that left its
+  // session with setsid) are re-parented here instead of to init: stop_all()
+  // finds and stops them.
+  prctl(PR_SET_CHILD_SUBREAPER, 1);
+}
+
+namespace {
+
+// A signal to a child's process group, and to the child itself if it left the
+// group (setsid): each process gets it once.
+void signal_child(pid_t pid, int signal_number) {
+  if (getpgid(pid) != pid) kill(pid, signal_number);
+  kill(-pid, signal_number);
+}
+
+// Processes whose parent is this one: our children and adopted orphans.
+std::vector<pid_t> own_children() {
+  std::vector<pid_t> out;
+  std::error_code error;
+  const pid_t self = getpid();
+  for (const auto& entry : std::filesystem::directory_iterator("/proc", error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream stat(entry.path() / "stat");
+    std::string line;
+    if (!std::getline(stat, line)) continue;
+    // pid (comm) state ppid ...: comm may hold spaces and parentheses.
+    const std::size_t close = line.rfind(')');
+    if (close == std::string::npos) continue;
+    char state = 0;
+    long ppid = 0;
+    if (std::sscanf(line.c_str() + close + 1, " %c %ld", &state, &ppid) == 2 && ppid == self && state != 'Z') {
+      out.push_back(static_cast<pid_t>(std::stol(name)));
+    }
+  }
+  return out;
+}
+
+}  // namespace
 
 ProcessGroup::~ProcessGroup() {
   for (auto& child : children_) {
-    if (child->running) kill(-child->pid, SIGKILL);
+    if (child->running) signal_child(child->pid, SIGKILL);
   }
   for (auto& child : children_) {
     if (child->running) waitpid(child->pid, nullptr, 0);
@@ -74,17 +116,26 @@ void ProcessGroup::start(const ProcessSpec& spec) {
   for (const std::string& word : spec.command) argv.push_back(const_cast<char*>(word.c_str()));
   argv.push_back(nullptr);
 
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
   if (pid == 0) {
     // Child: own process group (a terminal's Ctrl-C reaches only the launcher,
-    // which stops the children in order), output into the pipe, signals unblocked.
+    // which stops the children in order), output into the pipe, signals
+    // unblocked and at their defaults (a launcher started with & from a script
+    // ignores SIGINT, and exec would pass that on), and SIGTERM when the
+    // launcher dies, whatever kills it (kept across setsid and exec).
     setpgid(0, 0);
     dup2(fds[1], STDOUT_FILENO);
     dup2(fds[1], STDERR_FILENO);
+    for (int number = 1; number < NSIG; ++number) {
+      if (number != SIGKILL && number != SIGSTOP) signal(number, SIG_DFL);
+    }
     sigset_t none;
     sigemptyset(&none);
     sigprocmask(SIG_SETMASK, &none, nullptr);
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(128 + SIGTERM);  // the launcher died before prctl
     for (const auto& [name, value] : spec.environment) setenv(name.c_str(), value.c_str(), 1);
     execv(program.c_str(), argv.data());
     std::fprintf(stderr, "cannot execute %s: %s\n", program.c_str(), std::strerror(errno));
@@ -129,15 +180,18 @@ void ProcessGroup::drain(Child& child, bool final) {
 }
 
 void ProcessGroup::reap() {
-  for (auto& child : children_) {
-    if (!child->running) continue;
+  // Any child: ours, or an orphan adopted as subreaper (its status is not ours).
+  for (;;) {
     int status = 0;
-    const pid_t r = waitpid(child->pid, &status, WNOHANG);
-    if (r != child->pid) continue;
-    child->running = false;
-    child->status.exited = WIFEXITED(status);
-    child->status.code = WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status);
-    drain(*child, true);
+    const pid_t r = waitpid(-1, &status, WNOHANG);
+    if (r <= 0) break;
+    for (auto& child : children_) {
+      if (!child->running || child->pid != r) continue;
+      child->running = false;
+      child->status.exited = WIFEXITED(status);
+      child->status.code = WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status);
+      drain(*child, true);
+    }
   }
 }
 
@@ -169,16 +223,40 @@ void ProcessGroup::stop_all(std::chrono::milliseconds timeout) {
     Child& child = **it;
     if (!child.running) continue;
     child.status.stopped_by_us = true;
-    kill(-child.pid, SIGINT);
+    signal_child(child.pid, SIGINT);
     const auto end = std::chrono::steady_clock::now() + timeout;
     while (child.running && std::chrono::steady_clock::now() < end) poll(std::chrono::milliseconds(20));
     if (child.running) {
       std::fprintf(out_, "[launch] %s did not stop within %.1f s: SIGKILL\n", child.spec.name.c_str(),
                    static_cast<double>(timeout.count()) / 1000.0);
-      kill(-child.pid, SIGKILL);
+      signal_child(child.pid, SIGKILL);
       while (child.running) poll(std::chrono::milliseconds(20));
     }
   }
+  stop_adopted(timeout);
+}
+
+void ProcessGroup::stop_adopted(std::chrono::milliseconds timeout) {
+  std::vector<pid_t> left;
+  for (pid_t pid : own_children()) {
+    bool ours = false;
+    for (const auto& child : children_) ours = ours || (child->running && child->pid == pid);
+    if (!ours) left.push_back(pid);
+  }
+  if (left.empty()) return;
+  std::fprintf(out_, "[launch] stopping %zu process(es) left behind by the children\n", left.size());
+  std::fflush(out_);
+  for (pid_t pid : left) kill(pid, SIGTERM);
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < end) {
+    reap();
+    bool alive = false;
+    for (pid_t pid : left) alive = alive || kill(pid, 0) == 0;
+    if (!alive) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  for (pid_t pid : left) kill(pid, SIGKILL);
+  for (pid_t pid : left) waitpid(pid, nullptr, 0);
 }
 
 bool ProcessGroup::running(std::size_t i) const { return children_.at(i)->running; }

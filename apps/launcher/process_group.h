@@ -23,9 +23,13 @@ struct ExitStatus {
 };
 
 // Child processes with their output (stdout and stderr) forwarded line by line
-// to `out` as "[name] line". Each child runs in its own process group; stop()
-// sends SIGINT, waits up to a timeout, then SIGKILL. The destructor kills and
-// reaps whatever is left. Not thread-safe: one thread drives it.
+// to `out` as "[name] line". Each child runs in its own process group, with
+// default signal dispositions, and gets SIGTERM if the process that started it
+// dies (PR_SET_PDEATHSIG, whatever killed it). stop_all() sends SIGINT, waits
+// up to a timeout, then SIGKILL; then it stops the descendants the children
+// left behind (this process is their subreaper). The destructor kills and
+// reaps whatever is left. Not thread-safe: one thread drives it; it reaps every
+// child of the process (waitpid(-1)).
 class ProcessGroup {
  public:
   ProcessGroup(std::string bin_dir, std::FILE* out);
@@ -53,6 +57,7 @@ class ProcessGroup {
   std::string resolve(const std::string& program) const;
   void drain(Child& child, bool final);
   void reap();
+  void stop_adopted(std::chrono::milliseconds timeout);
 
   std::string bin_dir_;
   std::FILE* out_;

@@ -39,6 +39,11 @@ void StopSignal::install() {
     sigemptyset(&set);
     sigaddset(&set, SIGINT);
     sigaddset(&set, SIGTERM);
+    // A closed terminal or SSH session (SIGHUP) stops like Ctrl-C, unless the
+    // process was started to ignore it (nohup): a blocked signal is never
+    // discarded, so sigwait would see it.
+    struct sigaction hup {};
+    if (sigaction(SIGHUP, nullptr, &hup) != 0 || hup.sa_handler != SIG_IGN) sigaddset(&set, SIGHUP);
     pthread_sigmask(SIG_BLOCK, &set, nullptr);
     std::thread([set] {
       for (;;) {

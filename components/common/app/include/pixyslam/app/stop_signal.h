@@ -4,7 +4,8 @@
 
 namespace pixyslam::app {
 
-// SIGINT/SIGTERM as a flag a process can wait on. install() blocks the two
+// SIGINT/SIGTERM/SIGHUP as a flag a process can wait on (SIGHUP only when it
+// is not ignored at install(), as under nohup). install() blocks the
 // signals in the calling thread (call it first in main, before any thread
 // starts, so every thread inherits the mask) and starts a watcher thread that
 // sigwait()s for them. Process-wide; thread-safe after install().
@@ -18,7 +19,7 @@ class StopSignal {
   static void request();
   // The signal that requested the stop (0 if none or request()).
   static int signal_number();
-  // How many SIGINT/SIGTERM arrived so far (a second one can mean "really stop").
+  // How many stop signals arrived so far (a second one can mean "really stop").
   static int signal_count();
 };
 
