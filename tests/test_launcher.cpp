@@ -58,6 +58,29 @@ TEST(LaunchPlan, ErrorsNameFileAndKey) {
   std::remove(path.c_str());
 }
 
+TEST(LaunchPlan, RolesAreEssentialByDefaultAndCheckedByName) {
+  const std::string path = write_temp(
+      "launch:\n  processes:\n    - {name: a, command: [p]}\n    - {name: b, command: [q], role: optional}\n"
+      "    - {name: c, command: [r], role: essential}\n");
+  const LaunchPlan plan = read_launch_plan(path, {});
+  std::remove(path.c_str());
+  ASSERT_EQ(plan.processes.size(), 3u);
+  EXPECT_FALSE(plan.processes[0].optional);
+  EXPECT_TRUE(plan.processes[1].optional);
+  EXPECT_FALSE(plan.processes[2].optional);
+  for (const char* bad : {"role: spare", "role: optional, ends_run: true"}) {
+    const std::string file =
+        write_temp(std::string("launch:\n  processes:\n    - {name: a, command: [p], ") + bad + "}\n");
+    try {
+      read_launch_plan(file, {});
+      ADD_FAILURE() << "expected an error for " << bad;
+    } catch (const config::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("launch.processes[0].role"), std::string::npos) << e.what();
+    }
+    std::remove(file.c_str());
+  }
+}
+
 TEST(LaunchPlan, UnknownVariableAndDuplicateNameAreErrors) {
   const std::string unknown = write_temp("launch:\n  processes:\n    - name: a\n      command: ['${nope}']\n");
   EXPECT_THROW(read_launch_plan(unknown, {}), config::ConfigError);

@@ -1,6 +1,8 @@
 // The logger: sequence analysis (pure), CDR payloads, options from YAML, and a
 // LoggerNode on the shipped loopback profile recording what writers in this
 // test publish, read back with McapReader.
+#include <signal.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -8,6 +10,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <string>
@@ -792,6 +795,100 @@ TEST(LoggerNode, RotatesByPeriod) {
   EXPECT_LE(files.size(), 4u);
   expect_complete_rotation(files, c, 1, kCount);
   remove_rotated(base.path());
+}
+
+// A full disk, simulated per file with RLIMIT_FSIZE (a write past the limit
+// fails with EFBIG like one on a full disk with ENOSPC): each file fails at the
+// limit. The logger keeps every file as written (readable up to its last
+// complete chunk), drops and counts samples while it has no file, opens a new
+// file every retry_period_s alternating with fallback_dir, and never stops.
+TEST(LoggerNode, WriteFailuresKeepTheFileAndRecordingGoesOnInANewOne) {
+  const TempFile base("test_logger_full_disk");
+  const std::filesystem::path fallback =
+      std::filesystem::temp_directory_path() / ("test_logger_fallback_" + std::to_string(getpid()));
+  std::filesystem::remove_all(fallback);
+  std::filesystem::create_directories(fallback);
+  LoggerOptions options = node_options(base.path());
+  options.topics = {"pixyslam/odometry"};
+  options.compression = logger::McapCompression::kNone;
+  options.flush_period_s = 0.05;
+  options.retry_period_s = 0.2;
+  options.fallback_dir = fallback.string();
+  dds::Participant robot(loopback_options(), "test_robot");
+  dds::Writer<msg::Odometry> writer(robot);
+  LoggerNode node(options);
+  node.start();
+  ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(10)));
+
+  constexpr rlim_t kFileLimit = 48 * 1024;
+  rlimit before{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &before), 0);
+  const auto old_handler = signal(SIGXFSZ, SIG_IGN);
+  rlimit limited = before;
+  limited.rlim_cur = kFileLimit;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limited), 0);
+  constexpr int kCount = 1500;
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < kCount; ++i) {
+    std::this_thread::sleep_until(start + std::chrono::microseconds(1000 * i));
+    msg::Odometry m = odometry(i);
+    ASSERT_TRUE(writer.publish(m));
+  }
+  const bool all_received =
+      wait_until([&] { return received(node, "pixyslam/odometry") == kCount; }, std::chrono::seconds(20));
+  EXPECT_FALSE(node.failed());  // still recording, or about to retry
+  node.stop();
+  setrlimit(RLIMIT_FSIZE, &before);
+  signal(SIGXFSZ, old_handler);
+  ASSERT_TRUE(all_received) << node.counters_text();
+
+  const LoggerCounters c = node.counters();
+  EXPECT_TRUE(c.error.empty()) << c.error;
+  EXPECT_GE(c.write_failures, 2u) << c.last_write_error;
+  EXPECT_EQ(c.topics[0].written + c.topics[0].dropped, static_cast<std::uint64_t>(kCount));
+  ASSERT_GE(c.files.size(), 3u);
+  std::size_t in_fallback = 0;
+  std::vector<std::uint64_t> seqs;
+  for (const LoggedFile& f : c.files) {
+    if (std::filesystem::path(f.path).parent_path() == fallback) ++in_fallback;
+    const logger::McapReader reader(f.path);
+    EXPECT_GT(reader.messages().size(), 0u) << f.path << "\n" << reader.diagnostics_text();
+    if (!f.closed) {
+      EXPECT_FALSE(reader.recovery().footer_present) << f.path;
+    }
+    for (const logger::McapMessage& m : reader.messages()) seqs.push_back(m.sequence);
+  }
+  EXPECT_GE(in_fallback, 1u);
+  EXPECT_LT(in_fallback, c.files.size());
+  // In order across the files, nothing twice, and most of what was sent.
+  EXPECT_TRUE(std::is_sorted(seqs.begin(), seqs.end()));
+  EXPECT_EQ(std::adjacent_find(seqs.begin(), seqs.end()), seqs.end());
+  EXPECT_GE(seqs.size(), static_cast<std::size_t>(kCount) / 2) << node.counters_text();
+  for (const LoggedFile& f : c.files) std::filesystem::remove(f.path);
+  std::filesystem::remove_all(fallback);
+}
+
+// A restarted logger (the launcher restarts an optional process) or a reused
+// folder: the recording already there is kept, the next free name written.
+TEST(LoggerNode, AnExistingRecordingIsNeverOverwritten) {
+  const TempFile base("test_logger_existing");
+  const std::string first_restart = rotated_file_name(base.path(), 1);
+  std::filesystem::remove(first_restart);
+  { std::ofstream(base.path()) << "earlier recording"; }
+  {
+    LoggerOptions options = node_options(base.path());
+    options.topics = {"pixyslam/odometry"};
+    LoggerNode node(options);
+    node.stop();
+    ASSERT_EQ(node.counters().files.size(), 1u);
+    EXPECT_EQ(node.counters().files[0].path, first_restart);
+  }
+  std::ifstream kept(base.path());
+  std::string text;
+  std::getline(kept, text);
+  EXPECT_EQ(text, "earlier recording");
+  EXPECT_TRUE(logger::McapReader(first_restart).clean());
+  std::filesystem::remove(first_restart);
 }
 
 TEST(LoggerNode, BadTopicPatternIsAnError) {

@@ -51,6 +51,12 @@ std::vector<ProcessSpec> read_processes(config::YamlReader& launch, const std::s
     if (p.command.empty()) item.fail("command", "must list the program and its arguments");
     p.delay_s = item.number("delay_s", 0.0, 600.0, 0.0);
     p.ends_run = item.boolean("ends_run", false);
+    const std::string role = item.text("role", "essential");
+    if (role != "essential" && role != "optional") {
+      item.fail("role", "'" + role + "' is not a role (essential | optional)");
+    }
+    p.optional = role == "optional";
+    if (p.optional && p.ends_run) item.fail("role", "an optional process cannot end the run (ends_run)");
     item.finish();
     out.push_back(std::move(p));
   }

@@ -9,10 +9,13 @@
 // domain is reported ([health] lines; docs/deployment.md).
 // SIGINT, SIGTERM and SIGHUP stop the run in order; the children get SIGTERM
 // from the kernel if the launcher dies any other way (SIGKILL).
-// Exit code 0 only if every process ended cleanly.
+// A process with `role: optional` that fails is restarted with back-off (1, 2,
+// 4, ... 30 s) while the run goes on; an essential one stops the run.
+// Exit code 0 only if every process ended cleanly (optional ones included).
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -60,22 +63,64 @@ void print_health() {
   std::fflush(stdout);
 }
 
+// Optional processes that failed, waiting for their restart.
+struct Restart {
+  launcher::ProcessSpec spec;
+  Clock::time_point at;
+};
+std::vector<Restart> restarts;
+std::map<std::string, int> failures;  // per optional process name
+
+// Back-off before restart n (1, 2, ...): 1, 2, 4, ... 30 s.
+double restart_delay_s(int n) { return std::min(30.0, static_cast<double>(1 << std::min(n - 1, 5))); }
+
+void start_due_restarts(launcher::ProcessGroup& group) {
+  for (auto it = restarts.begin(); it != restarts.end();) {
+    if (Clock::now() < it->at) {
+      ++it;
+      continue;
+    }
+    std::printf("[launch] restarting %s (restart %d)\n", it->spec.name.c_str(), failures[it->spec.name]);
+    try {
+      group.start(it->spec);
+    } catch (const std::exception& e) {
+      std::printf("[launch] %s: %s\n", it->spec.name.c_str(), e.what());
+    }
+    it = restarts.erase(it);
+  }
+}
+
 bool supervise(launcher::ProcessGroup& group, Clock::time_point until, bool& failed, bool& finished) {
   while (Clock::now() < until) {
     print_health();
     for (std::size_t i : group.poll(std::chrono::milliseconds(100))) {
       const launcher::ExitStatus& status = group.status(i);
-      std::printf("[launch] %s ended: %s\n", group.spec(i).name.c_str(), status.describe().c_str());
+      const launcher::ProcessSpec& spec = group.spec(i);
+      std::printf("[launch] %s ended: %s\n", spec.name.c_str(), status.describe().c_str());
+      if (!status.ok() && spec.optional && status.exited && status.code == 2) {
+        std::printf("[launch] %s is optional: the run goes on; not restarted (exit code 2: a usage or "
+                    "configuration error)\n", spec.name.c_str());
+        continue;
+      }
+      if (!status.ok() && spec.optional && !app::StopSignal::requested()) {
+        const int n = ++failures[spec.name];
+        const double delay = restart_delay_s(n);
+        std::printf("[launch] %s is optional: the run goes on; restart in %.0f s\n", spec.name.c_str(), delay);
+        restarts.push_back({spec, Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                     std::chrono::duration<double>(delay))});
+        continue;
+      }
       if (!status.ok()) {
         failed = true;
         return false;
       }
-      if (group.spec(i).ends_run) {
+      if (spec.ends_run) {
         finished = true;
         return false;
       }
     }
     if (app::StopSignal::requested()) return false;
+    start_due_restarts(group);
   }
   return true;
 }
@@ -164,8 +209,9 @@ int run(const std::string& launch_file, const app::CommandLine& args) {
   std::printf("[launch] summary:\n");
   for (std::size_t i = 0; i < group.size(); ++i) {
     const launcher::ExitStatus& status = group.status(i);
-    std::printf("[launch]   %-16s %s%s\n", group.spec(i).name.c_str(), status.describe().c_str(),
-                status.ok() ? "" : "  <- FAILED");
+    const launcher::ProcessSpec& spec = group.spec(i);
+    std::printf("[launch]   %-16s %s%s%s\n", spec.name.c_str(), status.describe().c_str(),
+                status.ok() ? "" : "  <- FAILED", spec.optional && !status.ok() ? " (optional)" : "");
     if (!status.ok()) ++bad;
   }
   print_health();

@@ -5,8 +5,12 @@
 // configuration to stdout, logs to stderr; on a stop it drains what was
 // received, closes the file (summary and footer) and prints per-topic counts,
 // then one line per file: "logger: file PATH: M messages, C chunks, B bytes".
+// A write failure (disk full) does not stop it: the file so far is kept, the
+// samples are dropped and counted, and a new file is tried every
+// logger.retry_period_s (alternating with logger.fallback_dir).
 // Exit status: 0 after a clean stop, 2 for a configuration or command-line
-// error, 1 for any other failure (e.g. the file could not be written).
+// error, 1 for any other failure (the first file could not be created, or
+// samples were lost to write failures).
 #include <chrono>
 #include <cstdio>
 #include <exception>
@@ -74,6 +78,11 @@ int main(int argc, char** argv) {
                  c.queue_peak_bytes);
     if (!c.error.empty()) {
       std::fprintf(stderr, "logger: recording failed: %s\n", c.error.c_str());
+      return 1;
+    }
+    if (c.write_failures > 0) {
+      std::fprintf(stderr, "logger: %llu write failure(s), samples lost while not recording; last: %s\n",
+                   static_cast<unsigned long long>(c.write_failures), c.last_write_error.c_str());
       return 1;
     }
     std::fprintf(stderr, "logger: stopped (signal %d)\n", app::StopSignal::signal_number());

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <exception>
+#include <cstdio>
+#include <filesystem>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -81,7 +83,7 @@ LoggerNode::LoggerNode(const LoggerOptions& options) : options_(options) {
     counters.topic = name;
     topics_.push_back(counters);
   }
-  open_file(0);
+  open_first_file();
 
   participant_ = std::make_unique<dds::Participant>(options_.dds, "logger");
   for (std::size_t i = 0; i < options_.topics.size(); ++i) {
@@ -118,18 +120,45 @@ diagnostics::Snapshot LoggerNode::diagnostics_snapshot() const {
   s.counters.push_back({"files", c.files.size(), false});
   s.counters.push_back({"bytes_written", c.file.bytes_written, false});
   s.counters.push_back({"queue_peak_bytes", c.queue_peak_bytes, false});
-  s.error = c.error;
+  s.counters.push_back({"write_failures", c.write_failures, true});
+  s.error = !c.error.empty() ? c.error
+            : c.recording    ? std::string()
+                             : "not recording after a write failure (retrying): " + c.last_write_error;
   return s;
 }
 
-void LoggerNode::open_file(std::size_t index) {
+void LoggerNode::open_first_file() {
+  // An existing recording is never overwritten (a restarted logger, a reused
+  // run folder): the first free indexed name is taken instead.
+  const auto holds_data = [](const std::string& path) {
+    std::error_code error;
+    return std::filesystem::is_regular_file(path, error) && std::filesystem::file_size(path, error) > 0;
+  };
+  const bool rotating = rotation_enabled(options_);
+  if (!rotating && !holds_data(options_.output_file)) {
+    open_file(0);
+    return;
+  }
+  std::size_t index = rotating ? 0 : 1;
+  while (holds_data(rotated_file_name(options_.output_file, index))) ++index;
+  const std::string path = rotated_file_name(options_.output_file, index);
+  if (!rotating || index > 0) {
+    std::fprintf(stderr, "logger: WARN: %s already holds a recording: writing %s\n",
+                 (rotating ? rotated_file_name(options_.output_file, 0) : options_.output_file).c_str(), path.c_str());
+  }
+  open_file(index, path);
+}
+
+void LoggerNode::open_file(std::size_t index, const std::string& path_override) {
   logger::McapWriterOptions file;
   file.chunk_size_bytes = options_.chunk_size_bytes;
   file.compression = options_.compression;
   file.sync_after_chunk = options_.fsync;
-  const std::string path =
-      rotation_enabled(options_) ? rotated_file_name(options_.output_file, index) : options_.output_file;
+  const std::string path = !path_override.empty()       ? path_override
+                           : rotation_enabled(options_) ? rotated_file_name(options_.output_file, index)
+                                                        : options_.output_file;
   writer_.open(path, file);
+  file_given_up_ = false;
   file_index_ = index;
   file_opened_ = std::chrono::steady_clock::now();
 
@@ -141,8 +170,8 @@ void LoggerNode::open_file(std::size_t index) {
     std::map<std::string, std::string> metadata = metadata_base;
     metadata["type_name"] = info.type_name;
     const std::uint16_t channel = writer_.add_channel(info.topic, "cdr", schema, metadata);
-    if (index == 0) {
-      topics_[i].channel_id = channel;  // the same in every file: same order
+    if (topics_[i].channel_id == 0) {
+      topics_[i].channel_id = channel;  // the first file; the same in every file: same order
     } else if (topics_[i].channel_id != channel) {
       throw std::logic_error("logger: channel ids differ between rotated files");
     }
@@ -154,6 +183,7 @@ void LoggerNode::rotate() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     closed_files_.push_back(LoggedFile{writer_.path(), writer_.counters(), true});
+    file_given_up_ = true;  // listed; open_file() clears it
   }
   open_file(file_index_ + 1);
   std::lock_guard<std::mutex> lock(mutex_);
@@ -167,7 +197,8 @@ bool LoggerNode::size_limit_reached() const {
 
 void LoggerNode::update_file_counters() {
   totals_.files = closed_files_;
-  totals_.files.push_back(LoggedFile{writer_.path(), writer_.counters(), !writer_.is_open()});
+  if (!file_given_up_) totals_.files.push_back(LoggedFile{writer_.path(), writer_.counters(), !writer_.is_open()});
+  totals_.recording = writer_.is_open() || !file_given_up_;
   logger::McapWriterCounters sum;
   for (const LoggedFile& f : totals_.files) {
     sum.messages += f.counters.messages;
@@ -269,6 +300,7 @@ void LoggerNode::writer_loop() {
       auto deadline = Clock::time_point::max();
       if (timed) deadline = next_flush;
       if (rotate_by_time) deadline = std::min(deadline, file_opened_ + rotate_period);
+      if (file_given_up_) deadline = std::min(deadline, retry_at_);
       if (deadline != Clock::time_point::max()) {
         cv_.wait_until(lock, deadline, ready);
       } else {
@@ -283,7 +315,7 @@ void LoggerNode::writer_loop() {
         try {
           writer_.flush_chunk();
         } catch (const std::exception& e) {
-          record_error(e.what());
+          on_write_failure(e.what());
         }
       }
       next_flush = Clock::now() + period;
@@ -292,15 +324,16 @@ void LoggerNode::writer_loop() {
       try {
         rotate();
       } catch (const std::exception& e) {
-        record_error(e.what());
+        on_write_failure(e.what());
       }
     }
+    if (!stopping && file_given_up_ && Clock::now() >= retry_at_) reopen_after_failure();
     if (stopping) break;
   }
   try {
     writer_.close();
   } catch (const std::exception& e) {
-    record_error(e.what());
+    on_write_failure(e.what());
   }
   std::lock_guard<std::mutex> lock(mutex_);
   update_file_counters();
@@ -346,13 +379,51 @@ void LoggerNode::write_batch(std::deque<Pending>& batch) {
     queued_messages_ -= count;
     update_file_counters();
   }
-  if (!error.empty()) record_error(error);
+  if (!error.empty()) on_write_failure(error);
 }
 
-void LoggerNode::record_error(const std::string& what) {
+void LoggerNode::on_write_failure(const std::string& what) {
+  // A failed McapWriter has closed itself; anything else is closed here as
+  // far as it goes. The file keeps what reached it: readable up to its last
+  // complete chunk (docs/mcap.md).
+  if (writer_.is_open()) {
+    try {
+      writer_.close();
+    } catch (const std::exception&) {
+    }
+  }
+  const double retry_s = options_.retry_period_s;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++totals_.write_failures;
+    totals_.last_write_error = what;
+    if (!file_given_up_ && !writer_.path().empty()) {
+      closed_files_.push_back(LoggedFile{writer_.path(), writer_.counters(), false});
+    }
+    file_given_up_ = true;
+    retry_at_ = std::chrono::steady_clock::now() +
+                std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(retry_s));
+    update_file_counters();
+  }
+  std::fprintf(stderr, "logger: ERROR: %s; samples are dropped (counted) until a new file opens, next try in %.1f s\n",
+               what.c_str(), retry_s);
+}
+
+void LoggerNode::reopen_after_failure() {
+  ++retries_;
+  std::string path = rotated_file_name(options_.output_file, file_index_ + 1);
+  if (!options_.fallback_dir.empty() && retries_ % 2 == 1) {
+    path = (std::filesystem::path(options_.fallback_dir) / std::filesystem::path(path).filename()).string();
+  }
+  try {
+    open_file(file_index_ + 1, path);
+  } catch (const std::exception& e) {
+    on_write_failure(e.what());
+    return;
+  }
+  std::fprintf(stderr, "logger: recording again, to %s\n", path.c_str());
   std::lock_guard<std::mutex> lock(mutex_);
-  if (totals_.error.empty()) totals_.error = what;
-  accepting_ = false;
+  update_file_counters();
 }
 
 LoggerCounters LoggerNode::counters() const {

@@ -76,6 +76,8 @@ LoggerOptions read_logger_options(config::YamlReader& root, const std::string& c
   o.fsync = section.boolean("fsync", o.fsync);
   o.queue_max_bytes = static_cast<std::size_t>(section.integer(
       "queue_max_bytes", std::int64_t{1} << 20, std::int64_t{1} << 32, static_cast<std::int64_t>(o.queue_max_bytes)));
+  o.retry_period_s = section.number("retry_period_s", 0.1, 3600.0, o.retry_period_s);
+  o.fallback_dir = section.text("fallback_dir", o.fallback_dir);
   section.finish();
 
   if (root.has("dds")) {
@@ -107,6 +109,8 @@ std::string to_yaml(const LoggerOptions& o) {
      << "  flush_period_s: " << o.flush_period_s << "\n"
      << "  fsync: " << (o.fsync ? "true" : "false") << "\n"
      << "  queue_max_bytes: " << o.queue_max_bytes << "\n"
+     << "  retry_period_s: " << o.retry_period_s << "\n"
+     << "  fallback_dir: '" << o.fallback_dir << "'\n"
      << dds::to_yaml(o.dds);
   return os.str();
 }

@@ -53,7 +53,10 @@ struct LoggerCounters {
   std::size_t queue_peak_messages = 0;
   logger::McapWriterCounters file;    // totals over every file (final after stop())
   std::vector<LoggedFile> files;      // in order; one unless rotating
-  std::string error;                  // the write failure that stopped recording ("" if none)
+  std::string error;                  // a failure that stopped recording for good ("" if none)
+  std::uint64_t write_failures = 0;   // files given up after a write failure (disk full, ...)
+  std::string last_write_error;
+  bool recording = true;              // false while waiting to retry after a write failure
 };
 
 // The logger process: subscribes to the configured topics and writes every
@@ -76,7 +79,7 @@ struct LoggerCounters {
 // DDS callbacks only serialize and enqueue (bounded by queue_max_bytes; a
 // sample beyond the bound is dropped and counted); ONE writer thread writes
 // the file and writes the open chunk every flush_period_s, so a crash loses at
-// most about that much. The constructor creates (truncates) the file and
+// most about that much. The constructor creates the file (open_first_file) and
 // subscribes; samples arriving before start() wait in the queue. stop()
 // unsubscribes, drains the queue and closes the file (summary and footer);
 // counters are final after it. Throws std::runtime_error if the file cannot be
@@ -95,7 +98,9 @@ class LoggerNode {
   void stop();
 
   LoggerCounters counters() const;
-  // True once writing failed (disk full, ...): nothing more is recorded.
+  // True once recording stopped for good. A write failure (disk full, ...) is
+  // not that: the file so far is kept, samples are dropped and counted until a
+  // new file opens (LoggerOptions::retry_period_s, fallback_dir).
   bool failed() const;
   // One line per topic, "TOPIC: received R, written W, dropped D, seq gaps G".
   std::string counters_text() const;
@@ -118,22 +123,31 @@ class LoggerNode {
                std::vector<std::uint8_t>&& payload, bool serialized);
   void writer_loop();
   void write_batch(std::deque<Pending>& batch);
-  // Opens file `index` (rotated name when rotating) with every schema and channel.
-  void open_file(std::size_t index);
+  // Opens file `index` (rotated name when rotating, or `path`) with every
+  // schema and channel.
+  void open_file(std::size_t index, const std::string& path = "");
+  // The constructor's file: output_file, or the first indexed name that holds
+  // no recording yet.
+  void open_first_file();
+  // After a write failure: keeps the file as written, schedules a retry.
+  void on_write_failure(const std::string& what);
+  // The retry: the next rotated name, alternating with fallback_dir.
+  void reopen_after_failure();
   // Closes the current file and opens the next one. Writer thread only.
   void rotate();
   bool size_limit_reached() const;
   // Copies the writer's counters into totals_ (mutex_ held).
   void update_file_counters();
   diagnostics::Snapshot diagnostics_snapshot() const;
-  // The writer thread's failure: recorded once, recording stops.
-  void record_error(const std::string& what);
 
   LoggerOptions options_;
   std::vector<const TopicInfo*> topic_infos_;  // per topics_ entry
   logger::McapWriter writer_;  // after construction: the writer thread's alone (stop()'s if never started)
   std::size_t file_index_ = 0;
   std::chrono::steady_clock::time_point file_opened_;
+  bool file_given_up_ = false;  // the writer's file failed and is in closed_files_
+  std::chrono::steady_clock::time_point retry_at_;
+  std::uint64_t retries_ = 0;
 
   // Queue and counters.
   mutable std::mutex mutex_;

@@ -16,8 +16,10 @@ logger::McapCompression default_compression();
 
 // Everything the logger process is configured with (config/logger.yaml).
 struct LoggerOptions {
-  // `logger.output_file`: the MCAP file, created or truncated; a relative path
-  // is relative to the working directory. `logger --out` overrides it. With
+  // `logger.output_file`: the MCAP file, created; if it already holds data (a
+  // restarted logger, a reused folder) it is kept and the first free indexed
+  // name (run_001.mcap, ...) is written instead. A relative path is relative
+  // to the working directory. `logger --out` overrides it. With
   // rotation on, the files are named rotated_file_name(output_file, 0, 1, ...):
   // run.mcap -> run_000.mcap, run_001.mcap, ...
   std::string output_file = "pixyslam_run.mcap";
@@ -43,6 +45,14 @@ struct LoggerOptions {
   // `logger.queue_max_bytes`: payload bytes waiting for the writer thread;
   // samples beyond it are dropped and counted.
   std::size_t queue_max_bytes = std::size_t{64} << 20;
+  // `logger.retry_period_s`: after a write failure (disk full, ...) the file
+  // written so far is kept as it is (readable up to its last complete chunk),
+  // samples are dropped and counted, and a new file (the next rotated name) is
+  // tried this often.
+  double retry_period_s = 5.0;
+  // `logger.fallback_dir`: a second directory the retries alternate with
+  // ("" = retry in the output file's own directory only).
+  std::string fallback_dir;
   dds::DdsOptions dds;  // `dds:`
 };
 

@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# ctest launcher_roles: an optional process that fails is reported and
+# restarted with back-off while the essential ones go on; an essential one that
+# fails stops the run; an optional one exiting 2 (configuration error) is not
+# restarted.
+#   launcher_roles_test.sh LAUNCHER
+set -euo pipefail
+launcher=$1
+work=$(mktemp -d "${TMPDIR:-/tmp}/pixyslam_launcher_roles.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+
+cat > "$work/optional.yaml" <<'YAML'
+launch:
+  stop_timeout_s: 1
+  processes:
+    - name: flaky
+      role: optional
+      command: [/bin/sh, -c, "echo up; exit 1"]
+    - name: misconfigured
+      role: optional
+      command: [/bin/sh, -c, "exit 2"]
+    - name: essential
+      command: [/bin/sh, -c, "sleep 4; echo essential done"]
+      ends_run: true
+YAML
+status=0
+"$launcher" "$work/optional.yaml" --run-dir "$work/run1" > "$work/optional.log" 2>&1 || status=$?
+cat "$work/optional.log"
+fail() { echo "FAIL: $*"; exit 1; }
+grep -q "\[essential\] essential done" "$work/optional.log" || fail "the essential process did not run to its end"
+restarts=$(grep -c "restarting flaky" "$work/optional.log" || true)
+# Back-off 1 + 2 s within the 4 s run: two restarts (a third would come at 7 s).
+[[ $restarts -ge 2 && $restarts -le 3 ]] || fail "flaky restarted $restarts times (expected 2-3 in 4 s)"
+grep -q "restart in 1 s" "$work/optional.log" && grep -q "restart in 2 s" "$work/optional.log" ||
+  fail "no back-off 1 s, 2 s"
+grep -q "restarting misconfigured" "$work/optional.log" && fail "misconfigured (exit 2) was restarted"
+grep -q "misconfigured is optional: the run goes on; not restarted" "$work/optional.log" || fail "exit 2 not reported"
+[[ $status -eq 1 ]] || fail "exit code $status (expected 1: optional processes failed)"
+
+cat > "$work/essential.yaml" <<'YAML'
+launch:
+  stop_timeout_s: 1
+  processes:
+    - name: sleeper
+      command: [/bin/sleep, "30"]
+    - name: broken
+      command: [/bin/sh, -c, "sleep 0.5; exit 3"]
+YAML
+start=$(date +%s)
+status=0
+"$launcher" "$work/essential.yaml" --run-dir "$work/run2" > "$work/essential.log" 2>&1 || status=$?
+elapsed=$(( $(date +%s) - start ))
+cat "$work/essential.log"
+grep -q "stopping after .* (a process failed)" "$work/essential.log" || fail "an essential failure did not stop the run"
+[[ $elapsed -lt 10 && $status -eq 1 ]] || fail "essential failure: exit $status after $elapsed s"
+echo PASS
