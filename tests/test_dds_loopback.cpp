@@ -11,6 +11,13 @@
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
+#include <optional>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <gtest/gtest.h>
 
 #include "pixyslam/dds/endpoints.h"
@@ -196,6 +203,74 @@ TEST(DdsOptions, ReadsDeploymentKeys) {
   EXPECT_EQ(o.discovery_server, "10.200.0.3:11811");
   EXPECT_EQ(o.discovery_server_id, 2);
   EXPECT_EQ(o.security_dir, "/etc/pixyslam/sec");
+}
+
+TEST(DdsOptions, AnnounceIdentityIsOnUnlessSecureOrSet) {
+  for (const auto& [text, expected] : std::vector<std::pair<std::string, std::optional<bool>>>{
+           {"true", true}, {"false", false}, {"auto", std::nullopt}}) {
+    auto reader = config::YamlReader::from_string("dds:\n  announce_identity: " + text + "\n", "test.yaml");
+    auto dds = reader.child("dds");
+    const DdsOptions o = read_dds_options(dds, "/etc/pixyslam");
+    EXPECT_EQ(o.announce_identity, expected) << text;
+  }
+  DdsOptions o;
+  EXPECT_TRUE(announces_identity(o, false));
+  EXPECT_FALSE(announces_identity(o, true));
+  o.announce_identity = true;
+  EXPECT_TRUE(announces_identity(o, true));
+  o.announce_identity = false;
+  EXPECT_FALSE(announces_identity(o, false));
+  auto bad = config::YamlReader::from_string("dds:\n  announce_identity: sometimes\n", "test.yaml");
+  auto dds = bad.child("dds");
+  try {
+    read_dds_options(dds, "/etc/pixyslam");
+    FAIL() << "expected an error";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("dds.announce_identity"), std::string::npos) << e.what();
+  }
+}
+
+// What a participant tells everyone on the domain before any security: with
+// announce_identity false, neither its role nor the host, pid and process.
+class DiscoveryRecorder : public eprosima::fastdds::dds::DomainParticipantListener {
+ public:
+  void on_participant_discovery(eprosima::fastdds::dds::DomainParticipant*,
+                                eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+    std::lock_guard<std::mutex> lock(mutex);
+    std::map<std::string, std::string>& p = seen[info.info.m_participantName.to_string()];
+    for (const auto& property : info.info.m_properties) p[property.first()] = property.second();
+  }
+  std::mutex mutex;
+  std::map<std::string, std::map<std::string, std::string>> seen;
+};
+
+TEST(DdsLoopback, ParticipantsWithoutIdentityAnnounceNoNameHostOrPid) {
+  DiscoveryRecorder recorder;
+  auto* observer = create_participant(loopback_options(), "test_observer", &recorder);
+  ASSERT_NE(observer, nullptr);
+  {
+    Participant announced(loopback_options(), "test_announced");
+    DdsOptions quiet = loopback_options();
+    quiet.announce_identity = false;
+    Participant hidden(quiet, "test_hidden");
+    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    for (;;) {
+      {
+        std::lock_guard<std::mutex> lock(recorder.mutex);
+        if (recorder.seen.count("test_announced") && recorder.seen.count("pixyslam")) break;
+      }
+      ASSERT_LT(std::chrono::steady_clock::now(), end) << "both participants not discovered";
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  }
+  eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->delete_participant(observer);
+  std::lock_guard<std::mutex> lock(recorder.mutex);
+  EXPECT_EQ(recorder.seen.count("test_hidden"), 0u);
+  EXPECT_EQ(recorder.seen["test_announced"].count("pixyslam.pid"), 1u);
+  EXPECT_EQ(recorder.seen["test_announced"]["pixyslam.pid"], std::to_string(getpid()));
+  for (const char* key : {"pixyslam.host", "pixyslam.pid", "pixyslam.process"}) {
+    EXPECT_EQ(recorder.seen["pixyslam"].count(key), 0u) << key;
+  }
 }
 
 TEST(DdsOptions, BadAddressesNameTheKey) {

@@ -76,6 +76,16 @@ DdsOptions read_dds_options(config::YamlReader& reader, const std::string& confi
   o.robot_id = reader.text("robot_id", o.robot_id);
   if (o.robot_id.empty()) reader.fail("robot_id", "must not be empty");
   o.type_information = reader.boolean("type_information", o.type_information);
+  if (reader.has("announce_identity")) {
+    const std::string announce = reader.text("announce_identity");
+    if (announce == "true") {
+      o.announce_identity = true;
+    } else if (announce == "false") {
+      o.announce_identity = false;
+    } else if (announce != "auto") {
+      reader.fail("announce_identity", "'" + announce + "' is not true, false or auto");
+    }
+  }
   o.diagnostics_period_s = reader.number("diagnostics_period_s", 0.0, 3600.0, o.diagnostics_period_s);
   auto addresses = [&](const char* key) {
     std::vector<std::string> list = reader.has(key) ? reader.text_list(key) : std::vector<std::string>{};
@@ -170,8 +180,12 @@ std::string to_yaml(const DdsOptions& o) {
          "  initial_peers: " + yaml_list(o.initial_peers) + "\n" +
          "  discovery_server: " + quoted(o.discovery_server) + "\n" +
          "  discovery_server_id: " + std::to_string(o.discovery_server_id) + "\n" +
-         "  security_dir: " + quoted(o.security_dir) + "\n";
+         "  security_dir: " + quoted(o.security_dir) + "\n" +
+         "  announce_identity: " +
+         (o.announce_identity ? (*o.announce_identity ? "true" : "false") : std::string("auto")) + "\n";
 }
+
+bool announces_identity(const DdsOptions& options, bool secure) { return options.announce_identity.value_or(!secure); }
 
 namespace {
 
@@ -286,13 +300,20 @@ fdds::DomainParticipant* create_participant(const DdsOptions& options, const std
   }
   qos.name(name);
   apply_deployment(options, name, listener != nullptr, qos);
-  // Who this is, for inspection tools (pixyslam_spy participants): sent in discovery.
-  char host[256] = {};
-  if (gethostname(host, sizeof(host) - 1) != 0) host[0] = '\0';
-  const std::string process = program_invocation_short_name;  // glibc: argv[0] without folder
-  qos.properties().properties().emplace_back("pixyslam.host", host, true);
-  qos.properties().properties().emplace_back("pixyslam.pid", std::to_string(getpid()), true);
-  qos.properties().properties().emplace_back("pixyslam.process", process, true);
+  const auto& properties = qos.properties().properties();
+  const bool secure = std::any_of(properties.begin(), properties.end(),
+                                  [](const auto& p) { return p.name() == "dds.sec.auth.plugin"; });
+  if (announces_identity(options, secure)) {
+    // Who this is, for inspection tools (pixyslam_spy participants): sent in discovery.
+    char host[256] = {};
+    if (gethostname(host, sizeof(host) - 1) != 0) host[0] = '\0';
+    const std::string process = program_invocation_short_name;  // glibc: argv[0] without folder
+    qos.properties().properties().emplace_back("pixyslam.host", host, true);
+    qos.properties().properties().emplace_back("pixyslam.pid", std::to_string(getpid()), true);
+    qos.properties().properties().emplace_back("pixyslam.process", process, true);
+  } else {
+    qos.name("pixyslam");  // the role stays out of the plaintext announcement too
+  }
   fdds::DomainParticipant* participant =
       factory->create_participant(options.domain_id, qos, listener,
                                   listener != nullptr ? fdds::StatusMask::none() : fdds::StatusMask::all());

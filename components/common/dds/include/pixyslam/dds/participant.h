@@ -5,6 +5,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,7 +42,17 @@ struct DdsOptions {
   double diagnostics_period_s = 1.0;  // every process's report on pixyslam/diagnostics (0: none)
   std::string security_dir;  // DDS Security: ca.cert.pem, governance.p7s, permissions.p7s and
                              // <participant name>.cert.pem / .key.pem (scripts/make_dds_security.sh)
+  // Participant announcements (SPDP) are plaintext even with DDS Security (the
+  // standard sends them before authentication). When announced, they carry the
+  // process's role as participant name and pixyslam.host/pid/process properties
+  // (spy participants, the launcher's health lines). `announce_identity`:
+  // true | false | auto (unset: on, except with DDS Security, where the name is
+  // "pixyslam" and no property is sent).
+  std::optional<bool> announce_identity;
 };
+
+// Whether a participant with these options and this QoS announces its identity.
+bool announces_identity(const DdsOptions& options, bool secure);
 
 // Reads a `dds:` mapping (all keys optional) and calls reader.finish().
 // `config_dir` resolves a relative profiles_file and security_dir. Throws config::ConfigError.
@@ -70,7 +81,8 @@ std::string to_yaml(const DdsOptions& options);
 
 // Creates a DomainParticipant named `name` from the options' XML participant
 // profile (loaded first), the environment overrides and the deployment
-// settings, announcing pixyslam.host/pid/process properties for inspection.
+// settings, announcing pixyslam.host/pid/process properties for inspection
+// unless announces_identity() says otherwise.
 // `listener` (may be null) is attached from creation, for discovery callbacks
 // only (a listener set afterwards misses the first announcements); with one,
 // a discovery-server client is a super client that learns every participant
