@@ -4,6 +4,7 @@
 // loopback profile to a reader in the same test.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -16,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "dds_test_support.h"
+#include "diagnostics.h"
 #include "pixyslam/bridge/byte_source.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/pixy/pixy_block_parser.h"
@@ -339,6 +341,89 @@ TEST(PixyNode, PublishesOneObservationPerFrameAndSkipsBadBytes) {
   EXPECT_EQ(c.detections.detections, 5u * 1 + 5u * 2);
   EXPECT_EQ(c.detections.unknown_signature, 5u + 5u);
   EXPECT_TRUE(log.contains("final status: frames 20"));
+}
+
+// The diagnostics reports of the node under test (robot id of loopback_options()).
+using DiagnosticsInbox = test_support::Inbox<msg::Diagnostics>;
+::testing::Environment* const kDiagnosticsInboxCleanup =
+    ::testing::AddGlobalTestEnvironment(new test_support::InboxCleanup<msg::Diagnostics>);
+
+TEST(PixyNode, SyncWordFloodIsReadToTheEndAndRateLimitedWithAWarning) {
+  // Given a line that delivers "aa55 aa55 ..." at 1 MB/s for 2 s (a frame
+  // without blocks every 2 bytes), then, after 0.5 s of silence, a real
+  // camera's 50 frames at 50 Hz, each with landmark 1,
+  ObservationInbox& inbox = observation_inbox();
+  inbox.clear();
+  DiagnosticsInbox& diagnostics = DiagnosticsInbox::instance(loopback_options(), "test_diagnostics_reader");
+  diagnostics.clear();
+  auto script = std::make_shared<bridge::ByteScript>();
+  constexpr std::size_t kChunk = 4096;
+  constexpr std::size_t kFloodChunks = 488;  // 2.0 MB, 2.0 s at 1 MB/s
+  std::vector<std::uint8_t> flood;
+  for (std::size_t i = 0; i < kChunk / 2; ++i) {
+    flood.push_back(0x55);
+    flood.push_back(0xaa);
+  }
+  std::size_t bytes = 0;
+  std::uint64_t t = kBaseNs;
+  for (std::size_t i = 0; i < kFloodChunks; ++i) {
+    t = kBaseNs + static_cast<std::uint64_t>(1e3 * static_cast<double>((i + 1) * kChunk));  // 1 us per byte
+    script->add_bytes(flood, t);
+    bytes += flood.size();
+  }
+  const std::uint64_t flood_end_ns = t;
+  constexpr std::size_t kValidFrames = 50;
+  const std::vector<std::uint8_t> frame = pixy::encode_frame({landmark_1()});
+  for (std::size_t i = 0; i < kValidFrames; ++i) {
+    t = flood_end_ns + 500000000ull + kFrameNs * i;
+    script->add_bytes(frame, t);
+    bytes += frame.size();
+  }
+  script->add_idle(t + 1000000000ull);  // the last frame completes by frame_timeout_s
+
+  PixyNodeOptions options;
+  options.pixy.signatures.add(012, 1);
+  options.dds = loopback_options();
+  options.dds.diagnostics_period_s = 0.2;
+  options.process.status_period_s = 0.0;
+  LogLines log;
+  PixyNode node(options, std::make_unique<bridge::ScriptedByteSource>(script, "/dev/pixy_flood"), log.sink(),
+                bridge::ByteScript::clock(script));
+  ASSERT_TRUE(node.wait_for_subscribers(1, std::chrono::seconds(10)));
+  node.start();
+  ASSERT_TRUE(script->wait_finished(std::chrono::seconds(20)));
+  std::this_thread::sleep_for(milliseconds(300));  // the last flush and a diagnostics report
+
+  // then every byte was read and parsed,
+  const PixyNodeCounters c = node.counters();
+  EXPECT_EQ(c.device.bytes, bytes);
+  EXPECT_EQ(c.parser.bytes_in, bytes);
+  EXPECT_GE(c.parser.frames, kFloodChunks * kChunk / 2);
+  // frames without blocks were published at most at pixy.frame_rate_hz (50 Hz
+  // over 2 s, plus the tolerance's burst) and the camera's frames all were;
+  // every other frame was dropped before any DDS work and counted,
+  const pixy::FrameRateOptions& rate = options.pixy.rate;
+  const auto most_empty = static_cast<std::uint64_t>(rate.frame_rate_hz * (2.0 + rate.tolerance_s)) + 2;
+  EXPECT_LE(c.published, most_empty + kValidFrames);
+  EXPECT_EQ(c.rate.published, c.published);
+  EXPECT_EQ(c.rate.rate_limited, c.parser.frames - c.published);
+  EXPECT_EQ(c.rate.empty_rate_limited, c.rate.rate_limited);
+  const std::vector<msg::LandmarkObservation> got = inbox.wait_for(c.published, std::chrono::seconds(10));
+  EXPECT_EQ(got.size(), c.published);
+  EXPECT_EQ(std::count_if(got.begin(), got.end(), [](const auto& m) { return m.detections().size() == 1; }),
+            static_cast<std::ptrdiff_t>(kValidFrames));
+  // a WARN line named the offered rate and the limit,
+  EXPECT_TRUE(log.contains("WARN: frame rate over the limit: "));
+  EXPECT_TRUE(log.contains("50 Hz for frames without blocks (pixy.frame_rate_hz)"));
+  // and the diagnostics topic said WARN, naming the counter.
+  const std::vector<msg::Diagnostics> reports = diagnostics.wait_for(1, std::chrono::seconds(5));
+  const bool warned = std::any_of(reports.begin(), reports.end(), [](const msg::Diagnostics& d) {
+    return d.process() == "pixy_bridge" && d.level() == 1 &&
+           d.status().find("frames_rate_limited +") != std::string::npos;
+  });
+  EXPECT_TRUE(warned) << reports.size() << " reports";
+  node.stop();
+  EXPECT_TRUE(log.contains("final status: frames "));
 }
 
 TEST(PixyNode, MissingDeviceIsLoggedAndRetried) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/config/yaml_text.h"
 
 namespace pixyslam::pixy {
 namespace {
@@ -60,6 +61,16 @@ PixyOptions read_pixy_options(config::YamlReader& p) {
   c.bearing_sigma_rad = p.number("bearing_sigma_rad", 1e-6, 1.0, c.bearing_sigma_rad);
   c.range_sigma_floor_m = p.number("range_sigma_floor_m", 0.0, 10.0, c.range_sigma_floor_m);
   c.block_height_sigma_px = p.number("block_height_sigma_px", 0.0, 100.0, c.block_height_sigma_px);
+  FrameRateOptions& r = o.rate;
+  r.frame_rate_hz = p.number("frame_rate_hz", 0.1, 1000.0, r.frame_rate_hz);
+  // A little above the camera's rate unless told otherwise.
+  r.max_frame_rate_hz = p.number("max_frame_rate_hz", 0.1, 10000.0, 1.2 * r.frame_rate_hz);
+  if (r.max_frame_rate_hz < r.frame_rate_hz) {
+    p.fail("max_frame_rate_hz", "value " + config::yaml_number(r.max_frame_rate_hz) +
+                                    " is below frame_rate_hz (" + config::yaml_number(r.frame_rate_hz) +
+                                    "): frames without blocks may come at the camera's rate");
+  }
+  r.tolerance_s = p.number("frame_rate_tolerance_s", 0.0, 10.0, r.tolerance_s);
   config::YamlReader lm = p.child("landmarks");
   o.signatures = read_landmarks(lm);
   p.finish();

@@ -10,9 +10,11 @@
 namespace pixyslam::pixy_node {
 namespace {
 
-// The options, once the camera model passed pixy::validate() (before any DDS entity exists).
+// The options, once the camera model and the frame rates passed pixy::validate()
+// (before any DDS entity exists).
 const PixyNodeOptions& validated(const PixyNodeOptions& options) {
   pixy::validate(options.pixy.camera);
+  pixy::validate(options.pixy.rate);
   return options;
 }
 
@@ -25,6 +27,7 @@ PixyNode::PixyNode(const PixyNodeOptions& options, bridge::LogFunction log)
 PixyNode::PixyNode(const PixyNodeOptions& options, std::unique_ptr<bridge::ByteSource> source,
                    bridge::LogFunction log, bridge::ClockFunction clock)
     : options_(validated(options)),
+      rate_limiter_(options_.pixy.rate),
       runtime_("pixy_bridge", options.dds, options.process, std::move(source), std::move(log), std::move(clock),
                mutex_) {}
 
@@ -46,9 +49,13 @@ void PixyNode::start() {
 std::vector<diagnostics::Counter> PixyNode::diagnostic_counters_locked() const {
   const pixy::PixyParserCounters& p = parser_.counters();
   const pixy::DetectionCounters& k = detection_counters_;
+  const pixy::FrameRateCounters& r = rate_limiter_.counters();
   return {{"bytes_in", p.bytes_in, false},
           {"bytes_skipped", p.bytes_skipped, true},
           {"frames", p.frames, false},
+          // Frames over pixy.frame_rate_hz (without blocks) or pixy.max_frame_rate_hz: dropped.
+          {"frames_rate_limited", r.rate_limited, true},
+          {"empty_frames_rate_limited", r.empty_rate_limited, false},
           {"blocks_ok", p.blocks_ok, false},
           {"checksum_errors", p.checksum_errors, true},
           {"resyncs", p.resyncs, true},
@@ -74,6 +81,7 @@ PixyNodeCounters PixyNode::counters() const {
   c.device = runtime_.device_counters();
   c.parser = parser_.counters();
   c.detections = detection_counters_;
+  c.rate = rate_limiter_.counters();
   c.published = runtime_.published();
   c.publish_failures = runtime_.publish_failures();
   c.frames_timed_out = frames_timed_out_;
@@ -89,8 +97,10 @@ std::vector<std::string> PixyNode::status_lines() const {
 std::vector<std::string> PixyNode::status_lines_locked() const {
   const pixy::PixyParserCounters& p = parser_.counters();
   const pixy::DetectionCounters& k = detection_counters_;
+  const pixy::FrameRateCounters& r = rate_limiter_.counters();
   std::ostringstream stream, detections;
-  stream << "status: frames " << p.frames << " (timed out " << frames_timed_out_ << "), blocks " << p.blocks_ok
+  stream << "status: frames " << p.frames << " (timed out " << frames_timed_out_ << ", over the frame rate limit "
+         << r.rate_limited << ", of which without blocks " << r.empty_rate_limited << "), blocks " << p.blocks_ok
          << " (colour code " << p.colour_code_blocks_ok << ", outside a frame " << p.blocks_outside_frame
          << "), checksum errors " << p.checksum_errors << ", signature 0 " << p.zero_signature_blocks
          << ", resyncs " << p.resyncs << ", bytes skipped " << p.bytes_skipped;
@@ -115,6 +125,7 @@ void PixyNode::on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_
     frame_end_ns_ = receive_ns;  // the next frame opened in this chunk
   });
   if (progress() > mark) frame_end_ns_ = receive_ns;
+  log_rate_warning(receive_ns);
 }
 
 void PixyNode::on_poll(std::uint64_t now_ns) {
@@ -125,9 +136,18 @@ void PixyNode::on_poll(std::uint64_t now_ns) {
       publish(*frame, frame_end_ns_);
     }
   }
+  log_rate_warning(now_ns);
+}
+
+void PixyNode::log_rate_warning(std::uint64_t now_ns) {
+  if (const std::optional<pixy::FrameRateWarning> w = rate_limiter_.take_warning(now_ns)) {
+    runtime_.log("WARN: " + w->text());
+  }
 }
 
 void PixyNode::publish(const pixy::PixyFrame& frame, std::uint64_t end_ns) {
+  // First, before any work: a flood of frames must cost no more than parsing.
+  if (!rate_limiter_.admit(end_ns, frame.blocks.empty())) return;
   const std::vector<pixy::Detection> detections =
       pixy::to_detections(frame, options_.pixy.signatures, options_.pixy.camera, detection_counters_);
   if (detections.size() > kMaxDetectionsPerMessage) {

@@ -83,6 +83,9 @@ std::string to_yaml(const PixyNodeOptions& o) {
      << "  range_sigma_floor_m: " << yaml_number(c.range_sigma_floor_m) << "\n"
      << "  block_height_sigma_px: " << yaml_number(c.block_height_sigma_px) << "\n"
      << "  bearing_sigma_rad: " << yaml_number(c.bearing_sigma_rad) << "\n"
+     << "  frame_rate_hz: " << yaml_number(o.pixy.rate.frame_rate_hz) << "\n"
+     << "  max_frame_rate_hz: " << yaml_number(o.pixy.rate.max_frame_rate_hz) << "\n"
+     << "  frame_rate_tolerance_s: " << yaml_number(o.pixy.rate.tolerance_s) << "\n"
      << "  landmarks:" << (o.pixy.signatures.size() == 0 ? " {}" : "") << "\n";
   for (const auto& [signature, id] : o.pixy.signatures.entries()) {
     os << "    \"" << pixy::signature_tags(signature) << "\": " << id << "\n";

@@ -1,5 +1,6 @@
 #pragma once
 
+#include "pixyslam/pixy/frame_rate_limiter.h"
 #include "pixyslam/pixy/pixy_geometry.h"
 
 namespace pixyslam::config {
@@ -9,10 +10,12 @@ class YamlReader;
 namespace pixyslam::pixy {
 
 // Everything the Pixy core needs from configuration: the camera and landmark
-// model and which colour code marks which landmark. A plain value.
+// model, which colour code marks which landmark, and how fast frames may come.
+// A plain value.
 struct PixyOptions {
   CameraModel camera;
   SignatureMap signatures;
+  FrameRateOptions rate;  // warn_period_s is not read from the file
 };
 
 // Reads a `pixy:` mapping (every key but the two required ones has the paper's
@@ -28,6 +31,9 @@ struct PixyOptions {
 //   max_height_to_width: 2.2
 //   range_sigma_fraction: 0.05  # range sd = fraction * range
 //   bearing_sigma_rad: 0.027
+//   frame_rate_hz: 50           # the camera's frame rate: the most frames without blocks per second
+//   max_frame_rate_hz: 60       # the most frames per second; default 1.2 * frame_rate_hz
+//   frame_rate_tolerance_s: 0.1 # how early (bunched up) a frame may come and still pass
 //   landmarks:                  # required: colour-code signature -> landmark id
 //     "12": 1
 //     "0o13": 2

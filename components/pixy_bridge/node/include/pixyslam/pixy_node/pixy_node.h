@@ -11,6 +11,7 @@
 #include "pixyslam/bridge/bridge_runtime.h"
 #include "pixyslam/bridge/byte_source.h"
 #include "pixyslam/bridge/device_reader.h"
+#include "pixyslam/pixy/frame_rate_limiter.h"
 #include "pixyslam/pixy/pixy_block_parser.h"
 #include "pixyslam/pixy/pixy_geometry.h"
 #include "pixyslam/pixy_node/pixy_node_options.h"
@@ -21,6 +22,7 @@ struct PixyNodeCounters {
   bridge::DeviceCounters device;
   pixy::PixyParserCounters parser;
   pixy::DetectionCounters detections;
+  pixy::FrameRateCounters rate;          // frames over pixy.frame_rate_hz / max_frame_rate_hz, dropped
   std::uint64_t published = 0;           // LandmarkObservation messages written
   std::uint64_t publish_failures = 0;    // writes DDS refused
   std::uint64_t frames_timed_out = 0;    // frames closed by frame_timeout_s (not by the next frame)
@@ -33,6 +35,15 @@ struct PixyNodeCounters {
 // range/bearing detections (to_detections, seed paper Eq. 5/6) and publishes one
 // msg::LandmarkObservation per camera frame, also frames without detections,
 // frame "camera".
+//
+// Frame rate: a frame is published only if pixy::FrameRateLimiter admits it at
+// its stamp (before camera_latency_s): frames without blocks at most
+// pixy.frame_rate_hz, all frames at most pixy.max_frame_rate_hz. The others are
+// dropped before any geometry or DDS work, so a flood of sync words or frames
+// is read at line rate; they are counted (frames_rate_limited on the
+// diagnostics topic, which then says WARN) and a "WARN: frame rate over the
+// limit: ..." line naming the offered rate and the limits is logged at most
+// every 5 s while it lasts.
 //
 // Stamp: the host time (dds::now_ns() domain) at which the frame's last block
 // was read (for a frame without blocks: its start), minus camera_latency_s.
@@ -68,7 +79,9 @@ class PixyNode {
   // The reader thread's handlers, called with mutex_ held (BridgeRuntime).
   void on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns);
   void on_poll(std::uint64_t now_ns);
+  // Publishes the frame unless the rate limiter drops it.
   void publish(const pixy::PixyFrame& frame, std::uint64_t end_ns);
+  void log_rate_warning(std::uint64_t now_ns);
   std::vector<diagnostics::Counter> diagnostic_counters_locked() const;
   std::vector<std::string> status_lines_locked() const;
 
@@ -78,6 +91,7 @@ class PixyNode {
   mutable std::mutex mutex_;
   pixy::PixyBlockParser parser_;
   pixy::DetectionCounters detection_counters_;
+  pixy::FrameRateLimiter rate_limiter_;
   std::uint64_t frame_end_ns_ = 0;  // host time the open frame last advanced (opened or got a block)
   std::uint64_t frames_timed_out_ = 0;
   std::uint64_t detections_dropped_ = 0;

@@ -1,0 +1,287 @@
+// The pixy bridge's frame-rate limit (pixy::FrameRateLimiter) behind the block
+// parser, driven the way PixyNode drives it: bytes arrive in chunks stamped
+// with their arrival time, each frame the parser completes is offered at the
+// time of the chunk that completed it. A sync-word flood and valid frames at
+// 10 kHz are cut down to the configured rates and counted; a real camera's
+// 50 Hz (with read jitter and bunched reads) loses nothing. And the options.
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/pixy/frame_rate_limiter.h"
+#include "pixyslam/pixy/pixy_block_parser.h"
+#include "pixyslam/pixy/pixy_options.h"
+
+namespace pixyslam::pixy {
+namespace {
+
+constexpr std::uint64_t kBaseNs = 1700000000000000000ull;
+constexpr std::uint64_t kSecondNs = 1000000000ull;
+
+PixyBlock landmark_block() {
+  PixyBlock b;
+  b.colour_code = true;
+  b.signature = 012;
+  b.x = 160;
+  b.y = 100;
+  b.width = 20;
+  b.height = 42;
+  b.angle_deg = -3;
+  return b;
+}
+
+// A parser and a limiter wired like PixyNode: every completed frame is offered
+// at the arrival time of the chunk that completed it; warnings are collected.
+struct Bridge {
+  explicit Bridge(const FrameRateOptions& options = {}) : limiter(options) {}
+
+  void feed(const std::vector<std::uint8_t>& chunk, std::uint64_t at_ns) {
+    parser.feed(chunk.data(), chunk.size(), [&](PixyFrame&& frame) {
+      if (limiter.admit(at_ns, frame.blocks.empty())) {
+        ++published;
+        if (frame.blocks.empty()) ++published_empty;
+      }
+    });
+    if (std::optional<FrameRateWarning> w = limiter.take_warning(at_ns)) warnings.push_back(*w);
+  }
+
+  PixyBlockParser parser;
+  FrameRateLimiter limiter;
+  std::uint64_t published = 0;
+  std::uint64_t published_empty = 0;
+  std::vector<FrameRateWarning> warnings;
+};
+
+TEST(PixyRateLimit, SyncWordFloodPublishesAtMostTheCameraRate) {
+  // Given "aa55 aa55 ..." at 1 MB/s for 5 s, read in 1 KiB chunks (every sync
+  // word followed by another opens a frame: a frame without blocks per 2 bytes),
+  const FrameRateOptions options;  // 50 Hz camera, at most 60 frames/s
+  Bridge bridge(options);
+  constexpr std::size_t kChunk = 1024;
+  constexpr double kBytesPerS = 1e6;
+  constexpr double kSeconds = 5.0;
+  std::vector<std::uint8_t> chunk;
+  for (std::size_t i = 0; i < kChunk / 2; ++i) {
+    chunk.push_back(0x55);
+    chunk.push_back(0xaa);
+  }
+  const auto chunks = static_cast<std::size_t>(kBytesPerS * kSeconds / kChunk);
+  for (std::size_t i = 1; i <= chunks; ++i) {
+    bridge.feed(chunk, kBaseNs + static_cast<std::uint64_t>(1e9 * static_cast<double>(i * kChunk) / kBytesPerS));
+  }
+
+  // then every byte was parsed into frames without blocks, and at most
+  // frame_rate_hz * 5 s of them (plus the tolerance's burst) were published;
+  // every other one was dropped and counted,
+  const FrameRateCounters& c = bridge.limiter.counters();
+  const std::uint64_t frames = bridge.parser.counters().frames;
+  EXPECT_EQ(bridge.parser.counters().bytes_in, chunks * kChunk);
+  EXPECT_GE(frames, chunks * kChunk / 2 - 2);
+  EXPECT_EQ(c.frames, frames);
+  EXPECT_EQ(c.empty_frames, frames);
+  const auto most = static_cast<std::uint64_t>(options.frame_rate_hz * (kSeconds + options.tolerance_s)) + 1;
+  EXPECT_LE(bridge.published, most);
+  EXPECT_GE(bridge.published, static_cast<std::uint64_t>(options.frame_rate_hz * kSeconds) - 1);
+  EXPECT_EQ(c.published, bridge.published);
+  EXPECT_EQ(c.rate_limited, frames - bridge.published);
+  EXPECT_EQ(c.empty_rate_limited, c.rate_limited);
+
+  // and one warning (the flood's first second; the next is due 5 s later)
+  // named the offered rate and the limits.
+  ASSERT_EQ(bridge.warnings.size(), 1u);
+  const FrameRateWarning& w = bridge.warnings[0];
+  EXPECT_NEAR(w.frames_per_s, kBytesPerS / 2, kBytesPerS / 100);
+  EXPECT_DOUBLE_EQ(w.empty_frames_per_s, w.frames_per_s);
+  EXPECT_GT(w.dropped, 400000u);
+  EXPECT_EQ(w.empty_dropped, w.dropped);
+  const std::string text = w.text();
+  EXPECT_NE(text.find("frames/s offered"), std::string::npos) << text;
+  EXPECT_NE(text.find("50 Hz for frames without blocks (pixy.frame_rate_hz)"), std::string::npos) << text;
+  EXPECT_NE(text.find("60 Hz for all frames (pixy.max_frame_rate_hz)"), std::string::npos) << text;
+}
+
+TEST(PixyRateLimit, ValidFramesAt10kHzAreLimitedToTheMaximumRate) {
+  // Given valid one-block frames at 10 kHz for 5 s, each read on its own,
+  const FrameRateOptions options;
+  Bridge bridge(options);
+  const std::vector<std::uint8_t> frame = encode_frame({landmark_block()});
+  constexpr std::size_t kFrames = 50000;
+  constexpr std::uint64_t kPeriodNs = kSecondNs / 10000;
+  for (std::size_t i = 0; i < kFrames; ++i) bridge.feed(frame, kBaseNs + kPeriodNs * i);
+
+  // then at most max_frame_rate_hz * 5 s were published (each frame is
+  // complete when the next starts: the last one is still open),
+  const FrameRateCounters& c = bridge.limiter.counters();
+  EXPECT_EQ(bridge.parser.counters().frames, kFrames - 1);
+  EXPECT_EQ(bridge.parser.counters().blocks_ok, kFrames);
+  const double seconds = 1e-9 * static_cast<double>(kPeriodNs * (kFrames - 1));
+  EXPECT_LE(bridge.published,
+            static_cast<std::uint64_t>(options.max_frame_rate_hz * (seconds + options.tolerance_s)) + 1);
+  EXPECT_GE(bridge.published, static_cast<std::uint64_t>(options.max_frame_rate_hz * seconds) - 1);
+  EXPECT_EQ(bridge.published_empty, 0u);
+  // the rest were dropped and counted,
+  EXPECT_EQ(c.rate_limited, kFrames - 1 - bridge.published);
+  EXPECT_EQ(c.empty_rate_limited, 0u);
+  // and the warning named 10000 frames/s, none without blocks.
+  ASSERT_EQ(bridge.warnings.size(), 1u);
+  EXPECT_NEAR(bridge.warnings[0].frames_per_s, 10000.0, 1.0);
+  EXPECT_EQ(bridge.warnings[0].empty_frames_per_s, 0.0);
+  EXPECT_EQ(bridge.warnings[0].empty_dropped, 0u);
+}
+
+TEST(PixyRateLimit, WarnsAtMostOncePerPeriodWhileTheFloodLasts) {
+  // Frames without blocks at 1 kHz for 60 s, one per read.
+  FrameRateOptions options;
+  Bridge bridge(options);
+  const std::vector<std::uint8_t> empty_frame = {0x55, 0xaa};  // a lone frame-start sync
+  std::uint64_t t = kBaseNs;
+  for (int i = 0; i < 60000; ++i, t += kSecondNs / 1000) bridge.feed(empty_frame, t);
+  // The first warning after the first second, then one every 5 s: 1 + 11.
+  ASSERT_EQ(bridge.warnings.size(), 12u);
+  EXPECT_EQ(bridge.limiter.counters().warnings, 12u);
+  std::uint64_t dropped = 0;
+  for (const FrameRateWarning& w : bridge.warnings) {
+    EXPECT_NEAR(w.empty_frames_per_s, 1000.0, 1.0);
+    dropped += w.dropped;
+  }
+  // The drops of the last 4 s are not reported yet: when the flood ends, they
+  // are once the period is over, then nothing more.
+  EXPECT_LT(dropped, bridge.limiter.counters().rate_limited);
+  EXPECT_FALSE(bridge.limiter.take_warning(t + kSecondNs).has_value());
+  const std::optional<FrameRateWarning> last = bridge.limiter.take_warning(t + 5 * kSecondNs);
+  ASSERT_TRUE(last.has_value());
+  EXPECT_EQ(dropped + last->dropped, bridge.limiter.counters().rate_limited);
+  EXPECT_FALSE(bridge.limiter.take_warning(t + 60 * kSecondNs).has_value());
+}
+
+TEST(PixyRateLimit, NormalCameraInputIsUntouched) {
+  // A 50 Hz camera for 10 min: a third of the frames without blocks, arrival
+  // jitter of +-8 ms, and every 50th read late, so that two frames are parsed
+  // from one chunk at the same time.
+  Bridge bridge;
+  std::mt19937 prng(7);
+  std::uniform_int_distribution<int> jitter_us(-8000, 8000);
+  constexpr std::size_t kFrames = 50 * 600;
+  std::vector<std::uint8_t> pending;
+  for (std::size_t i = 0; i < kFrames; ++i) {
+    const std::vector<std::uint8_t> frame =
+        encode_frame(i % 3 == 0 ? std::vector<PixyBlock>{} : std::vector<PixyBlock>{landmark_block()});
+    pending.insert(pending.end(), frame.begin(), frame.end());
+    if (i % 50 == 48) continue;  // read together with the next frame
+    const auto at = static_cast<std::int64_t>(kBaseNs + i * (kSecondNs / 50)) + 1000 * jitter_us(prng);
+    bridge.feed(pending, static_cast<std::uint64_t>(at));
+    pending.clear();
+  }
+  const FrameRateCounters& c = bridge.limiter.counters();
+  EXPECT_EQ(c.frames, kFrames - 1);  // the last frame is still open
+  EXPECT_EQ(c.rate_limited, 0u);
+  EXPECT_EQ(bridge.published, kFrames - 1);
+  EXPECT_TRUE(bridge.warnings.empty());
+
+  // Only frames without blocks at exactly the camera rate: all published too.
+  Bridge empty_only;
+  const std::vector<std::uint8_t> empty_frame = {0x55, 0xaa};
+  for (std::size_t i = 0; i < kFrames; ++i) {
+    const auto at = static_cast<std::int64_t>(kBaseNs + i * (kSecondNs / 50)) + 1000 * jitter_us(prng);
+    empty_only.feed(empty_frame, static_cast<std::uint64_t>(at));
+  }
+  // (a lone sync opens a frame only once the next word is read: the last two are not delivered)
+  EXPECT_EQ(empty_only.limiter.counters().frames, kFrames - 2);
+  EXPECT_EQ(empty_only.limiter.counters().rate_limited, 0u);
+  EXPECT_EQ(empty_only.published, kFrames - 2);
+  EXPECT_TRUE(empty_only.warnings.empty());
+}
+
+TEST(PixyRateLimit, EmptyFramesUseUpBothLimitsAndAClockStepRestartsThem) {
+  // A frame without blocks uses up room in both limits; frames with blocks
+  // may still come up to max_frame_rate_hz.
+  FrameRateOptions options;
+  options.frame_rate_hz = 10.0;
+  options.max_frame_rate_hz = 20.0;
+  options.tolerance_s = 0.0;
+  FrameRateLimiter limiter(options);
+  std::uint64_t t = kBaseNs;
+  EXPECT_TRUE(limiter.admit(t, true));
+  EXPECT_FALSE(limiter.admit(t + kSecondNs / 20, true));  // 20 Hz of empty frames: over 10 Hz
+  EXPECT_TRUE(limiter.admit(t + kSecondNs / 20, false));  // but a frame with blocks passes
+  EXPECT_FALSE(limiter.admit(t + kSecondNs / 20 + 1, false));
+  t += kSecondNs / 10;
+  EXPECT_TRUE(limiter.admit(t, true));
+  // The host clock steps back an hour: the schedule restarts there.
+  EXPECT_TRUE(limiter.admit(t - 3600 * kSecondNs, false));
+  EXPECT_EQ(limiter.counters().clock_steps_back, 1u);
+  EXPECT_EQ(limiter.counters().rate_limited, 2u);
+  EXPECT_EQ(limiter.counters().empty_rate_limited, 1u);
+}
+
+// ---------------------------------------------------------------- options
+
+PixyOptions read(const std::string& extra) {
+  auto root = config::YamlReader::from_string(
+      "pixy:\n  landmark_height_m: 0.08\n" + extra + "  landmarks:\n    \"12\": 1\n", "test.yaml");
+  config::YamlReader pixy = root.child("pixy");
+  return read_pixy_options(pixy);
+}
+
+std::string error_of(const std::string& extra) {
+  try {
+    read(extra);
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(PixyRateLimitOptions, DefaultsFollowTheCameraRate) {
+  const PixyOptions d = read("");
+  EXPECT_DOUBLE_EQ(d.rate.frame_rate_hz, 50.0);
+  EXPECT_DOUBLE_EQ(d.rate.max_frame_rate_hz, 60.0);
+  EXPECT_DOUBLE_EQ(d.rate.tolerance_s, 0.1);
+  const PixyOptions sixty = read("  frame_rate_hz: 60\n");
+  EXPECT_DOUBLE_EQ(sixty.rate.max_frame_rate_hz, 72.0);  // 1.2 x the camera's rate unless set
+  const PixyOptions set = read("  frame_rate_hz: 30\n  max_frame_rate_hz: 31\n  frame_rate_tolerance_s: 0\n");
+  EXPECT_DOUBLE_EQ(set.rate.frame_rate_hz, 30.0);
+  EXPECT_DOUBLE_EQ(set.rate.max_frame_rate_hz, 31.0);
+  EXPECT_DOUBLE_EQ(set.rate.tolerance_s, 0.0);
+}
+
+TEST(PixyRateLimitOptions, BadRatesAreNamed) {
+  EXPECT_NE(error_of("  frame_rate_hz: 0\n").find("test.yaml: key 'pixy.frame_rate_hz': value 0"),
+            std::string::npos);
+  EXPECT_NE(error_of("  frame_rate_hz: 5000\n").find("key 'pixy.frame_rate_hz'"), std::string::npos);
+  EXPECT_NE(error_of("  max_frame_rate_hz: fast\n").find("key 'pixy.max_frame_rate_hz'"), std::string::npos);
+  const std::string below = error_of("  frame_rate_hz: 50\n  max_frame_rate_hz: 40\n");
+  EXPECT_NE(below.find("test.yaml: key 'pixy.max_frame_rate_hz': value 40 is below frame_rate_hz (50)"),
+            std::string::npos)
+      << below;
+  EXPECT_NE(error_of("  frame_rate_tolerance_s: -1\n").find("key 'pixy.frame_rate_tolerance_s'"),
+            std::string::npos);
+
+  // The limiter checks options built in code the same way.
+  FrameRateOptions bad;
+  bad.frame_rate_hz = 0.0;
+  EXPECT_THROW(FrameRateLimiter{bad}, std::invalid_argument);
+  try {
+    bad = FrameRateOptions{};
+    bad.max_frame_rate_hz = 10.0;
+    validate(bad);
+    ADD_FAILURE() << "expected invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("max_frame_rate_hz must be >= frame_rate_hz (50; is 10)"),
+              std::string::npos)
+        << e.what();
+  }
+  bad = FrameRateOptions{};
+  bad.tolerance_s = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(validate(bad), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pixyslam::pixy
