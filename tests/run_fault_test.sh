@@ -5,8 +5,12 @@
 # them. During a 60 s run:
 #   encoder_bridge, pixy_bridge, slam_estimator and logger are each killed
 #   with SIGKILL and restarted a second later (the logger into a new file);
-#   both serial devices vanish for 1 s and come back (robot_sim unplug_at_s).
-# Passes if: every process runs to the end and exits 0 on SIGINT; the killed
+#   both serial devices vanish for 1 s and come back (robot_sim unplug_at_s);
+#   a second logger (logger_full) records to a disk that fills up: every file
+#   it writes fails at FULL_KB (ulimit -f, SIGXFSZ ignored: writes fail like
+#   on a full disk), and it retries a new file every 2 s.
+# Passes if: every process runs to the end and exits 0 on SIGINT (logger_full:
+# 1, naming its write failures, and every file it wrote readable); the killed
 # logger's file is readable (only its open chunk lost) and so is the new one;
 # no MapState holds NaN or inf; after each fault a MapState follows within
 # RESUME_S of the restart; the restarted estimator resumed from its checkpoint
@@ -34,6 +38,10 @@ sed -i -e "s/^  duration_s: [0-9.]* /  duration_s: $sim_s /" -e "s/^  unplug_at_
 grep -q "unplug_at_s: $unplug_at_s " "$work/config/robot_sim.yaml" || { echo "FAIL: cannot set unplug_at_s"; exit 1; }
 cfg=$work/config dev=$work/dev
 mkdir -p "$dev"
+full_kb=${FULL_KB:-150}
+sed -e "s/^  retry_period_s: [0-9.]* /  retry_period_s: 2 /" -e "s/^  flush_period_s: [0-9.]* /  flush_period_s: 0.5 /" \
+  "$cfg/logger.yaml" > "$cfg/logger_full.yaml"
+grep -q "retry_period_s: 2 " "$cfg/logger_full.yaml" || { echo "FAIL: cannot set retry_period_s"; exit 1; }
 
 now_ns() { date +%s%N; }
 logger_runs=0
@@ -42,6 +50,9 @@ start() {  # start NAME: the process NAME in the background, output appended to 
   case $name in
     logger) logger_runs=$((logger_runs + 1))
             set -- "$bin/logger" --config "$cfg/logger.yaml" --out "$work/run_$logger_runs.mcap" ;;
+    logger_full) mkdir -p "$work/full"
+            set -- bash -c "trap '' XFSZ; ulimit -f $full_kb; exec \"\$@\"" logger_full \
+              "$bin/logger" --config "$cfg/logger_full.yaml" --out "$work/full/run.mcap" ;;
     slam_estimator) set -- "$bin/slam_estimator" --config "$cfg/slam_estimator.yaml" --out "$work/estimator" \
                       --checkpoint "$work/checkpoint.yaml" ;;
     evaluator) set -- "$bin/sim_evaluator" --dds-config "$cfg/slam_estimator.yaml" --out "$work/evaluator" \
@@ -58,7 +69,7 @@ start() {  # start NAME: the process NAME in the background, output appended to 
 fail() { echo "FAIL: $*"; exit 1; }
 alive() { kill -0 "${pid_of[$1]}" 2>/dev/null; }
 
-for p in logger slam_estimator evaluator encoder_bridge pixy_bridge; do start "$p"; done
+for p in logger logger_full slam_estimator evaluator encoder_bridge pixy_bridge; do start "$p"; done
 sleep 1
 start robot_sim
 t0=$(date +%s.%N)
@@ -93,17 +104,34 @@ robot_status=0
 wait "${pid_of[robot_sim]}" || robot_status=$?
 sleep 2  # the last samples reach the estimator, evaluator and logger
 declare -A status_of
-for p in encoder_bridge pixy_bridge slam_estimator evaluator logger; do
+for p in encoder_bridge pixy_bridge slam_estimator evaluator logger logger_full; do
   alive "$p" || { tail -20 "$work/$p.log"; fail "$p is not running at the end of the run"; }
   kill -INT "${pid_of[$p]}"
   status_of[$p]=0
   wait "${pid_of[$p]}" || status_of[$p]=$?
 done
-for p in robot_sim encoder_bridge pixy_bridge slam_estimator evaluator logger; do
+for p in robot_sim encoder_bridge pixy_bridge slam_estimator evaluator logger logger_full; do
   grep -v "robot_sim: t [0-9]* s, \|status: " "$work/$p.log" | sed "s/^/[$p] /"
 done
 [[ $robot_status -eq 0 ]] || fail "robot_sim exited with $robot_status"
-for p in "${!status_of[@]}"; do [[ ${status_of[$p]} -eq 0 ]] || fail "$p exited with ${status_of[$p]}"; done
+for p in "${!status_of[@]}"; do
+  [[ $p == logger_full ]] && continue
+  [[ ${status_of[$p]} -eq 0 ]] || fail "$p exited with ${status_of[$p]}"
+done
+
+# The logger on the full disk: ran to the end, exit 1 naming the failures, and
+# every file it wrote readable up to its failure.
+[[ ${status_of[logger_full]} -eq 1 ]] || fail "logger_full exited with ${status_of[logger_full]} (expected 1)"
+grep -q "write failure(s), samples lost while not recording" "$work/logger_full.log" ||
+  fail "logger_full did not report its write failures"
+full_files=0 full_states=0
+for f in "$work"/full/run*.mcap; do
+  n=$("$bin/pixyslam_log" print "$f" --topic pixyslam/map_state --json 2>/dev/null | wc -l || true)
+  [[ $n -gt 0 ]] || fail "$f (written on the full disk) holds no readable MapState"
+  full_files=$((full_files + 1)) full_states=$((full_states + n))
+done
+[[ $full_files -ge 3 ]] || fail "logger_full wrote $full_files file(s): expected a new one after each failure"
+echo "full disk: $full_files files of at most $full_kb KB, $full_states MapStates readable, $(grep -c 'logger: ERROR' "$work/logger_full.log") write failures"
 
 # Both logs readable: the killed logger's file loses at most its open chunk.
 for f in "$work/run_1.mcap" "$work/run_2.mcap"; do
