@@ -34,17 +34,31 @@ DdsOptions loopback_options() {
   return o;
 }
 
+// A reader that keeps every message it receives; wait_for(n) waits until it has n.
+template <class Message>
+struct Collector {
+  explicit Collector(Participant& participant)
+      : reader(participant, [this](const Message& m) {
+          std::lock_guard<std::mutex> lock(mutex);
+          got.push_back(m);
+          cv.notify_all();
+        }) {}
+  bool wait_for(std::size_t n) {
+    std::unique_lock<std::mutex> lock(mutex);
+    return cv.wait_for(lock, std::chrono::seconds(10), [&] { return got.size() >= n; });
+  }
+  std::mutex mutex;
+  std::condition_variable cv;
+  std::vector<Message> got;
+  Reader<Message> reader;  // last: its callback uses the members above
+};
+
 TEST(DdsLoopback, EveryOdometryMessageArrivesInOrder) {
   Participant sender(loopback_options(), "test_sender");
   Participant receiver(loopback_options(), "test_receiver");
-  std::mutex mutex;
-  std::condition_variable cv;
-  std::vector<msg::Odometry> got;
-  Reader<msg::Odometry> reader(receiver, [&](const msg::Odometry& m) {
-    std::lock_guard<std::mutex> lock(mutex);
-    got.push_back(m);
-    cv.notify_all();
-  });
+  Collector<msg::Odometry> collected(receiver);
+  const std::vector<msg::Odometry>& got = collected.got;
+  const Reader<msg::Odometry>& reader = collected.reader;
   Writer<msg::Odometry> writer(sender);
   ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(10)));
 
@@ -55,9 +69,9 @@ TEST(DdsLoopback, EveryOdometryMessageArrivesInOrder) {
     m.v_mps(0.01 * i);
     ASSERT_TRUE(writer.publish(m));
   }
-  std::unique_lock<std::mutex> lock(mutex);
-  ASSERT_TRUE(cv.wait_for(lock, std::chrono::seconds(10), [&] { return got.size() == kCount; }))
-      << "received " << got.size();
+  ASSERT_TRUE(collected.wait_for(kCount)) << "received " << got.size();
+  std::lock_guard<std::mutex> lock(collected.mutex);
+  ASSERT_EQ(got.size(), static_cast<std::size_t>(kCount));
   for (int i = 0; i < kCount; ++i) {
     EXPECT_EQ(got[i].header().seq(), static_cast<std::uint64_t>(i + 1));
     EXPECT_EQ(got[i].header().robot_id(), "test_robot");
@@ -79,14 +93,9 @@ std::vector<std::uint8_t> odometry_bytes(std::uint64_t seq) {
 TEST(DdsLoopback, MalformedSamplesAreCountedAndDroppedAndTheReaderGoesOn) {
   Participant sender(loopback_options(), "test_hostile_sender");
   Participant receiver(loopback_options(), "test_receiver");
-  std::mutex mutex;
-  std::condition_variable cv;
-  std::vector<msg::Odometry> got;
-  Reader<msg::Odometry> reader(receiver, [&](const msg::Odometry& m) {
-    std::lock_guard<std::mutex> lock(mutex);
-    got.push_back(m);
-    cv.notify_all();
-  });
+  Collector<msg::Odometry> collected(receiver);
+  const std::vector<msg::Odometry>& got = collected.got;
+  const Reader<msg::Odometry>& reader = collected.reader;
   test_support::RawSampleWriter<msg::Odometry> hostile(sender);
   ASSERT_TRUE(hostile.wait_for_readers(1, std::chrono::seconds(10)));
 
@@ -95,8 +104,9 @@ TEST(DdsLoopback, MalformedSamplesAreCountedAndDroppedAndTheReaderGoesOn) {
   ASSERT_TRUE(hostile.write(odometry_bytes(1)));             // a valid one after them
   ASSERT_TRUE(hostile.write(odometry_bytes(1ull << 40)));   // hostile seq: a jump, not lost messages
   ASSERT_TRUE(hostile.write(odometry_bytes((1ull << 40) + 3)));  // then 2 really lost
-  std::unique_lock<std::mutex> lock(mutex);
-  ASSERT_TRUE(cv.wait_for(lock, std::chrono::seconds(10), [&] { return got.size() == 3; })) << got.size();
+  ASSERT_TRUE(collected.wait_for(3)) << got.size();
+  std::lock_guard<std::mutex> lock(collected.mutex);
+  ASSERT_EQ(got.size(), 3u);
   EXPECT_DOUBLE_EQ(got[0].v_mps(), 0.25);
   EXPECT_EQ(got[0].header().robot_id(), "hostile");
   EXPECT_EQ(reader.malformed(), bad.size());

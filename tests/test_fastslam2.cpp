@@ -215,6 +215,15 @@ sim::WorldRun noisy_world(std::uint64_t seed, double v_sigma_mps, double w_sigma
   return sim::simulate(w);
 }
 
+// Drops the camera frames of [from_s, to_s] (a blind stretch).
+void blind_camera(sim::WorldRun& run, double from_s, double to_s) {
+  std::vector<ObservationFrame> kept;
+  for (const ObservationFrame& f : run.frames) {
+    if (f.t_s < from_s || f.t_s > to_s) kept.push_back(f);
+  }
+  run.frames = std::move(kept);
+}
+
 // The filter's mean pose after every odometry sample of the run.
 std::vector<eval::TimedPose> estimated_trajectory(FastSlam2& f, const sim::WorldRun& run) {
   std::vector<eval::TimedPose> est;
@@ -331,11 +340,7 @@ TEST(FastSlam2, DelayedSamplingThroughACameraGap) {
   for (int r = 1; r <= 5; ++r) {
     sim::WorldOptions w;
     sim::WorldRun run = noisy_world(200 + r, 0.1, 0.15, w);
-    std::vector<ObservationFrame> kept;
-    for (const ObservationFrame& f : run.frames) {
-      if (f.t_s < 20.0 || f.t_s > 60.0) kept.push_back(f);
-    }
-    run.frames = kept;
+    blind_camera(run, 20.0, 60.0);
     auto ate_of = [&](bool delayed, FilterCounters* counters, PoseEstimate* last) {
       FilterOptions o = options_for_world(w, 100, static_cast<std::uint64_t>(r));
       o.delayed_sampling.enabled = delayed;
@@ -379,11 +384,7 @@ TEST(FastSlam2, FrameUncertaintyFloorsTheCovarianceAndLeavesTheEstimatesAlone) {
   for (int r = 1; r <= 3; ++r) {
     sim::WorldOptions w;
     sim::WorldRun run = noisy_world(300 + r, 0.05, 0.1, w);
-    std::vector<ObservationFrame> kept;
-    for (const ObservationFrame& f : run.frames) {
-      if (f.t_s >= 30.0) kept.push_back(f);
-    }
-    run.frames = kept;
+    blind_camera(run, 0.0, 30.0);
     FilterOptions o = options_for_world(w, 100, static_cast<std::uint64_t>(r));
     FastSlam2 without(o, run.initial_pose);
     o.frame_uncertainty = true;
