@@ -1,7 +1,7 @@
 // mrclam_eval: the accuracy table of the FastSLAM core on MRCLAM, one parameter
 // set for every robot, several seeds per robot.
 //   mrclam_eval --dataset DIR --config FILE [--robots 1,2,3,4,5] [--seeds 1,2,3]
-//               [--association known_id|maximum_likelihood] [--segments SECONDS]
+//               [--association known_id|maximum_likelihood] [--segments SECONDS] [--loro]
 // --association maximum_likelihood withholds the landmark ids from the filter
 // (the landmark columns then match nothing by id; ATE and heading still count).
 // Every run also reports the pose NEES against the truth (3 dof, ideal mean 3).
@@ -10,6 +10,15 @@
 // s of truth after it), each running to the end of the robot's data: one line
 // per segment, then count, mean, median, p90 and worst ATE and heading RMSE and
 // the pooled NEES per robot and over all segments (docs/mrclam.md).
+// --loro (leave one robot out) adds, per robot of --robots with ground truth:
+// the `mrclam:` corrections fitted (apps/slam_offline/mrclam_fit.h) on the
+// OTHER robots of the data set with ground truth (of 1..5, whatever --robots
+// says), then the filter on this robot with the config's filter options and
+// each seed, with the fitted corrections, the config's `mrclam:` values (the
+// main table's runs) and neutral corrections (1, 0, 0, 1, 0): ATE and heading
+// RMSE of each, per robot (means over the seeds) and the mean over robots. The
+// fit on all robots with ground truth is printed first. With --segments, the
+// segment statistics of the three corrections per robot too.
 // Exit codes: 0 done, 77 dataset folder absent (skip), 1 error,
 // 3 a robot's mean ATE is not better than dead reckoning.
 #include <algorithm>
@@ -18,12 +27,14 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <map>
 #include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "mrclam_dataset.h"
+#include "mrclam_fit.h"
 #include "offline_run.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/slam/slam_options_yaml.h"
@@ -48,7 +59,17 @@ std::vector<int> parse_list(const std::string& text) {
 
 constexpr const char* kUsage =
     "usage: mrclam_eval --dataset DIR --config FILE [--robots 1,2] [--seeds 1,2] "
-    "[--association known_id|maximum_likelihood] [--segments SECONDS]";
+    "[--association known_id|maximum_likelihood] [--segments SECONDS] [--loro]\n"
+    "  --dataset DIR      MRCLAM data set folder (exit 77 when absent)\n"
+    "  --config FILE      filter options (filter:) and corrections (mrclam:)\n"
+    "  --robots LIST      robots to run, default 1,2,3,4,5\n"
+    "  --seeds LIST       filter seeds per robot, default 1,2,3\n"
+    "  --association M    known_id (default) or maximum_likelihood (ids withheld)\n"
+    "  --segments S       also restart each robot from the ground truth every S seconds\n"
+    "  --loro             leave one robot out: per robot with ground truth, the mrclam:\n"
+    "                     corrections fitted on the other robots with ground truth;\n"
+    "                     ATE and heading RMSE with that fit, with the config's mrclam:\n"
+    "                     values and with neutral corrections (1, 0, 0, 1, 0)";
 
 double parse_seconds(const std::string& text) {
   char* end = nullptr;
@@ -114,10 +135,183 @@ std::vector<Segment> run_segments(const slam::FilterOptions& options, const offl
   return out;
 }
 
+// ATE and heading RMSE (deg) of one full run.
+struct RunScore {
+  double ate_m = 0.0;
+  double heading_deg = 0.0;
+};
+
+offline::MrclamSensorModel model_of(const mrclam::CorrectionFit& f) {
+  offline::MrclamSensorModel m;
+  m.range_scale = f.range.range_scale;
+  m.range_cos_bearing_exponent = f.range.cos_bearing_exponent;
+  m.odometry_delay_s = f.delay.delay_s;
+  m.speed_scale = f.speed.speed_scale;
+  m.speed_loss_per_radps = f.speed.speed_loss_per_radps;
+  return m;
+}
+
+std::string robot_list(const std::vector<const mrclam::RobotData*>& robots) {
+  std::string out;
+  for (const mrclam::RobotData* r : robots) out += (out.empty() ? "" : ",") + std::to_string(r->robot);
+  return out;
+}
+
+void print_fit(const std::string& label, const mrclam::CorrectionFit& f) {
+  std::printf("%s: range_scale %.4f range_cos_bearing_exponent %.3f odometry_delay_s %.2f speed_scale %.4f "
+              "speed_loss_per_radps %.3f\n",
+              label.c_str(), f.range.range_scale, f.range.cos_bearing_exponent, f.delay.delay_s, f.speed.speed_scale,
+              f.speed.speed_loss_per_radps);
+  std::printf("%*s  range: %zu detections, %zu inliers; range error robust sd %.3f m (uncorrected %.3f m), RMS %.3f m "
+              "(uncorrected %.3f m); bearing error robust sd %.4f rad, RMS %.4f rad, median %+.4f rad\n",
+              static_cast<int>(label.size()), "", f.range.samples, f.range.inliers, f.range.range_sigma_m,
+              f.range.range_sigma_before_m, f.range.range_rms_m, f.range.range_rms_before_m, f.range.bearing_sigma_rad,
+              f.range.bearing_rms_rad, f.range.bearing_median_rad);
+  std::printf("%*s  delay: correlation %.4f (%.4f at %.2f s), %zu samples; speed: %zu windows, %zu inliers, "
+              "residual robust sd %.4f m/s\n",
+              static_cast<int>(label.size()), "", f.delay.correlation, f.delay.correlation_at_zero,
+              f.delay.lags_s.empty() ? 0.0 : f.delay.lags_s.front(), f.delay.samples, f.speed.samples,
+              f.speed.inliers, f.speed.sigma_mps);
+}
+
+// mrclam_eval --loro (see the top of this file). `config_scores[robot]` holds
+// the main table's runs (config corrections, one per seed), `config_segments`
+// the segments run with them (empty without --segments).
+void run_loro(const std::string& dataset, slam::FilterOptions options, const offline::MrclamSensorModel& config_model,
+              const std::vector<int>& robots, const std::vector<int>& seeds, double segment_every_s,
+              const std::map<int, std::vector<RunScore>>& config_scores,
+              const std::map<int, std::vector<Segment>>& config_segments) {
+  constexpr double kDeg = 180.0 / M_PI;
+  std::printf("\nLORO: leave one robot out: the mrclam: corrections fitted on the other robots with ground truth\n");
+  std::vector<mrclam::RobotData> pool;
+  for (int r = 1; r <= 5; ++r) {
+    mrclam::RobotData d = mrclam::load_robot(dataset, r);
+    if (!d.groundtruth.empty()) pool.push_back(std::move(d));
+  }
+  if (pool.size() < 2) {
+    std::printf("LORO: %zu robot(s) with ground truth in %s: nothing to leave out\n", pool.size(), dataset.c_str());
+    return;
+  }
+  std::vector<const mrclam::RobotData*> all;
+  for (const mrclam::RobotData& d : pool) all.push_back(&d);
+  print_fit("fit on robots " + robot_list(all), mrclam::fit_corrections(all));
+  std::printf("config mrclam:        range_scale %.4f range_cos_bearing_exponent %.3f odometry_delay_s %.2f "
+              "speed_scale %.4f speed_loss_per_radps %.3f\n",
+              config_model.range_scale, config_model.range_cos_bearing_exponent, config_model.odometry_delay_s,
+              config_model.speed_scale, config_model.speed_loss_per_radps);
+  const offline::MrclamSensorModel neutral;  // 1, 0, 0, 1, 0
+
+  struct RobotRow {
+    int robot = 0;
+    std::string fitted_on;
+    offline::MrclamSensorModel fit;
+    RunScore loro, config, neutral;  // means over the seeds
+    std::vector<Segment> loro_segments, neutral_segments;
+  };
+  std::vector<RobotRow> rows;
+  std::printf("%-6s %-5s %9s %9s %9s %10s %10s %10s\n", "robot", "seed", "ATE_loro", "ATE_cfg", "ATE_neut",
+              "head_loro", "head_cfg", "head_neut");
+  for (int robot : robots) {
+    const auto held_out = std::find_if(pool.begin(), pool.end(), [&](const auto& d) { return d.robot == robot; });
+    if (held_out == pool.end()) {
+      std::printf("robot %d: no ground truth, not evaluated\n", robot);
+      continue;
+    }
+    std::vector<const mrclam::RobotData*> others;
+    for (const mrclam::RobotData& d : pool) {
+      if (d.robot != robot) others.push_back(&d);
+    }
+    RobotRow row;
+    row.robot = robot;
+    row.fitted_on = robot_list(others);
+    const mrclam::CorrectionFit fit = mrclam::fit_corrections(others);
+    print_fit("loro robot " + std::to_string(robot) + ", fit on robots " + row.fitted_on, fit);
+    row.fit = model_of(fit);
+    const offline::RunInput with_fit = offline::mrclam_input(*held_out, row.fit);
+    const offline::RunInput with_neutral = offline::mrclam_input(*held_out, neutral);
+    const auto config_it = config_scores.find(robot);
+    for (std::size_t i = 0; i < seeds.size(); ++i) {
+      options.seed = static_cast<std::uint64_t>(seeds[i]);
+      RunScore score[3];
+      const offline::RunInput* inputs[2] = {&with_fit, &with_neutral};
+      for (int m = 0; m < 2; ++m) {
+        const offline::RunResult res = offline::run_filter(options, *inputs[m]);
+        const offline::Report rep = offline::evaluate(*inputs[m], res);
+        score[m == 0 ? 0 : 2] = {rep.filter.ate_rmse_m, rep.filter.heading_rmse_rad * kDeg};
+      }
+      if (config_it != config_scores.end() && i < config_it->second.size()) score[1] = config_it->second[i];
+      std::printf("%-6d %-5d %9.3f %9.3f %9.3f %10.2f %10.2f %10.2f\n", robot, seeds[i], score[0].ate_m,
+                  score[1].ate_m, score[2].ate_m, score[0].heading_deg, score[1].heading_deg, score[2].heading_deg);
+      std::fflush(stdout);
+      const double n = static_cast<double>(seeds.size());
+      row.loro.ate_m += score[0].ate_m / n;
+      row.loro.heading_deg += score[0].heading_deg / n;
+      row.config.ate_m += score[1].ate_m / n;
+      row.config.heading_deg += score[1].heading_deg / n;
+      row.neutral.ate_m += score[2].ate_m / n;
+      row.neutral.heading_deg += score[2].heading_deg / n;
+      if (segment_every_s > 0.0) {
+        for (const Segment& g : run_segments(options, with_fit, robot, segment_every_s)) row.loro_segments.push_back(g);
+        for (const Segment& g : run_segments(options, with_neutral, robot, segment_every_s)) {
+          row.neutral_segments.push_back(g);
+        }
+      }
+    }
+    rows.push_back(std::move(row));
+  }
+  if (rows.empty()) return;
+
+  std::printf("\nLORO table (means over seeds %s; fit: corrections fitted on the other robots)\n",
+              [&] {
+                std::string s;
+                for (int seed : seeds) s += (s.empty() ? "" : ",") + std::to_string(seed);
+                return s;
+              }()
+                  .c_str());
+  std::printf("%-6s %-10s %8s %6s %7s %8s %7s %9s %9s %9s %10s %10s %10s\n", "robot", "fit_on", "r_scale", "r_exp",
+              "delay_s", "v_scale", "v_loss", "ATE_loro", "ATE_cfg", "ATE_neut", "head_loro", "head_cfg", "head_neut");
+  RunScore mean_loro, mean_config, mean_neutral;
+  const double n = static_cast<double>(rows.size());
+  for (const RobotRow& r : rows) {
+    std::printf("%-6d %-10s %8.4f %6.3f %7.2f %8.4f %7.3f %9.3f %9.3f %9.3f %10.2f %10.2f %10.2f\n", r.robot,
+                r.fitted_on.c_str(), r.fit.range_scale, r.fit.range_cos_bearing_exponent, r.fit.odometry_delay_s,
+                r.fit.speed_scale, r.fit.speed_loss_per_radps, r.loro.ate_m, r.config.ate_m, r.neutral.ate_m,
+                r.loro.heading_deg, r.config.heading_deg, r.neutral.heading_deg);
+    mean_loro.ate_m += r.loro.ate_m / n;
+    mean_loro.heading_deg += r.loro.heading_deg / n;
+    mean_config.ate_m += r.config.ate_m / n;
+    mean_config.heading_deg += r.config.heading_deg / n;
+    mean_neutral.ate_m += r.neutral.ate_m / n;
+    mean_neutral.heading_deg += r.neutral.heading_deg / n;
+  }
+  std::printf("LORO MEAN over %zu robots: ATE %.3f m with the held-out fit, %.3f m with the config's mrclam:, %.3f m "
+              "neutral; heading RMSE %.2f / %.2f / %.2f deg\n",
+              rows.size(), mean_loro.ate_m, mean_config.ate_m, mean_neutral.ate_m, mean_loro.heading_deg,
+              mean_config.heading_deg, mean_neutral.heading_deg);
+  if (segment_every_s > 0.0) {
+    std::printf("\nLORO SEGMENTS (restarted from the truth every %.0f s):\n", segment_every_s);
+    std::vector<Segment> all_loro, all_config, all_neutral;
+    for (const RobotRow& r : rows) {
+      const auto c = config_segments.find(r.robot);
+      const std::vector<Segment> config = c == config_segments.end() ? std::vector<Segment>{} : c->second;
+      print_segment_summary("loro segments robot " + std::to_string(r.robot) + " fit    ", r.loro_segments);
+      print_segment_summary("loro segments robot " + std::to_string(r.robot) + " config ", config);
+      print_segment_summary("loro segments robot " + std::to_string(r.robot) + " neutral", r.neutral_segments);
+      all_loro.insert(all_loro.end(), r.loro_segments.begin(), r.loro_segments.end());
+      all_config.insert(all_config.end(), config.begin(), config.end());
+      all_neutral.insert(all_neutral.end(), r.neutral_segments.begin(), r.neutral_segments.end());
+    }
+    print_segment_summary("LORO SEGMENTS all robots fit    ", all_loro);
+    print_segment_summary("LORO SEGMENTS all robots config ", all_config);
+    print_segment_summary("LORO SEGMENTS all robots neutral", all_neutral);
+  }
+}
+
 int run(int argc, char** argv) {
   std::string dataset, config_path, association;
   std::vector<int> robots{1, 2, 3, 4, 5}, seeds{1, 2, 3};
   double segment_every_s = 0.0;  // 0: no segments
+  bool loro = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
@@ -125,8 +319,14 @@ int run(int argc, char** argv) {
       return 0;
     }
   }
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string key = argv[i], value = argv[i + 1];
+  for (int i = 1; i < argc; ++i) {
+    const std::string key = argv[i];
+    if (key == "--loro") {
+      loro = true;
+      continue;
+    }
+    if (i + 1 >= argc) throw std::invalid_argument(kUsage);
+    const std::string value = argv[++i];
     if (key == "--dataset") dataset = value;
     else if (key == "--config") config_path = value;
     else if (key == "--robots") robots = parse_list(value);
@@ -135,7 +335,7 @@ int run(int argc, char** argv) {
     else if (key == "--segments") segment_every_s = parse_seconds(value);
     else throw std::invalid_argument("unknown argument '" + key + "'\n" + kUsage);
   }
-  if (argc % 2 == 0 || dataset.empty() || config_path.empty()) throw std::invalid_argument(kUsage);
+  if (dataset.empty() || config_path.empty()) throw std::invalid_argument(kUsage);
   if (!std::filesystem::is_directory(dataset)) {
     std::printf("SKIP: dataset folder %s not found\n", dataset.c_str());
     return 77;
@@ -160,6 +360,8 @@ int run(int argc, char** argv) {
   int runs = 0;
   offline::NeesStats nees_all;
   std::vector<std::pair<int, offline::RunInput>> inputs;  // kept for the segments
+  std::map<int, std::vector<RunScore>> config_scores;     // kept for --loro
+  std::map<int, std::vector<Segment>> config_segments;
   for (int robot : robots) {
     const mrclam::RobotData data = mrclam::load_robot(dataset, robot);
     const offline::RunInput input = offline::mrclam_input(data, model);
@@ -176,6 +378,7 @@ int run(int argc, char** argv) {
                   res.landmarks.size(), res.wall_time_s, rep.nees.mean(), 100.0 * rep.nees.fraction_inside(),
                   100.0 * rep.nees.fraction_below_upper());
       std::fflush(stdout);
+      config_scores[robot].push_back({rep.filter.ate_rmse_m, rep.filter.heading_rmse_rad * kDeg});
       robot_ate += rep.filter.ate_rmse_m;
       robot_dr += rep.dead_reckoning.ate_rmse_m;
       sum_ate += rep.filter.ate_rmse_m;
@@ -225,6 +428,7 @@ int run(int argc, char** argv) {
         }
       }
       print_segment_summary("segments robot " + std::to_string(robot), of_robot);
+      config_segments[robot] = of_robot;
       all.insert(all.end(), of_robot.begin(), of_robot.end());
     }
     if (!all.empty()) {
@@ -235,6 +439,9 @@ int run(int argc, char** argv) {
       std::printf("worst segment: robot %d seed %d start %.1f s: ATE %.3f m, heading RMSE %.2f deg\n", worst.robot,
                   worst.seed, worst.start_s, worst.errors.ate_rmse_m, worst.errors.heading_rmse_rad * kDeg);
     }
+  }
+  if (loro) {
+    run_loro(dataset, options, model, robots, seeds, segment_every_s, config_scores, config_segments);
   }
   if (!all_better) {
     std::printf("FAIL: some robot's mean ATE is not better than dead reckoning\n");
