@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/eval/trajectory_metrics.h"
 #include "pixyslam/sim/sim_world.h"
 #include "pixyslam/slam_node/estimator_node.h"
@@ -198,6 +199,23 @@ TEST(EstimatorNode, ResumesFromItsCheckpointAfterARestart) {
   const eval::TrajectoryErrors errors_after = eval::compare_trajectory(after, run.truth);
   EXPECT_LT(errors_before.ate_rmse_m, 0.15);
   EXPECT_LT(errors_after.ate_rmse_m, 0.15);
+}
+
+// Was: a directory as the checkpoint file escaped as std::ios_base::failure (exit 1,
+// the path not named); now a ConfigError before anything starts.
+TEST(EstimatorNode, CheckpointPathThatIsADirectoryIsAConfigError) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("pixyslam_ckpt_is_dir_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  EstimatorOptions options = test_options();
+  options.checkpoint.file = dir.string();
+  try {
+    EstimatorNode node(options);
+    ADD_FAILURE() << "started with a directory as the checkpoint file";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(dir.string() + ": not a regular file"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
 }
 
 // A checkpoint older than max_age_s belongs to another run: ignored.

@@ -91,6 +91,40 @@ TEST(MapCheckpoint, WriteReplacesTheFileWholeAndLeavesNoTemporary) {
   std::filesystem::remove_all(dir);
 }
 
+// Was: yaml-cpp read the directory through an ifstream and std::ios_base::failure
+// escaped the estimator's start (exit 1, the path not named).
+TEST(MapCheckpoint, DirectoryIsAConfigErrorNamingIt) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("pixyslam_ckpt_dir_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  try {
+    read_map_checkpoint(dir.string());
+    ADD_FAILURE() << "read a directory as a checkpoint";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(dir.string() + ": not a regular file"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// A checkpoint may be larger than the 1 MiB limit of a configuration file.
+TEST(MapCheckpoint, ACheckpointOverTheConfigFileLimitStillLoads) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("pixyslam_ckpt_big_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "c.yaml").string();
+  MapCheckpoint c = sample_checkpoint();
+  c.landmarks.clear();
+  for (int id = 0; id < 8000; ++id) {
+    c.landmarks.push_back({id, Eigen::Vector2d(id * 0.123456789, -id * 0.987654321),
+                           (Eigen::Matrix2d() << 0.0031234567, 0.0011234567, 0.0011234567, 0.0021234567).finished(),
+                           1000u + static_cast<std::uint32_t>(id)});
+  }
+  write_map_checkpoint(path, c);
+  ASSERT_GT(std::filesystem::file_size(path), config::kMaxConfigFileBytes);
+  EXPECT_EQ(read_map_checkpoint(path).landmarks.size(), 8000u);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(MapCheckpoint, ResumePoseWidensWithTheGap) {
   const MapCheckpoint c = sample_checkpoint();
   const slam::PoseGaussian now = resume_pose(c, 0.0, 0.5, 1.0);

@@ -1,6 +1,13 @@
 // Tests of config::YamlReader: typed access, defaults, required keys, unknown-key
-// detection and strict scalar parsing.
+// detection, strict scalar parsing, and hostile files (directories, FIFOs, oversize
+// files, duplicate keys).
 
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -223,6 +230,158 @@ TEST(YamlReader, NonScalarKeyIsAConfigErrorNamingTheLine) {
     EXPECT_NE(m.find("line 3"), std::string::npos) << m;
   }
   EXPECT_THROW(filter.keys(), ConfigError);
+}
+
+}  // namespace
+}  // namespace pixyslam::config
+
+// Issue 18 (hostile or unlucky config input): every problem is a ConfigError
+// naming the file, never a crash or a silently ignored setting.
+namespace pixyslam::config {
+namespace {
+
+// A fresh temporary directory, removed with everything in it at the end of the test.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "pixyslam_yaml_XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  std::string file(const std::string& name, const std::string& text) const {
+    const std::string p = (path_ / name).string();
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+  std::string path() const { return path_.string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// Was: yaml-cpp read the directory through an ifstream and std::ios_base::failure
+// escaped (encoder_bridge, pixy_bridge and logger aborted, exit 134).
+TEST(YamlReaderFiles, DirectoryIsAConfigErrorNamingIt) {
+  const TempDir dir;
+  const std::string m = config_error_of([&] { YamlReader::from_file(dir.path()); });
+  EXPECT_TRUE(contains(m, dir.path() + ": not a regular file")) << m;
+  EXPECT_TRUE(contains(m, "directory")) << m;
+  const std::string t = config_error_of([&] { read_config_text(dir.path()); });
+  EXPECT_TRUE(contains(t, dir.path() + ": not a regular file")) << t;
+}
+
+// Was: YAML::LoadFile opened the FIFO and waited for a writer for ever.
+TEST(YamlReaderFiles, FifoIsRejectedWithoutWaitingForAWriter) {
+  const TempDir dir;
+  const std::string fifo = dir.path() + "/config.yaml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string m = config_error_of([&] { YamlReader::from_file(fifo); });
+  EXPECT_TRUE(contains(m, fifo + ": not a regular file")) << m;
+}
+
+// Was: no limit (48 MB of YAML took 4 GB of memory).
+TEST(YamlReaderFiles, FileOverTheSizeLimitIsRejectedBeforeParsing) {
+  const TempDir dir;
+  // A comment padded to exactly the limit still loads,
+  std::string text = "a: 1\n#";
+  text += std::string(kMaxConfigFileBytes - text.size() - 1, 'x') + "\n";
+  ASSERT_EQ(text.size(), kMaxConfigFileBytes);
+  const std::string at_limit = dir.file("at_limit.yaml", text);
+  EXPECT_EQ(YamlReader::from_file(at_limit).integer("a", 0, 5), 1);
+  // one byte more does not: the message names the file and both sizes.
+  const std::string over = dir.file("over.yaml", text + "\n");
+  const std::string m = config_error_of([&] { YamlReader::from_file(over); });
+  EXPECT_TRUE(contains(m, over + ": file is " + std::to_string(kMaxConfigFileBytes + 1) + " bytes")) << m;
+  EXPECT_TRUE(contains(m, std::to_string(kMaxConfigFileBytes))) << m;
+  // A caller with bigger files (checkpoints) passes its own limit.
+  EXPECT_EQ(YamlReader::from_file(over, 2 * kMaxConfigFileBytes).integer("a", 0, 5), 1);
+}
+
+TEST(YamlReaderFiles, MissingFileNamesTheFileAndTheReason) {
+  const std::string m = config_error_of([] { YamlReader::from_file("/nonexistent/dir/pixyslam_missing.yaml"); });
+  EXPECT_TRUE(contains(m, "/nonexistent/dir/pixyslam_missing.yaml: cannot open file")) << m;
+  EXPECT_TRUE(contains(m, "No such file")) << m;
+}
+
+// Was: accepted, the first value won (yaml-cpp keeps both; a lookup finds the first).
+TEST(YamlReaderDuplicates, DuplicateScalarKeyNamesKeyAndBothLines) {
+  const std::string m = config_error_of([] {
+    YamlReader::from_string("filter:\n  particles: 100\n  seed: 1\n  particles: 500\n", "dup.yaml");
+  });
+  EXPECT_TRUE(contains(m, "dup.yaml: key 'filter.particles': duplicate at line 4 (first at line 2)")) << m;
+}
+
+TEST(YamlReaderDuplicates, DuplicateSectionIsAnError) {
+  const std::string m = config_error_of([] {
+    YamlReader::from_string(
+        "filter:\n"
+        "  particles: 100\n"
+        "estimator:\n"
+        "  status_period_s: 5\n"
+        "filter:\n"
+        "  seed: 7\n",
+        "sections.yaml");
+  });
+  EXPECT_TRUE(contains(m, "sections.yaml: key 'filter': duplicate at line 5 (first at line 1)")) << m;
+}
+
+TEST(YamlReaderDuplicates, DuplicateInANestedMappingOfAFileNamesFilePathAndBothLines) {
+  const TempDir dir;
+  const std::string path = dir.file("nested.yaml",
+                                    "a: 1\n"
+                                    "outer:\n"
+                                    "  inner:\n"
+                                    "    x: 1\n"
+                                    "    y: 2\n"
+                                    "    # a comment\n"
+                                    "    x: 3\n");
+  const std::string m = config_error_of([&] { YamlReader::from_file(path); });
+  EXPECT_TRUE(contains(m, path + ": key 'outer.inner.x': duplicate at line 7 (first at line 4)")) << m;
+}
+
+TEST(YamlReaderDuplicates, DuplicateInAListItemAndOnOneLine) {
+  const std::string m = config_error_of([] {
+    YamlReader::from_string("processes:\n  - {name: a}\n  - {name: b, delay_s: 1, name: c}\n", "list.yaml");
+  });
+  EXPECT_TRUE(contains(m, "key 'processes[1].name': duplicate at line 3, column 27 (first at line 3, column 6)"))
+      << m;
+}
+
+TEST(YamlReaderDuplicates, SameKeyInDifferentMappingsAndAliasesAreFine) {
+  YamlReader r = YamlReader::from_string(
+      "a: {x: 1}\n"
+      "b: {x: 2}\n"
+      "c: &shared {x: 3}\n"
+      "d: *shared\n"
+      "e: [*shared, *shared]\n",
+      "ok.yaml");
+  EXPECT_EQ(r.child("d").integer("x", 0, 5), 3);
+}
+
+// A misspelt key with no value (null) is as unknown as one with a value.
+TEST(YamlReaderUnknownKeys, NullValuedTypoIsAnUnknownKey) {
+  for (const char* value : {"", " ~", " null"}) {
+    YamlReader top = YamlReader::from_string(std::string("known: 1\ntypo:") + value + "\n", "null_top.yaml");
+    EXPECT_EQ(top.integer("known", 0, 5), 1);
+    const std::string m = config_error_of([&] { top.finish(); });
+    EXPECT_TRUE(contains(m, "null_top.yaml: key 'typo': unknown key")) << value << ": " << m;
+
+    YamlReader root =
+        YamlReader::from_string(std::string("section:\n  typo:") + value + "\n  known: 2\n", "null_nested.yaml");
+    YamlReader section = root.child("section");
+    EXPECT_EQ(section.integer("known", 0, 5, 0), 2);
+    EXPECT_EQ(section.number("other", 0.0, 1.0, 0.5), 0.5);  // absent optional keys do not excuse it
+    const std::string n = config_error_of([&] { section.finish(); });
+    EXPECT_TRUE(contains(n, "null_nested.yaml: key 'section.typo': unknown key")) << value << ": " << n;
+  }
 }
 
 }  // namespace

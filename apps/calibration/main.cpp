@@ -105,7 +105,7 @@ std::vector<calibration::PoleSample> camera_samples(const app::CommandLine& args
 
 int calibrate_camera(const app::CommandLine& args) {
   const std::string config_path = args.get("config");
-  const std::string config_text = read_file(config_path);
+  const std::string config_text = config::read_config_text(config_path);  // regular file, size-capped
   config::YamlReader root = config::YamlReader::from_string(config_text, config_path);
   config::YamlReader pixy_yaml = root.child("pixy");
   const pixy::PixyOptions pixy = pixy::read_pixy_options(pixy_yaml);
@@ -172,8 +172,9 @@ int odometry(const app::CommandLine& args) {
   std::printf("  wheel_radius_m %.5f (was %.5f), wheel_base_m %.4f (was %.4f)\n", fit.wheel_radius_m,
               options.wheel_radius_m, fit.wheel_base_m, options.wheel_base_m);
   if (args.has("out")) {
-    std::string out = calibration::replace_yaml_value(read_file(config_path), "encoder_bridge", "wheel_radius_m",
-                                                      config::yaml_number(std::round(fit.wheel_radius_m * 1e6) / 1e6));
+    std::string out =
+        calibration::replace_yaml_value(config::read_config_text(config_path), "encoder_bridge", "wheel_radius_m",
+                                        config::yaml_number(std::round(fit.wheel_radius_m * 1e6) / 1e6));
     out = calibration::replace_yaml_value(out, "encoder_bridge", "wheel_base_m",
                                           config::yaml_number(std::round(fit.wheel_base_m * 1e5) / 1e5));
     write_file(args.get("out"), out);

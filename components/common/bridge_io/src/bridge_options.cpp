@@ -1,6 +1,7 @@
 #include "pixyslam/bridge/bridge_options.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 
@@ -28,11 +29,16 @@ void apply_command_line(const app::CommandLine& args, std::string& serial_device
   }
   if (args.has("dds-config")) dds.profiles_file = args.get("dds-config");
   const std::string& profiles = dds.profiles_file;
-  if (!profiles.empty() && !std::ifstream(profiles).good()) {
-    throw config::ConfigError((args.has("dds-config") ? std::string("--dds-config")
-                                                      : args.get("config") + ": key 'dds.profiles_file'") +
-                              ": cannot read '" + profiles + "'");
+  if (profiles.empty()) return;
+  const std::string where =
+      args.has("dds-config") ? std::string("--dds-config") : args.get("config") + ": key 'dds.profiles_file'";
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(profiles, ec);
+  if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) {
+    throw config::ConfigError(where + ": " + profiles + ": not a regular file" +
+                              (std::filesystem::is_directory(st) ? " (a directory)" : ""));
   }
+  if (!std::ifstream(profiles).good()) throw config::ConfigError(where + ": cannot read '" + profiles + "'");
 }
 
 std::string to_yaml_lines(const BridgeProcessOptions& o) {

@@ -1,12 +1,104 @@
 #include "pixyslam/config/yaml_reader.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <map>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 namespace pixyslam::config {
 namespace {
+
+// What a non-regular file is, for the error message.
+const char* file_kind(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a pipe";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a plain file";
+}
+
+[[noreturn]] void fail_not_regular(const std::string& path, mode_t mode) {
+  throw ConfigError(path + ": not a regular file (" + file_kind(mode) + ")");
+}
+
+[[noreturn]] void fail_too_large(const std::string& path, unsigned long long size, std::size_t max_bytes) {
+  throw ConfigError(path + ": file is " + std::to_string(size) + " bytes, more than the limit of " +
+                    std::to_string(max_bytes) + " bytes for a configuration file");
+}
+
+class FileDescriptor {
+ public:
+  explicit FileDescriptor(int fd) : fd_(fd) {}
+  ~FileDescriptor() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  FileDescriptor(const FileDescriptor&) = delete;
+  FileDescriptor& operator=(const FileDescriptor&) = delete;
+  int get() const { return fd_; }
+
+ private:
+  int fd_;
+};
+
+// The line of a mark, 1-based ("?" for a node built in code).
+std::string line_of(const YAML::Mark& mark) {
+  return mark.is_null() ? std::string("?") : std::to_string(mark.line + 1);
+}
+
+// Throws a ConfigError for the first key that appears twice in one mapping,
+// anywhere in the document. yaml-cpp keeps both entries of a duplicated key
+// (a lookup finds the first), so this walks every mapping's entries. Iterative
+// (no recursion on nesting), and every container is walked once: an alias
+// (*name) is the anchored node itself, recognised by its position in the text,
+// so neither "billion laughs" nor a self-referencing anchor multiplies the work.
+void reject_duplicate_keys(const YAML::Node& root, const std::string& origin) {
+  std::vector<std::pair<YAML::Node, std::string>> pending{{root, ""}};
+  std::set<std::pair<int, int>> visited;  // (position, type) of walked containers
+  while (!pending.empty()) {
+    const YAML::Node node = pending.back().first;
+    const std::string path = std::move(pending.back().second);
+    pending.pop_back();
+    if (!node.IsMap() && !node.IsSequence()) continue;
+    const YAML::Mark mark = node.Mark();
+    if (!mark.is_null() && !visited.insert({mark.pos, static_cast<int>(node.Type())}).second) continue;
+    if (node.IsSequence()) {
+      for (std::size_t i = 0; i < node.size(); ++i) {
+        pending.emplace_back(node[i], path + "[" + std::to_string(i) + "]");
+      }
+      continue;
+    }
+    std::map<std::string, YAML::Mark> seen;
+    for (const auto& kv : node) {
+      // A mapping or list used as a key is reported by key_text() when read.
+      if (!kv.first.IsScalar()) continue;
+      const std::string& key = kv.first.Scalar();
+      const std::string key_path = path.empty() ? key : path + "." + key;
+      const auto [first, inserted] = seen.emplace(key, kv.first.Mark());
+      if (!inserted) {
+        const YAML::Mark& a = first->second;
+        const YAML::Mark& b = kv.first.Mark();
+        // Both on one line ("{a: 1, a: 2}"): the columns tell them apart.
+        const bool same_line = !a.is_null() && !b.is_null() && a.line == b.line;
+        auto where = [&](const YAML::Mark& m) {
+          return "line " + line_of(m) + (same_line ? ", column " + std::to_string(m.column + 1) : std::string());
+        };
+        throw ConfigError(origin + ": key '" + key_path + "': duplicate at " + where(b) + " (first at " + where(a) +
+                          ")");
+      }
+      pending.emplace_back(kv.second, key_path);
+    }
+  }
+}
 
 std::string describe(const YAML::Node& node) {
   if (node.IsScalar()) return "'" + node.Scalar() + "'";
@@ -21,9 +113,8 @@ YamlReader parse(const std::string& origin, const Load& load) {
     YAML::Node root = load();
     if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
     if (!root.IsMap()) throw ConfigError(origin + ": top level must be a mapping of keys");
+    reject_duplicate_keys(root, origin);
     return YamlReader(root, origin, "");
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(origin + ": cannot open file");
   } catch (const YAML::ParserException& e) {
     std::ostringstream os;
     os << origin << ": YAML syntax error at line " << e.mark.line + 1 << ", column "
@@ -34,8 +125,42 @@ YamlReader parse(const std::string& origin, const Load& load) {
 
 }  // namespace
 
-YamlReader YamlReader::from_file(const std::string& path) {
-  return parse(path, [&] { return YAML::LoadFile(path); });
+std::string read_config_text(const std::string& path, std::size_t max_bytes) {
+  // stat() first: a directory, FIFO or device is never opened (opening a FIFO
+  // would wait for a writer); fstat() of the open file closes the race.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    throw ConfigError(path + ": cannot open file (" + std::strerror(errno) + ")");
+  }
+  if (!S_ISREG(st.st_mode)) fail_not_regular(path, st.st_mode);
+  const FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK));
+  if (fd.get() < 0) throw ConfigError(path + ": cannot open file (" + std::strerror(errno) + ")");
+  if (::fstat(fd.get(), &st) != 0) throw ConfigError(path + ": cannot read file (" + std::strerror(errno) + ")");
+  if (!S_ISREG(st.st_mode)) fail_not_regular(path, st.st_mode);
+  if (static_cast<unsigned long long>(st.st_size) > max_bytes) {
+    fail_too_large(path, static_cast<unsigned long long>(st.st_size), max_bytes);
+  }
+  // Read at most max_bytes + 1: a file that grew since fstat() is still caught.
+  std::string text(static_cast<std::size_t>(st.st_size) + 1, '\0');
+  std::size_t done = 0;
+  for (;;) {
+    if (done == text.size()) {
+      if (text.size() > max_bytes) fail_too_large(path, text.size(), max_bytes);
+      text.resize(std::min(max_bytes + 1, text.size() * 2));
+    }
+    const ssize_t n = ::read(fd.get(), &text[done], text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw ConfigError(path + ": cannot read file (" + std::strerror(errno) + ")");
+    if (n == 0) break;
+    done += static_cast<std::size_t>(n);
+  }
+  text.resize(done);
+  return text;
+}
+
+YamlReader YamlReader::from_file(const std::string& path, std::size_t max_bytes) {
+  const std::string text = read_config_text(path, max_bytes);
+  return parse(path, [&] { return YAML::Load(text); });
 }
 
 YamlReader YamlReader::from_string(const std::string& text, const std::string& origin) {

@@ -13,6 +13,17 @@ namespace pixyslam::slam_node {
 EstimatorNode::EstimatorNode(const EstimatorOptions& options)
     : options_(options), queue_(options.queue) {
   slam::validate(options_.filter);
+  if (!options_.checkpoint.file.empty()) {
+    // A directory (or device, FIFO) can be neither read nor replaced by rename():
+    // a configuration error now, not a failed write every period.
+    std::error_code ec;
+    const std::filesystem::file_status st = std::filesystem::status(options_.checkpoint.file, ec);
+    if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) {
+      throw config::ConfigError(options_.checkpoint.file + ": not a regular file (" +
+                                (std::filesystem::is_directory(st) ? "a directory" : "not a plain file") +
+                                "; estimator.checkpoint.file or --checkpoint)");
+    }
+  }
   participant_ = std::make_unique<dds::Participant>(options_.dds, "slam_estimator");
   map_writer_ = std::make_unique<dds::Writer<msg::MapState>>(*participant_);
   odometry_reader_ = std::make_unique<dds::Reader<msg::Odometry>>(

@@ -17,6 +17,9 @@ namespace {
 
 constexpr double kMaxCoordinate = 1e6;
 constexpr double kMaxVariance = 1e6;
+// A checkpoint is written by the estimator, not by hand: ~170 bytes per landmark,
+// so 16 MiB (~100000 landmarks) instead of the 1 MiB limit of a configuration file.
+constexpr std::size_t kMaxCheckpointFileBytes = std::size_t{16} << 20;
 
 using config::yaml_number;
 
@@ -98,7 +101,9 @@ MapCheckpoint parse_map_checkpoint(const std::string& text, const std::string& o
   return parse(config::YamlReader::from_string(text, origin));
 }
 
-MapCheckpoint read_map_checkpoint(const std::string& path) { return parse(config::YamlReader::from_file(path)); }
+MapCheckpoint read_map_checkpoint(const std::string& path) {
+  return parse(config::YamlReader::from_file(path, kMaxCheckpointFileBytes));
+}
 
 void write_map_checkpoint(const std::string& path, const MapCheckpoint& checkpoint) {
   const std::string text = to_yaml(checkpoint);

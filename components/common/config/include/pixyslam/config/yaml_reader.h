@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <initializer_list>
 #include <set>
@@ -19,14 +20,28 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The largest file from_file() reads by default (1 MiB; the shipped configs are
+// a few KiB). Checked before parsing: yaml-cpp needs ~85 bytes of memory per byte
+// of YAML, so 48 MB of text took 4 GB.
+inline constexpr std::size_t kMaxConfigFileBytes = std::size_t{1} << 20;
+
+// The text of the file at `path` for a YAML parse: a ConfigError naming the file
+// if it cannot be opened or read, is not a regular file (a directory, a FIFO, a
+// device: "<path>: not a regular file (a directory)") or is larger than
+// `max_bytes`. Nothing but ConfigError escapes.
+std::string read_config_text(const std::string& path, std::size_t max_bytes = kMaxConfigFileBytes);
+
 // Typed, validated access to one YAML mapping. Every key read is remembered;
 // finish() rejects keys that were never read, so a typo is an error, not a
 // silently ignored setting. Children share the file name and extend the key path.
 // Thread-compatible.
 class YamlReader {
  public:
-  // Parses a file; a syntax error names the file, line and column.
-  static YamlReader from_file(const std::string& path);
+  // Parses a file read with read_config_text(path, max_bytes); a syntax error
+  // names the file, line and column. Both parsers reject a key that appears twice
+  // in one mapping anywhere in the document (yaml-cpp would keep both and the
+  // first would win): "<file>: key 'a.b': duplicate at line 7 (first at line 3)".
+  static YamlReader from_file(const std::string& path, std::size_t max_bytes = kMaxConfigFileBytes);
   // Parses text (tests, embedded defaults); `origin` stands in for a file name.
   static YamlReader from_string(const std::string& text, const std::string& origin);
 
