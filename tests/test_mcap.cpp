@@ -1,7 +1,8 @@
 // Tests of the MCAP writer and reader (components/logger/core, docs/mcap.md):
 // CRC-32, exact bytes of small files against hand-computed records, round
-// trips in every mode, truncation at every byte, corruption, statistics and
-// error messages.
+// trips in every mode, truncation at every byte, corruption, statistics,
+// error messages, and damage: resynchronising past bad records, "not closed"
+// against "damaged".
 
 #include <algorithm>
 #include <cstdint>
@@ -421,6 +422,8 @@ TEST_P(McapTruncation, EveryByteOffset) {
     EXPECT_FALSE(rec.footer_present);
     EXPECT_FALSE(reader.clean());
     EXPECT_FALSE(reader.diagnostics().empty());
+    EXPECT_EQ(reader.state(), McapFileState::kNotClosed) << reader.diagnostics_text();
+    EXPECT_EQ(reader.damage().intact_until, last_end);
     EXPECT_EQ(rec.header_present, cut >= records.front().end);
     // A Footer without its closing magic ends the parse at the Footer.
     EXPECT_EQ(rec.valid_bytes, last_end);
@@ -477,10 +480,13 @@ TEST(McapRecovery, CopyOfOpenFileAndZeroTail) {
     ASSERT_FALSE(reader.diagnostics().empty());
     EXPECT_EQ(reader.diagnostics()[0].offset, snapshot.size() - 4096);
     EXPECT_NE(reader.diagnostics()[0].message.find("0x00"), std::string::npos);
+    EXPECT_EQ(reader.state(), McapFileState::kNotClosed) << reader.diagnostics_text();
   }
   writer.close();
   const McapReader reader(path);
   EXPECT_TRUE(reader.clean()) << reader.diagnostics_text();
+  EXPECT_EQ(reader.state(), McapFileState::kComplete);
+  EXPECT_TRUE(reader.damage().closed && reader.damage().summary_found && reader.damage().chunk_index_used);
   EXPECT_EQ(reader.messages().size(), 15u);
   EXPECT_EQ(reader.chunks().size(), 2u);
 }
@@ -751,6 +757,243 @@ TEST(McapWriter, DestructorClosesTheFile) {
   EXPECT_EQ(reader.messages().size(), 1000u);
   ASSERT_TRUE(reader.statistics().has_value());
   EXPECT_EQ(reader.statistics()->message_end_time_ns, 999u);
+}
+
+// ---- Damage: resynchronising past a bad record (docs/mcap.md, "Damage") ----
+
+// A log of `count` messages in many small chunks (zstd when built in).
+struct ManyChunks {
+  std::vector<McapMessage> written;
+  Bytes file;
+  std::vector<McapChunkInfo> chunks;  // as a clean read finds them
+  std::uint64_t data_end = 0;         // offset of the Data End record
+};
+
+ManyChunks write_many_chunks(const TempDir& dir, int count, McapCompression compression) {
+  ManyChunks out;
+  const std::string path = dir.file("many.mcap");
+  McapWriterOptions options;
+  options.chunk_size_bytes = 1024;
+  options.compression = compression;
+  out.written = write_sample(path, options, count);
+  out.file = read_bytes(path);
+  const McapReader good(out.file, "good");
+  EXPECT_TRUE(good.clean()) << good.diagnostics_text();
+  out.chunks = good.chunks();
+  for (const RecordSpan& r : top_level_records(out.file)) {
+    if (r.op == 0x0F) out.data_end = r.offset;
+  }
+  return out;
+}
+
+McapCompression zstd_if_built() {
+  return mcap_compression_available(McapCompression::kZstd) ? McapCompression::kZstd : McapCompression::kNone;
+}
+
+// The messages read are the written ones without those of `lost_chunk`
+// (none when it is SIZE_MAX), in order.
+void expect_all_but_chunk(const ManyChunks& log, const McapReader& reader, std::size_t lost_chunk) {
+  std::size_t first_lost = 0;
+  std::size_t lost = 0;
+  for (std::size_t i = 0; i < log.chunks.size(); ++i) {
+    if (i < lost_chunk) first_lost += log.chunks[i].message_count;
+    if (i == lost_chunk) lost = log.chunks[i].message_count;
+  }
+  ASSERT_EQ(reader.messages().size(), log.written.size() - lost) << reader.diagnostics_text();
+  for (std::size_t i = 0; i < reader.messages().size(); ++i) {
+    const McapMessage& expected = log.written[i < first_lost ? i : i + lost];
+    ASSERT_EQ(reader.messages()[i].sequence, expected.sequence) << i;
+    ASSERT_EQ(reader.messages()[i].data, expected.data) << i;
+  }
+}
+
+bool damage_recorded_at(const McapReader& reader, std::uint64_t offset) {
+  bool in_records = false;
+  for (const McapDamagedRecord& d : reader.damage().records) in_records = in_records || d.offset == offset;
+  bool in_diagnostics = false;
+  for (const McapDiagnostic& d : reader.diagnostics()) in_diagnostics = in_diagnostics || d.offset == offset;
+  return in_records && in_diagnostics;
+}
+
+// One chunk's length field damaged (beyond the end of the file, or a little
+// off): every other chunk is read, with and without the summary (which is cut
+// off in the second case, so that the reader has to scan). The chunk's own
+// header still gives its length and its CRC checks it, so it is read too;
+// damaging its records as well loses that chunk alone.
+TEST(McapDamage, CorruptChunkLengthLosesAtMostThatChunk) {
+  TempDir dir;
+  const ManyChunks log = write_many_chunks(dir, 3000, zstd_if_built());
+  ASSERT_GE(log.chunks.size(), 20u);
+  const std::size_t victim_index = log.chunks.size() / 2;
+  const McapChunkInfo& victim = log.chunks[victim_index];
+  for (const bool with_summary : {true, false}) {
+    for (const int length_byte : {1, 7}) {
+      for (const bool records_damaged : {false, true}) {
+        SCOPED_TRACE(std::string(with_summary ? "with summary" : "summary cut off") + ", length byte " +
+                     std::to_string(length_byte) + (records_damaged ? ", records damaged" : ""));
+        Bytes file = log.file;
+        file[victim.offset + 1 + static_cast<std::uint64_t>(length_byte)] ^= 0x40;
+        if (records_damaged) file[victim.offset + victim.length - 5] ^= 0x21;
+        if (!with_summary) file.resize(log.data_end);
+        const McapReader reader(file, "damaged");
+        expect_all_but_chunk(log, reader, records_damaged ? victim_index : SIZE_MAX);
+        EXPECT_EQ(reader.state(), McapFileState::kDamaged);
+        EXPECT_TRUE(damage_recorded_at(reader, victim.offset)) << reader.diagnostics_text();
+        EXPECT_EQ(reader.damage().intact_until, victim.offset);
+        EXPECT_EQ(reader.recovery().rejected_chunks, records_damaged ? 1u : 0u);
+        EXPECT_EQ(reader.recovery().complete_chunks, log.chunks.size() - (records_damaged ? 1 : 0));
+        EXPECT_EQ(reader.damage().footer_found, with_summary);
+        EXPECT_EQ(reader.damage().summary_found, with_summary);
+        EXPECT_EQ(reader.damage().chunk_index_used, with_summary);
+        EXPECT_EQ(reader.recovery().footer_present, with_summary);
+        EXPECT_FALSE(reader.damage().closed && !with_summary);
+      }
+    }
+  }
+}
+
+// The chunk's opcode and length both destroyed (zeros): with the chunk index
+// it is still found and read; without the summary the reader scans past it
+// to its Message Index records and loses only it.
+TEST(McapDamage, DestroyedChunkPrefixResynchronisesAtTheNextChunk) {
+  TempDir dir;
+  const ManyChunks log = write_many_chunks(dir, 1500, zstd_if_built());
+  const std::size_t victim_index = 3;
+  const McapChunkInfo& victim = log.chunks[victim_index];
+  for (const bool with_summary : {true, false}) {
+    SCOPED_TRACE(with_summary ? "with summary" : "summary cut off");
+    Bytes file = log.file;
+    std::fill(file.begin() + static_cast<std::ptrdiff_t>(victim.offset),
+              file.begin() + static_cast<std::ptrdiff_t>(victim.offset + 9), 0);
+    if (!with_summary) file.resize(log.data_end);
+    const McapReader reader(file, "damaged");
+    expect_all_but_chunk(log, reader, with_summary ? SIZE_MAX : victim_index);
+    EXPECT_EQ(reader.state(), McapFileState::kDamaged);
+    EXPECT_TRUE(damage_recorded_at(reader, victim.offset)) << reader.diagnostics_text();
+    if (!with_summary) {
+      // Skipped: the chunk, up to its Message Index records.
+      ASSERT_EQ(reader.damage().skipped.size(), 1u) << reader.diagnostics_text();
+      EXPECT_EQ(reader.damage().skipped[0].begin, victim.offset);
+      EXPECT_EQ(reader.damage().skipped[0].end, victim.offset + victim.length);
+      EXPECT_EQ(reader.damage().bytes_skipped, victim.length);
+    }
+  }
+}
+
+// A file cut in the middle of a chunk: not closed (not damaged), every chunk
+// before the cut read, "intact up to" the cut chunk.
+TEST(McapDamage, TruncatedMidChunkIsNotClosed) {
+  TempDir dir;
+  for (const McapCompression compression : {McapCompression::kNone, zstd_if_built()}) {
+    SCOPED_TRACE(mcap_compression_name(compression));
+    const ManyChunks log = write_many_chunks(dir, 1500, compression);
+    const std::size_t cut_chunk = log.chunks.size() - 4;
+    const McapChunkInfo& c = log.chunks[cut_chunk];
+    for (const std::uint64_t into : {std::uint64_t{5}, std::uint64_t{30}, c.length / 2, c.length - 1}) {
+      SCOPED_TRACE("cut " + std::to_string(into) + " bytes into the chunk");
+      const Bytes file(log.file.begin(), log.file.begin() + static_cast<std::ptrdiff_t>(c.offset + into));
+      const McapReader reader(file, "cut");
+      std::size_t expected = 0;
+      for (std::size_t i = 0; i < cut_chunk; ++i) expected += log.chunks[i].message_count;
+      expect_same_messages(log.written, reader.messages(), expected);
+      EXPECT_EQ(reader.state(), McapFileState::kNotClosed) << reader.diagnostics_text();
+      EXPECT_FALSE(reader.damage().closed);
+      EXPECT_FALSE(reader.damage().footer_found);
+      EXPECT_FALSE(reader.damage().summary_found);
+      EXPECT_TRUE(reader.damage().records.empty());
+      EXPECT_EQ(reader.damage().bytes_skipped, 0u);
+      EXPECT_EQ(reader.damage().intact_until, c.offset);
+      EXPECT_EQ(reader.recovery().valid_bytes, c.offset);
+      EXPECT_EQ(reader.recovery().rejected_chunks, 0u);
+    }
+  }
+}
+
+// Random bytes over the middle of an unchunked file (Message records straight
+// in the data section, no index): the reader scans to the first record after
+// them and reads everything from there on.
+TEST(McapDamage, GarbageInUnchunkedFileResumesAtTheNextRecord) {
+  TempDir dir;
+  const std::string path = dir.file("unchunked.mcap");
+  McapWriterOptions options;
+  options.chunk_size_bytes = 0;
+  const std::vector<McapMessage> written = write_sample(path, options, 400);
+  const Bytes good = read_bytes(path);
+  const std::vector<RecordSpan> records = top_level_records(good);
+  std::mt19937 prng(2024);
+  for (int trial = 0; trial < 20; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    Bytes file = good;
+    // From somewhere before record k's prefix to somewhere after it.
+    const std::size_t k = 20 + prng() % (records.size() - 60);
+    const std::uint64_t from = records[k].offset - prng() % 30;
+    const std::uint64_t to = records[k].offset + 9 + prng() % 100;
+    for (std::uint64_t i = from; i < to; ++i) file[i] = static_cast<std::uint8_t>(prng());
+    // Records whose prefix (opcode, length) is intact and starts before the
+    // garbage are read; the first record starting after the garbage is where
+    // reading resumes, and every record from there on is read.
+    std::size_t before = 0;
+    std::size_t after = 0;
+    std::uint64_t resume = 0;
+    std::uint64_t bad = 0;
+    for (const RecordSpan& r : records) {
+      if (r.offset + 9 <= from) {
+        before += r.op == 0x05 ? 1 : 0;
+        bad = r.end;
+      }
+      if (r.offset >= to && resume == 0) resume = r.offset;
+      if (r.offset >= to && r.op == 0x05) ++after;
+    }
+    const McapReader reader(file, "garbage");
+    EXPECT_EQ(reader.state(), McapFileState::kDamaged);
+    EXPECT_EQ(reader.messages().size(), before + after) << reader.diagnostics_text();
+    ASSERT_EQ(reader.damage().skipped.size(), 1u) << reader.diagnostics_text();
+    EXPECT_EQ(reader.damage().skipped[0].begin, bad) << reader.diagnostics_text();
+    EXPECT_EQ(reader.damage().skipped[0].end, resume) << reader.diagnostics_text();
+    EXPECT_LE(reader.damage().intact_until, bad);
+    EXPECT_GE(reader.damage().intact_until, std::min(from, records[k - 1].offset));
+    EXPECT_TRUE(reader.recovery().footer_present);
+    // Everything after the garbage is exactly what was written.
+    const std::size_t n = reader.messages().size();
+    for (std::size_t i = 0; i < after && i < n; ++i) {
+      EXPECT_EQ(reader.messages()[n - 1 - i].sequence, written[written.size() - 1 - i].sequence);
+      EXPECT_EQ(reader.messages()[n - 1 - i].data, written[written.size() - 1 - i].data);
+    }
+  }
+}
+
+// 200 single-byte corruptions at random offsets of a chunked file (fixed
+// seed): never a crash or a hang, every file is reported damaged (none as
+// complete or as merely not closed), at most one chunk's messages are lost,
+// and what is read is what was written, in order.
+TEST(McapDamage, SingleByteCorruptionSweepIsAlwaysReportedAsDamage) {
+  TempDir dir;
+  const ManyChunks log = write_many_chunks(dir, 1200, zstd_if_built());
+  std::uint64_t largest_chunk = 0;
+  for (const McapChunkInfo& c : log.chunks) largest_chunk = std::max(largest_chunk, c.message_count);
+  std::map<std::uint32_t, std::size_t> index_of_sequence;
+  for (std::size_t i = 0; i < log.written.size(); ++i) index_of_sequence[log.written[i].sequence] = i;
+  std::mt19937 prng(18);
+  for (int trial = 0; trial < 200; ++trial) {
+    Bytes file = log.file;
+    const std::uint64_t at = 8 + prng() % (file.size() - 8);
+    file[at] ^= static_cast<std::uint8_t>(1 + prng() % 255);
+    SCOPED_TRACE("trial " + std::to_string(trial) + ": byte " + std::to_string(at) + " of " +
+                 std::to_string(file.size()));
+    const McapReader reader(file, "corrupt");
+    EXPECT_EQ(reader.state(), McapFileState::kDamaged) << reader.diagnostics_text();
+    EXPECT_FALSE(reader.clean());
+    EXPECT_LE(reader.damage().intact_until, at + 1) << reader.diagnostics_text();
+    EXPECT_GE(reader.messages().size(), log.written.size() - largest_chunk) << reader.diagnostics_text();
+    std::size_t next = 0;
+    for (const McapMessage& m : reader.messages()) {
+      const auto it = index_of_sequence.find(m.sequence);
+      ASSERT_NE(it, index_of_sequence.end()) << "a message that was never written";
+      ASSERT_GE(it->second, next) << "messages out of order";
+      EXPECT_EQ(m.data, log.written[it->second].data);
+      next = it->second + 1;
+    }
+  }
 }
 
 }  // namespace

@@ -29,16 +29,73 @@ std::string seconds(std::uint64_t ns) {
   return os.str();
 }
 
+std::string plural(std::uint64_t n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+// Where a damaged file is damaged, in one line.
+std::string damage_summary(const logger::McapReader& reader) {
+  const logger::McapDamage& d = reader.damage();
+  std::string s = "first damage at offset " + std::to_string(d.intact_until) + "; " +
+                  plural(d.records.size(), "damaged record", "damaged records") + ", " +
+                  plural(d.bytes_skipped, "byte", "bytes") + " skipped, " +
+                  plural(reader.diagnostics().size(), "diagnostic", "diagnostics") + "; ";
+  s += d.footer_found ? "footer found" : "no footer";
+  if (d.footer_found) s += d.chunk_index_used ? ", chunks located by the chunk index" : ", chunk index not used";
+  return s;
+}
+
 std::string status_text(const logger::McapReader& reader) {
   const logger::McapRecovery& r = reader.recovery();
-  if (reader.clean()) return "complete (summary and footer present, no problems)";
-  std::string s = r.footer_present ? "complete but with problems" : "RECOVERED (no footer: the writer did not close it)";
-  return s;
+  const logger::McapDamage& d = reader.damage();
+  switch (reader.state()) {
+    case logger::McapFileState::kComplete:
+      return std::string("complete (footer") + (r.summary_present ? " and summary" : "") + " present" +
+             (r.summary_present ? "" : ", no summary section") + ", no problems)";
+    case logger::McapFileState::kNotClosed:
+      return "RECOVERED, not closed (no footer; records intact up to offset " + std::to_string(d.intact_until) +
+             ", " + std::to_string(r.bytes_ignored_at_end) + " bytes after it ignored)";
+    case logger::McapFileState::kDamaged: break;
+  }
+  return "DAMAGED (" + damage_summary(reader) + ")";
+}
+
+// The summary line of `info`: the same facts as the status, never contradicting it.
+std::string summary_text(const logger::McapReader& reader) {
+  const logger::McapRecovery& r = reader.recovery();
+  const logger::McapDamage& d = reader.damage();
+  if (d.summary_found) return d.chunk_index_used ? "yes (chunk index used)" : "yes";
+  if (r.summary_present) return "present but damaged (not used to find chunks)";
+  return (d.footer_found || r.footer_present) ? "none (the footer points at no summary)" : "no";
+}
+
+// On `err`, for a damaged file: one line saying so, then every diagnostic
+// with its offset (at most `max_lines`, 0 = all).
+void report_damage(const logger::McapReader& reader, std::ostream& err, std::size_t max_lines) {
+  const std::string& path = reader.path();
+  if (reader.state() == logger::McapFileState::kNotClosed) {
+    const logger::McapRecovery& r = reader.recovery();
+    err << path << ": not closed (no footer; records intact up to offset " << reader.damage().intact_until << ", "
+        << r.bytes_ignored_at_end << " bytes after it ignored)\n";
+    return;
+  }
+  if (reader.state() != logger::McapFileState::kDamaged) return;
+  err << path << ": damaged: " << damage_summary(reader) << "\n";
+  std::size_t lines = 0;
+  for (const logger::McapDiagnostic& d : reader.diagnostics()) {
+    if (max_lines > 0 && lines == max_lines) {
+      err << path << ": " << reader.diagnostics().size() - lines
+          << " more diagnostics (pixyslam_log info lists them all)\n";
+      break;
+    }
+    err << path << ": offset " << d.offset << ": " << d.message << "\n";
+    ++lines;
+  }
 }
 
 }  // namespace
 
-int run_info(const std::string& path, std::ostream& out) {
+int run_info(const std::string& path, std::ostream& out, std::ostream& err) {
   const logger::McapReader reader(path);
   const logger::McapRecovery& rec = reader.recovery();
   const auto& messages = reader.messages();
@@ -46,7 +103,7 @@ int run_info(const std::string& path, std::ostream& out) {
   out << "file:        " << path << "\n";
   out << "size:        " << rec.file_size << " bytes\n";
   out << "status:      " << status_text(reader) << "\n";
-  out << "summary:     " << yes_no(rec.summary_present) << ", footer: " << yes_no(rec.footer_present) << "\n";
+  out << "summary:     " << summary_text(reader) << ", footer: " << yes_no(rec.footer_present) << "\n";
   out << "header:      profile '" << reader.profile() << "', library '" << reader.library() << "'\n";
 
   std::uint64_t first = std::numeric_limits<std::uint64_t>::max();
@@ -102,10 +159,23 @@ int run_info(const std::string& path, std::ostream& out) {
         << "; messages recovered " << rec.messages_recovered << "\n"
         << "  valid bytes " << rec.valid_bytes << " of " << rec.file_size << ", ignored at end "
         << rec.bytes_ignored_at_end << "\n";
+  }
+  if (reader.state() == logger::McapFileState::kNotClosed) {
     out << "diagnostics: " << reader.diagnostics().size() << "\n";
     for (const logger::McapDiagnostic& d : reader.diagnostics()) {
       out << "  offset " << d.offset << ": " << d.message << "\n";
     }
+  }
+  if (reader.state() == logger::McapFileState::kDamaged) {
+    const logger::McapDamage& damage = reader.damage();
+    out << "damage:      " << plural(damage.records.size(), "damaged record", "damaged records") << ", "
+        << plural(damage.bytes_skipped, "byte", "bytes") << " skipped in "
+        << plural(damage.skipped.size(), "range", "ranges") << " (diagnostics on stderr)\n";
+    for (const logger::McapDamagedRecord& d : damage.records) {
+      out << "  offset " << d.offset << " .. " << d.end << ": " << d.what << "\n";
+    }
+    report_damage(reader, err, 0);
+    return 1;
   }
   return 0;
 }
@@ -126,7 +196,7 @@ struct TopicCheck {
 
 }  // namespace
 
-int run_check(const CheckRequest& request, std::ostream& out) {
+int run_check(const CheckRequest& request, std::ostream& out, std::ostream& err) {
   const logger::McapReader reader(request.path);
   bool ok = true;
 
@@ -138,6 +208,7 @@ int run_check(const CheckRequest& request, std::ostream& out) {
     out << (pass ? "OK   " : "FAIL ") << "file: " << status_text(reader) << ", " << reader.diagnostics().size()
         << " diagnostics, " << reader.recovery().bytes_ignored_at_end << " bytes ignored at end"
         << (pass ? " (allowed)" : " (--allow-recovered to check it anyway)") << "\n";
+    if (reader.state() == logger::McapFileState::kDamaged) report_damage(reader, err, 20);
   }
 
   std::map<std::uint16_t, TopicCheck> topics;
@@ -258,7 +329,7 @@ std::vector<Value> decoded_messages(const std::string& path, const std::string& 
 
 }  // namespace
 
-int run_print(const PrintRequest& request, std::ostream& out) {
+int run_print(const PrintRequest& request, std::ostream& out, std::ostream& err) {
   const logger::McapReader reader(request.path);
   if (!request.topic.empty() && reader.find_channel(request.topic) == nullptr) {
     throw std::runtime_error(request.path + ": no channel '" + request.topic + "'");
@@ -280,7 +351,10 @@ int run_print(const PrintRequest& request, std::ostream& out) {
     record.add("message", std::move(value));
     out << (request.json ? to_json_line(record) + "\n" : to_yaml_document(record));
   }
-  return status;
+  // After the messages, so that it is the last thing a terminal shows.
+  out.flush();
+  report_damage(reader, err, 20);
+  return reader.state() == logger::McapFileState::kDamaged ? 1 : status;
 }
 
 int run_compare(const CompareRequest& request, std::ostream& out) {

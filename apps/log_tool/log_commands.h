@@ -8,9 +8,12 @@
 
 namespace pixyslam::log_tool {
 
-// `pixyslam_log info FILE`: what is in an MCAP file and how complete it is.
-// Returns the exit status: 0 when the file could be read (recovered or not).
-int run_info(const std::string& path, std::ostream& out);
+// `pixyslam_log info FILE`: what is in an MCAP file and how complete it is:
+// status complete, not closed (a writer that did not close it: every record up
+// to the cut intact) or damaged (records, offsets, bytes skipped). Returns the
+// exit status: 0 when complete or not closed, 1 when damaged (then every
+// diagnostic with its byte offset goes to `err`).
+int run_info(const std::string& path, std::ostream& out, std::ostream& err);
 
 struct CheckRequest {
   std::string path;
@@ -21,8 +24,10 @@ struct CheckRequest {
 // `pixyslam_log check FILE`: decodes every message with the project's types
 // and checks per topic (and robot) that header seq is exactly 1..N, that the
 // MCAP sequence and publish time agree with the header, and the expected
-// counts. One line per topic. Returns 0 only if everything checks, else 1.
-int run_check(const CheckRequest& request, std::ostream& out);
+// counts. One line per topic. A file that is not complete fails unless
+// allow_recovered; the damage of a damaged one goes to `err` with its byte
+// offsets. Returns 0 only if everything checks, else 1.
+int run_check(const CheckRequest& request, std::ostream& out, std::ostream& err);
 
 struct PrintRequest {
   std::string path;
@@ -32,8 +37,11 @@ struct PrintRequest {
 
 // `pixyslam_log print FILE.mcap [--topic T] [--json]`: every message decoded
 // with the project's types, in file order, with its topic and log time (the
-// same printers as `echo`). Returns 0, or 1 if a payload cannot be decoded.
-int run_print(const PrintRequest& request, std::ostream& out);
+// same printers as `echo`). Prints the messages it could read; on `err`, a
+// file that is not closed is noted, and the damage of a damaged one listed
+// with byte offsets. Returns 0, or 1 if a payload cannot be decoded or the
+// file is damaged.
+int run_print(const PrintRequest& request, std::ostream& out, std::ostream& err);
 
 struct CompareRequest {
   std::string first_path;

@@ -11,7 +11,9 @@
 // DDS options: --dds-config FILE (a YAML with a `dds:` mapping, e.g.
 // config/slam_estimator.yaml; default: config/dds/profiles.xml on domain 0),
 // --domain N. The same program is also built as pixyslam_log (info/check).
-// Exit status: 0 ok, 1 check failed / too few samples / file unreadable,
+// Exit status: 0 ok, 1 check failed / too few samples / file unreadable or
+// damaged (info, print, check; a file its writer did not close is not
+// damaged: info and print exit 0, check needs --allow-recovered),
 // 2 command-line or config error.
 #include <algorithm>
 #include <cstdio>
@@ -182,8 +184,8 @@ int main(int argc, char** argv) {
   }
 
   try {
-    if (command == "info") return log_tool::run_info(a.positional[0], std::cout);
-    if (command == "print") return log_tool::run_print({a.positional[0], a.topic, a.json}, std::cout);
+    if (command == "info") return log_tool::run_info(a.positional[0], std::cout, std::cerr);
+    if (command == "print") return log_tool::run_print({a.positional[0], a.topic, a.json}, std::cout, std::cerr);
     if (command == "compare") {
       a.compare.first_path = a.positional[0];
       a.compare.second_path = a.positional[1];
@@ -191,7 +193,7 @@ int main(int argc, char** argv) {
     }
     if (command == "check") {
       a.check.path = a.positional[0];
-      return log_tool::run_check(a.check, std::cout);
+      return log_tool::run_check(a.check, std::cout, std::cerr);
     }
     const dds::DdsOptions options = dds_options(a);
     if (command == "participants") return log_tool::run_participants(options, a.seconds < 0 ? 4.0 : a.seconds, std::cout);

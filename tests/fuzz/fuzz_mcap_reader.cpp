@@ -1,6 +1,7 @@
 // libFuzzer target: arbitrary bytes as an MCAP file. The reader must either
 // refuse it with std::runtime_error (not MCAP at all) or recover what it can,
-// with consistent accounting, and never crash or read out of bounds.
+// with consistent accounting (recovery and damage report), and never crash or
+// read out of bounds.
 
 #include <cstddef>
 #include <cstdint>
@@ -18,6 +19,23 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(r.valid_bytes <= size);
     FUZZ_CHECK(r.valid_bytes + r.bytes_ignored_at_end == size);
     FUZZ_CHECK(r.messages_recovered == reader.messages().size());
+    // The damage report: complete exactly when clean, ranges inside the file
+    // and adding up, nothing damaged in a file only cut short.
+    const pixyslam::logger::McapDamage& d = reader.damage();
+    FUZZ_CHECK((d.state == pixyslam::logger::McapFileState::kComplete) == reader.clean());
+    FUZZ_CHECK(d.intact_until <= size);
+    std::uint64_t skipped = 0;
+    std::uint64_t previous_end = 0;
+    for (const pixyslam::logger::McapByteRange& range : d.skipped) {
+      FUZZ_CHECK(range.begin < range.end && range.end <= size && range.begin >= previous_end);
+      previous_end = range.end;
+      skipped += range.end - range.begin;
+    }
+    FUZZ_CHECK(skipped == d.bytes_skipped);
+    for (const pixyslam::logger::McapDamagedRecord& record : d.records) FUZZ_CHECK(record.end <= size);
+    if (d.state == pixyslam::logger::McapFileState::kNotClosed) {
+      FUZZ_CHECK(d.records.empty() && d.skipped.empty() && !r.footer_present);
+    }
     for (const pixyslam::logger::McapMessage& m : reader.messages()) {
       (void)reader.find_channel(m.channel_id);  // a message may name an unknown channel: no crash
     }

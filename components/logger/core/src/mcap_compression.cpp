@@ -26,6 +26,24 @@ std::vector<std::uint8_t> zstd_compress(const std::vector<std::uint8_t>& in, int
 }
 
 std::vector<std::uint8_t> zstd_decompress(const std::uint8_t* data, std::size_t size, std::size_t expected) {
+  // The sizes the frame headers state, checked before allocating (a damaged
+  // uncompressed_size must not cost a gigabyte of zeroed memory).
+  unsigned long long stated = 0;
+  bool all_stated = true;
+  for (std::size_t at = 0; at < size;) {
+    const unsigned long long content = ZSTD_getFrameContentSize(data + at, size - at);
+    const std::size_t frame = ZSTD_findFrameCompressedSize(data + at, size - at);
+    if (content == ZSTD_CONTENTSIZE_ERROR || ZSTD_isError(frame)) {
+      throw std::runtime_error("zstd: not a valid zstd frame at byte " + std::to_string(at) + " of the records");
+    }
+    if (content == ZSTD_CONTENTSIZE_UNKNOWN) all_stated = false;
+    stated += content == ZSTD_CONTENTSIZE_UNKNOWN ? 0 : content;
+    at += frame;
+  }
+  if (all_stated && stated != expected) {
+    throw std::runtime_error("zstd frames hold " + std::to_string(stated) + " bytes, uncompressed_size says " +
+                             std::to_string(expected));
+  }
   std::vector<std::uint8_t> out(expected);
   const std::size_t n = ZSTD_decompress(out.data(), out.size(), data, size);
   if (ZSTD_isError(n)) throw std::runtime_error(std::string("zstd: ") + ZSTD_getErrorName(n));
@@ -55,11 +73,23 @@ std::vector<std::uint8_t> lz4_decompress(const std::uint8_t* data, std::size_t s
   if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION))) {
     throw std::runtime_error("lz4: cannot create a decompression context");
   }
-  std::vector<std::uint8_t> out(expected);
-  std::size_t in_pos = 0;
-  std::size_t out_pos = 0;
-  std::size_t hint = 1;
+  // The content size the frame header states (0: not stated), checked before allocating.
+  LZ4F_frameInfo_t frame{};
+  std::size_t in_pos = size;
+  std::size_t hint = LZ4F_getFrameInfo(ctx, &frame, data, &in_pos);
   std::string error;
+  if (LZ4F_isError(hint)) {
+    error = std::string("lz4: ") + LZ4F_getErrorName(hint);
+  } else if (frame.contentSize != 0 && frame.contentSize != expected) {
+    error = "lz4 frame holds " + std::to_string(frame.contentSize) + " bytes, uncompressed_size says " +
+            std::to_string(expected);
+  }
+  if (!error.empty()) {
+    LZ4F_freeDecompressionContext(ctx);
+    throw std::runtime_error(error);
+  }
+  std::vector<std::uint8_t> out(expected);
+  std::size_t out_pos = 0;
   while (hint != 0 && error.empty()) {
     std::size_t in_n = size - in_pos;
     std::size_t out_n = out.size() - out_pos;

@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -34,6 +35,15 @@ const char* detail::opcode_name(std::uint8_t op) {
     case kOpDataEnd: return "Data End";
     default: return "unknown";
   }
+}
+
+const char* mcap_file_state_name(McapFileState state) {
+  switch (state) {
+    case McapFileState::kComplete: return "complete";
+    case McapFileState::kNotClosed: return "not closed";
+    case McapFileState::kDamaged: return "damaged";
+  }
+  return "damaged";
 }
 
 namespace {
@@ -143,9 +153,142 @@ bool same(const McapChannel& a, const McapChannel& b) {
          a.message_encoding == b.message_encoding && a.metadata == b.metadata;
 }
 
+// The records of a Chunk, decoded without touching the reader: used to read a
+// chunk and to check a candidate record while resynchronising.
+struct ChunkContent {
+  McapChunkInfo info;
+  std::string problem;  // "" = CRC, decompression and inner records fine
+  std::vector<McapSchema> schemas;
+  std::vector<McapChannel> channels;
+  std::vector<McapMessage> messages;
+  std::vector<std::uint64_t> message_offsets;  // of each message, within the uncompressed records
+};
+
+// Points `plain` at the uncompressed records (into the file or into `decoded`);
+// returns "" or what is wrong.
+std::string decode_chunk(const McapChunkInfo& info, const std::uint8_t* records, std::vector<std::uint8_t>& decoded,
+                         const std::uint8_t*& plain) {
+  if (info.uncompressed_size > kMaxChunkUncompressedBytes) {
+    return "uncompressed_size " + std::to_string(info.uncompressed_size) + " is implausibly large";
+  }
+  if (info.compression.empty()) {
+    if (info.uncompressed_size == info.compressed_size) return "";
+    return "uncompressed chunk of " + std::to_string(info.compressed_size) + " bytes, uncompressed_size says " +
+           std::to_string(info.uncompressed_size);
+  }
+  try {
+    decoded = decompress_chunk(info.compression, records, static_cast<std::size_t>(info.compressed_size),
+                               info.uncompressed_size);
+    plain = decoded.data();
+    return "";
+  } catch (const std::exception& e) {
+    return std::string("cannot decompress: ") + e.what();
+  }
+}
+
+// Parses the records inside a chunk into `out` (only checks them unless `keep`);
+// returns "" or what is wrong (the chunk is then rejected whole).
+std::string parse_chunk_records(const std::uint8_t* p, std::size_t n, ChunkContent& out, bool keep) {
+  std::size_t pos = 0;
+  while (pos < n) {
+    if (n - pos < kRecordPrefixBytes) return "inner record at chunk offset " + std::to_string(pos) + " cut short";
+    const std::uint8_t op = p[pos];
+    const std::uint64_t len = le64(p + pos + 1);
+    if (len > n - pos - kRecordPrefixBytes) {
+      return "inner " + op_text(op) + " record at chunk offset " + std::to_string(pos) + " overruns the chunk";
+    }
+    ByteSource s(p + pos + kRecordPrefixBytes, static_cast<std::size_t>(len));
+    try {
+      switch (op) {
+        case kOpSchema: {
+          McapSchema schema = parse_schema(s);
+          if (keep) out.schemas.push_back(std::move(schema));
+          break;
+        }
+        case kOpChannel: {
+          McapChannel channel = parse_channel(s);
+          if (keep) out.channels.push_back(std::move(channel));
+          break;
+        }
+        case kOpMessage: {
+          if (len < 22) throw FieldOverrun{0, 22};
+          if (keep) {
+            out.message_offsets.push_back(pos);
+            out.messages.push_back(parse_message(s));
+          }
+          break;
+        }
+        default:
+          if (op == 0 || op == kOpHeader || op == kOpFooter || op == kOpChunk || op == kOpDataEnd) {
+            return op_text(op) + " record inside a chunk at chunk offset " + std::to_string(pos);
+          }
+          break;  // other records are not expected here but harmless
+      }
+    } catch (const FieldOverrun&) {
+      return "malformed inner " + op_text(op) + " record at chunk offset " + std::to_string(pos);
+    } catch (const RecordError& e) {
+      return "malformed inner " + op_text(op) + " record at chunk offset " + std::to_string(pos) + ": " + e.message;
+    }
+    pos += kRecordPrefixBytes + static_cast<std::size_t>(len);
+  }
+  return "";
+}
+
+// Decodes the content (`len` bytes after the record prefix) of a Chunk record.
+void decode_chunk_content(const std::uint8_t* content, std::size_t len, ChunkContent& out, bool keep) {
+  ByteSource s(content, len);
+  std::uint32_t stored_crc = 0;
+  const std::uint8_t* records = nullptr;
+  McapChunkInfo& info = out.info;
+  try {
+    info.message_start_time_ns = s.u64();
+    info.message_end_time_ns = s.u64();
+    info.uncompressed_size = s.u64();
+    stored_crc = s.u32();
+    info.compression = s.str();
+    info.compressed_size = s.u64();
+    if (info.compressed_size > s.remaining()) {
+      out.problem = "records field of " + std::to_string(info.compressed_size) + " bytes, only " +
+                    std::to_string(s.remaining()) + " in the record";
+      return;
+    }
+    records = s.take(static_cast<std::size_t>(info.compressed_size));
+  } catch (const FieldOverrun&) {
+    out.problem = "malformed Chunk record header";
+    return;
+  }
+  std::vector<std::uint8_t> decoded;
+  const std::uint8_t* plain = records;
+  out.problem = decode_chunk(info, records, decoded, plain);
+  if (!out.problem.empty()) return;
+  const auto plain_size = static_cast<std::size_t>(info.uncompressed_size);
+  if (stored_crc != 0) {
+    const std::uint32_t computed = crc32(plain, plain_size);
+    if (computed != stored_crc) {
+      out.problem = "CRC mismatch: chunk says " + hex32(stored_crc) + ", records give " + hex32(computed);
+      return;
+    }
+  }
+  out.problem = parse_chunk_records(plain, plain_size, out, keep);
+}
+
+void skip_string(ByteSource& s) { s.take(s.u32()); }
+
+void skip_string_map(ByteSource& s) {
+  ByteSource m = take_prefixed(s);
+  while (m.remaining() > 0) {
+    skip_string(m);
+    skip_string(m);
+  }
+}
+
+bool known_opcode(std::uint8_t op) { return op >= kOpHeader && op <= kOpDataEnd; }
+
 }  // namespace
 
-// The front-to-back parse; fills the reader's fields.
+// The parse; fills the reader's fields. Front to back, with the chunk index
+// (when the summary is intact) and a scan for the next valid record to get
+// past damage.
 class McapReader::Parser {
  public:
   Parser(McapReader& reader, const std::vector<std::uint8_t>& bytes)
@@ -153,59 +296,125 @@ class McapReader::Parser {
 
   void run() {
     r_.recovery_.file_size = size_;
+    verify_budget_ = 8 * static_cast<std::uint64_t>(size_) + (std::uint64_t{64} << 20);
+    locate_footer();
     std::uint64_t pos = kMagic.size();
-    std::uint64_t valid_end = pos;
-    bool footer_seen = false;
     while (pos < size_) {
+      if (summary_ok_ && !in_summary_ && pos >= summary_start_) in_summary_ = true;
+      if (index_used_) {
+        const auto known = anchors_.find(pos);
+        if (known != anchors_.end() && known->second.op == kOpChunk) {
+          pos = read_indexed_chunk(pos, known->second.length);
+          continue;
+        }
+        if (const std::string inside = inside_indexed_chunk(pos); !inside.empty()) {
+          pos = resync(pos, pos + 1, inside);
+          continue;
+        }
+      }
       const std::uint64_t remaining = size_ - pos;
       if (remaining < kRecordPrefixBytes) {
-        diag(pos, std::to_string(remaining) + " bytes at the end, too few for a record: file cut short");
-        break;
+        pos = resync(pos, pos + 1, std::to_string(remaining) + " bytes, too few for a record");
+        continue;
       }
       const std::uint8_t op = data_[pos];
       const std::uint64_t len = le64(data_ + pos + 1);
       if (op == 0) {
-        diag(pos, "opcode 0x00 is not a record (zeroed or corrupt data); the rest of the file is ignored");
+        pos = resync(pos, pos + 1, "opcode 0x00 is not a record (zeroed or corrupt data)");
+        continue;
+      }
+      if (closing_magic_ && footer_at_ == 0 && pos == size_ - kMagic.size()) {
+        diag(pos, "the file ends with the closing magic, but no valid Footer precedes it");
+        note_damage(pos, size_, "closing magic without a Footer");
         break;
+      }
+      if (op == kOpChunk) {
+        const std::optional<std::uint64_t> pos_after = chunk_with_bad_length(pos, len);
+        if (pos_after) {
+          pos = *pos_after;
+          if (pos == size_ + 1) break;  // a chunk cut by the end of the file
+          continue;
+        }
       }
       if (len > remaining - kRecordPrefixBytes) {
-        diag(pos, op_text(op) + " record of " + std::to_string(len) + " content bytes, but only " +
-                      std::to_string(remaining - kRecordPrefixBytes) + " remain: file cut short");
-        break;
+        pos = resync(pos, pos + 1,
+                     op_text(op) + " record of " + std::to_string(len) + " content bytes, but only " +
+                         std::to_string(remaining - kRecordPrefixBytes) + " remain");
+        continue;
       }
-      if (pos == kMagic.size() && op != kOpHeader)
-        diag(pos, "first record is " + op_text(op) + ", not Header");
-      if (op != kOpMessageIndex) finish_pending_chunk();
-      handle(op, pos, data_ + pos + kRecordPrefixBytes, static_cast<std::size_t>(len));
-      pos += kRecordPrefixBytes + len;
-      valid_end = pos;
-      if (op == kOpFooter) {
-        footer_seen = true;
-        if (size_ - pos >= kMagic.size() && std::equal(kMagic.begin(), kMagic.end(), data_ + pos)) {
-          r_.recovery_.footer_present = true;
-          valid_end = pos + kMagic.size();
-          if (size_ > valid_end) {
-            diag(valid_end, std::to_string(size_ - valid_end) + " bytes after the closing magic");
-          }
-        } else {
-          diag(pos, "Footer not followed by the closing magic");
+      const std::uint64_t end = pos + kRecordPrefixBytes + len;
+      if (const std::uint64_t anchor = next_anchor_after(pos); anchor < end) {
+        pos = resync(pos, pos + 1,
+                     op_text(op) + " record of " + std::to_string(len) + " content bytes runs across offset " +
+                         std::to_string(anchor) + ", where " + anchor_text(anchor));
+        continue;
+      }
+      if (op != kOpFooter && op != kOpDataEnd && op != kOpChunk) {
+        if (const std::optional<std::uint64_t> next = bad_length(pos, op, end)) {
+          pos = *next;
+          continue;
         }
-        break;
+      }
+      if (pos == kMagic.size() && op != kOpHeader) diag(pos, "first record is " + op_text(op) + ", not Header");
+      if (op != kOpMessageIndex) finish_pending_chunk(true);
+      if (op == kOpFooter) {
+        const FooterEnd how = footer_end(pos);
+        if (how != FooterEnd::kNotTheFooter) {
+          handle(op, pos, data_ + pos + kRecordPrefixBytes, static_cast<std::size_t>(len));
+          footer_seen_ = true;
+          valid_end_ = end;
+          if (how == FooterEnd::kClosed) {
+            r_.recovery_.footer_present = true;
+            valid_end_ = end + kMagic.size();
+            if (size_ > valid_end_) {
+              diag(valid_end_, std::to_string(size_ - valid_end_) + " bytes after the closing magic");
+            }
+          } else {
+            tail_diag(end, "Footer not followed by the closing magic");
+          }
+          break;
+        }
+        pos = after_bad(pos, end, "Footer record that is not at the end of the file");
+        continue;
+      }
+      if (!known_opcode(op)) {
+        if (op >= 0x80) {  // private records: skipped
+          if (end_ok(end)) {
+            pos = valid_end_ = end;
+          } else {
+            pos = resync(pos, pos + 1, "record with opcode " + op_text(op) + " is followed by no valid record");
+          }
+          continue;
+        }
+        diag(pos, "record with opcode " + op_text(op) + " (reserved, not an MCAP record)");
+        pos = after_bad(pos, end, "record with a reserved opcode");
+        continue;
+      }
+      if (!handle(op, pos, data_ + pos + kRecordPrefixBytes, static_cast<std::size_t>(len))) {
+        pos = after_bad(pos, end, op_text(op) + " record unusable");
+        continue;
+      }
+      pos = valid_end_ = end;
+    }
+    finish_pending_chunk(closing_magic_);  // still pending: the file ends after its Message Index records
+    if (!footer_seen_) {
+      const std::string text =
+          "no Footer: the file was cut short or its writer did not close it (" +
+          std::to_string(size_ - valid_end_) + " bytes after the last complete record ignored)";
+      if (closing_magic_) {
+        diag(valid_end_, text);
+      } else {
+        tail_diag(valid_end_, text);
       }
     }
-    finish_pending_chunk();
-    if (!footer_seen) {
-      diag(valid_end, "no Footer: the file was cut short or its writer did not close it (" +
-                          std::to_string(size_ - valid_end) +
-                          " bytes after the last complete record ignored)");
-    }
-    r_.recovery_.valid_bytes = valid_end;
-    r_.recovery_.bytes_ignored_at_end = size_ - valid_end;
+    r_.recovery_.valid_bytes = valid_end_;
+    r_.recovery_.bytes_ignored_at_end = size_ - valid_end_;
     r_.recovery_.messages_recovered = r_.messages_.size();
-    final_checks(footer_seen);
+    final_checks(footer_seen_);
     if (suppressed_ > 0) {
-      r_.diagnostics_.push_back({valid_end, std::to_string(suppressed_) + " further diagnostics suppressed"});
+      r_.diagnostics_.push_back({valid_end_, std::to_string(suppressed_) + " further diagnostics suppressed"});
     }
+    finish_damage();
   }
 
  private:
@@ -233,8 +442,24 @@ class McapReader::Parser {
     std::uint64_t start;
     std::uint64_t length;
   };
+  // A record whose place is certain: the Footer before the closing magic, and
+  // from an intact summary the chunks, their Message Index records, the
+  // summary's first record, the first Summary Offset record and Data End.
+  struct Anchor {
+    std::uint8_t op = 0;          // 0: any record
+    std::uint64_t length = 0;     // whole record; 0: not known
+    std::uint64_t indexes_end = 0;  // chunks: end of their Message Index records
+  };
+  enum class FooterEnd { kClosed, kCutInMagic, kNotTheFooter };
+  enum class Candidate { kBad, kWeak, kStrong };
+
+  // Records found in a row before a scan takes an offset as the next record
+  // (unless one of them is a chunk that decodes and matches its CRC, a Data End
+  // whose CRC matches, or the Footer: one of those is enough).
+  static constexpr int kWeakChain = 3;
 
   void diag(std::uint64_t offset, std::string message) {
+    if (offset > 0) first_problem_ = std::min(first_problem_, offset);
     if (r_.diagnostics_.size() >= kMaxDiagnostics) {
       ++suppressed_;
       return;
@@ -242,7 +467,557 @@ class McapReader::Parser {
     r_.diagnostics_.push_back({offset, std::move(message)});
   }
 
-  void handle(std::uint8_t op, std::uint64_t pos, const std::uint8_t* content, std::size_t len) {
+  // A diagnostic that a writer which did not close its file explains (a cut
+  // record, a zero tail, no Footer): damage only when the file ends with the
+  // closing magic.
+  void tail_diag(std::uint64_t offset, std::string message) {
+    if (closing_magic_) {
+      diag(offset, std::move(message));
+      return;
+    }
+    ++tail_diagnostics_;
+    if (r_.diagnostics_.size() >= kMaxDiagnostics) {
+      ++suppressed_;
+      return;
+    }
+    r_.diagnostics_.push_back({offset, std::move(message)});
+  }
+
+  // One damaged record; a second problem of the same record is added to its text.
+  void note_damage(std::uint64_t offset, std::uint64_t end, std::string what) {
+    first_problem_ = std::min(first_problem_, offset);
+    std::vector<McapDamagedRecord>& records = r_.damage_.records;
+    if (!records.empty() && records.back().offset == offset && records.back().end == end) {
+      records.back().what += "; " + what;
+    } else if (records.size() < kMaxDiagnostics) {
+      records.push_back({offset, end, std::move(what)});
+    }
+  }
+
+  bool magic_at(std::uint64_t at) const {
+    return at <= size_ && size_ - at >= kMagic.size() && std::equal(kMagic.begin(), kMagic.end(), data_ + at);
+  }
+
+  // ---- the summary, from the end of the file -----------------------------------------------
+
+  // Finds the Footer before the closing magic; when the summary it points at
+  // parses (and its CRC matches, when set), takes the places of the records
+  // it names as anchors, and with valid Chunk Index records reads chunks by them.
+  void locate_footer() {
+    constexpr std::uint64_t kFooterBytes = kRecordPrefixBytes + kFooterContentBytes;
+    if (size_ < 2 * kMagic.size() + kFooterBytes || !magic_at(size_ - kMagic.size())) return;
+    closing_magic_ = true;
+    const std::uint64_t f = size_ - kMagic.size() - kFooterBytes;
+    if (data_[f] != kOpFooter || le64(data_ + f + 1) != kFooterContentBytes) return;
+    footer_at_ = f;
+    anchors_[f] = {kOpFooter, kFooterBytes, 0};
+    const std::uint64_t summary_start = le64(data_ + f + 9);
+    const std::uint64_t summary_offset_start = le64(data_ + f + 17);
+    const std::uint32_t crc = static_cast<std::uint32_t>(le64(data_ + f + 25) & 0xFFFFFFFFu);
+    if (summary_start == 0 || summary_start < kMagic.size() || summary_start > f) return;
+    if (summary_offset_start != 0 && (summary_offset_start < summary_start || summary_offset_start > f)) return;
+    const auto summary_bytes = static_cast<std::size_t>(f + kFooterCrcBytes - summary_start);
+    if (crc != 0 && crc32(data_ + summary_start, summary_bytes) != crc) return;
+    struct IndexedChunk {
+      std::uint64_t offset, length, indexes_length;
+      std::vector<std::uint64_t> index_offsets;
+    };
+    std::vector<IndexedChunk> chunks;
+    bool summary_offset_seen = summary_offset_start == 0;
+    for (std::uint64_t at = summary_start; at < f;) {
+      if (f - at < kRecordPrefixBytes) return;
+      const std::uint8_t op = data_[at];
+      const std::uint64_t len = le64(data_ + at + 1);
+      if (len > f - at - kRecordPrefixBytes) return;
+      summary_offset_seen = summary_offset_seen || at == summary_offset_start;
+      if (op == kOpChunkIndex) {
+        ByteSource s(data_ + at + kRecordPrefixBytes, static_cast<std::size_t>(len));
+        try {
+          IndexedChunk c{};
+          s.u64();
+          s.u64();
+          c.offset = s.u64();
+          c.length = s.u64();
+          for (const auto& [channel, offset] : parse_u16_u64_map(s)) c.index_offsets.push_back(offset);
+          c.indexes_length = s.u64();
+          chunks.push_back(std::move(c));
+        } catch (const FieldOverrun&) {
+          return;
+        } catch (const RecordError&) {
+          return;
+        }
+      }
+      at += kRecordPrefixBytes + len;
+    }
+    if (!summary_offset_seen) return;
+    summary_ok_ = true;
+    summary_start_ = summary_start;
+    anchors_[summary_start] = {0, 0, 0};
+    if (summary_offset_start != 0) anchors_[summary_offset_start] = {kOpSummaryOffset, 0, 0};
+    const std::uint64_t data_end_at = summary_start - 13;
+    if (summary_start >= kMagic.size() + 13 && data_[data_end_at] == kOpDataEnd &&
+        le64(data_ + data_end_at + 1) == 4) {
+      anchors_[data_end_at] = {kOpDataEnd, 13, 0};
+    }
+    // Usable when every chunk lies in the data section, in order, without overlaps.
+    std::sort(chunks.begin(), chunks.end(),
+              [](const IndexedChunk& a, const IndexedChunk& b) { return a.offset < b.offset; });
+    std::uint64_t previous_end = kMagic.size();
+    for (const IndexedChunk& c : chunks) {
+      if (c.offset < previous_end || c.length <= kRecordPrefixBytes || c.length > summary_start - c.offset ||
+          c.indexes_length > summary_start - c.offset - c.length) {
+        return;
+      }
+      const std::uint64_t chunk_end = c.offset + c.length;
+      for (const std::uint64_t mi : c.index_offsets) {
+        if (mi < chunk_end || mi >= chunk_end + c.indexes_length) return;
+      }
+      // Without a summary CRC, a Chunk opcode where each chunk should be stands in for it.
+      if (crc == 0 && data_[c.offset] != kOpChunk) return;
+      previous_end = chunk_end + c.indexes_length;
+    }
+    index_used_ = !chunks.empty();
+    for (const IndexedChunk& c : chunks) {
+      anchors_[c.offset] = {kOpChunk, c.length, c.offset + c.length + c.indexes_length};
+      for (const std::uint64_t mi : c.index_offsets) anchors_[mi] = {kOpMessageIndex, 0, 0};
+    }
+  }
+
+  // The first anchor after `pos`, or the file size.
+  std::uint64_t next_anchor_after(std::uint64_t pos) const {
+    const auto it = anchors_.upper_bound(pos);
+    return it == anchors_.end() ? size_ : it->first;
+  }
+
+  std::string anchor_text(std::uint64_t at) const {
+    const auto it = anchors_.find(at);
+    if (it == anchors_.end()) return "no record is known";
+    if (it->second.op == kOpFooter) return "the Footer is";
+    if (it->second.op == 0) return "the summary starts";
+    return std::string("the summary puts a ") + opcode_name(it->second.op) + " record";
+  }
+
+  // Non-empty when `pos` is inside a chunk the index names, or among its
+  // Message Index records but not at one: no record can start there.
+  std::string inside_indexed_chunk(std::uint64_t pos) const {
+    auto it = anchors_.upper_bound(pos);
+    while (it != anchors_.begin()) {
+      --it;
+      if (it->second.op != kOpChunk) continue;
+      const std::uint64_t start = it->first;
+      const std::uint64_t chunk_end = start + it->second.length;
+      if (pos < chunk_end) {
+        return "offset " + std::to_string(pos) + " is inside the Chunk at " + std::to_string(start) +
+               " (chunk index)";
+      }
+      if (pos >= it->second.indexes_end) return "";
+      // Among its Message Index records: only a Message Index that ends among them.
+      if (size_ - pos >= kRecordPrefixBytes && data_[pos] == kOpMessageIndex &&
+          le64(data_ + pos + 1) <= it->second.indexes_end - pos - kRecordPrefixBytes) {
+        return "";
+      }
+      return "no Message Index record at offset " + std::to_string(pos) +
+             ", among the Message Index records of the Chunk at " + std::to_string(start) + " (chunk index)";
+    }
+    return "";
+  }
+
+  // ---- resynchronisation ------------------------------------------------------------------
+
+  // A record at `at` that is certainly cut by the end of the file: a known
+  // opcode and a length past the end, or fewer bytes left than a record prefix.
+  bool cut_looking(std::uint64_t at) const {
+    if (at >= size_) return false;
+    if (size_ - at < kRecordPrefixBytes) return true;
+    return known_opcode(data_[at]) && le64(data_ + at + 1) > size_ - at - kRecordPrefixBytes;
+  }
+
+  // Can reading go on at `end`, the declared end of a record?
+  bool end_ok(std::uint64_t end) {
+    if (end == size_ || anchors_.count(end) > 0) return true;
+    if (end > size_) return false;
+    if (!closing_magic_ && (cut_looking(end) || zeros_from(end))) return true;
+    return probe(end, true);
+  }
+
+  bool zeros_from(std::uint64_t at) const {
+    return at < size_ && data_[at] == 0 &&
+           std::all_of(data_ + at, data_ + size_, [](std::uint8_t b) { return b == 0; });
+  }
+
+  // Before a record at `pos` whose length fits is used: when no valid record
+  // follows its declared `end` but valid records start inside it, its length
+  // field is damaged (too large, e.g. swallowing the records after it):
+  // returns where to go on (the record is skipped). When nothing valid starts
+  // inside it, the damage is after it, and it is read.
+  std::optional<std::uint64_t> bad_length(std::uint64_t pos, std::uint8_t op, std::uint64_t end) {
+    cheap_chunks_ = true;
+    const bool fine = end_ok(end);
+    cheap_chunks_ = false;
+    if (fine) return std::nullopt;
+    std::uint64_t next = end;
+    for (std::uint64_t q = pos + 1; q < end; ++q) {
+      if (plausible_start(q) && probe(q)) {
+        next = q;
+        break;
+      }
+    }
+    if (next == end) return std::nullopt;
+    finish_pending_chunk(true);
+    const std::string what = op_text(op) + " record of " + std::to_string(end - pos - kRecordPrefixBytes) +
+                             " content bytes is followed by no valid record (length field damaged)";
+    note_damage(pos, next, what);
+    r_.damage_.skipped.push_back({pos, next});
+    r_.damage_.bytes_skipped += next - pos;
+    diag(pos, what + ": skipped " + std::to_string(next - pos) + " bytes to the next valid record at offset " +
+                  std::to_string(next));
+    return next;
+  }
+
+  // After a record at `pos` that could not be used although its length fits:
+  // go on at its declared end when a record follows there, else resynchronise.
+  std::uint64_t after_bad(std::uint64_t pos, std::uint64_t end, const std::string& what) {
+    if (end_ok(end)) {
+      note_damage(pos, end, what);
+      valid_end_ = end;
+      return end;
+    }
+    return resync(pos, pos + 1, what + ", and no valid record follows it");
+  }
+
+  // Finds the next valid record after the bad one at `bad`: the next anchor
+  // (chunk index / Footer), or before it the first offset from `from` where
+  // probe() finds valid records. Returns where to go on (the file size when
+  // nothing valid follows: then the rest is a cut record, zeros or garbage).
+  std::uint64_t resync(std::uint64_t bad, std::uint64_t from, const std::string& why) {
+    const std::uint64_t limit = next_anchor_after(bad);
+    std::uint64_t next = limit;
+    const bool in_chunk = index_used_ && !inside_indexed_chunk(bad).empty();
+    if (!in_chunk) {
+      for (std::uint64_t q = from; q < limit; ++q) {
+        if (plausible_start(q) && probe(q)) {
+          next = q;
+          break;
+        }
+      }
+    }
+    // A chunk's Message Index records cut short by the end of the file are not wrong.
+    finish_pending_chunk(next < size_ || closing_magic_);
+    if (next >= size_) {
+      end_of_data(bad, why);
+      return size_;
+    }
+    note_damage(bad, next, why);
+    r_.damage_.skipped.push_back({bad, next});
+    r_.damage_.bytes_skipped += next - bad;
+    diag(bad, why + ": skipped " + std::to_string(next - bad) + " bytes to the next valid record at offset " +
+                  std::to_string(next));
+    return next;
+  }
+
+  // Nothing valid from `at` to the end of the file.
+  void end_of_data(std::uint64_t at, const std::string& why) {
+    const std::uint64_t remaining = size_ - at;
+    if (std::all_of(data_ + at, data_ + size_, [](std::uint8_t b) { return b == 0; })) {
+      tail_diag(at, "opcode 0x00 is not a record (zeroed or corrupt data); the rest of the file is ignored");
+      if (closing_magic_) note_damage(at, size_, "zeros up to the end of the file");
+      return;
+    }
+    if (cut_looking(at)) {
+      if (remaining < kRecordPrefixBytes) {
+        tail_diag(at, std::to_string(remaining) + " bytes at the end, too few for a record: file cut short");
+      } else {
+        const std::uint8_t op = data_[at];
+        tail_diag(at, op_text(op) + " record of " + std::to_string(le64(data_ + at + 1)) +
+                          " content bytes, but only " + std::to_string(remaining - kRecordPrefixBytes) +
+                          " remain: file cut short");
+      }
+      if (closing_magic_) note_damage(at, size_, "record cut short before the closing magic");
+      return;
+    }
+    note_damage(at, size_, why);
+    r_.damage_.skipped.push_back({at, size_});
+    r_.damage_.bytes_skipped += remaining;
+    diag(at, why + "; no valid record follows: the last " + std::to_string(remaining) + " bytes are ignored");
+  }
+
+  // Cheap test before probe(): a record opcode and a length inside the file.
+  bool plausible_start(std::uint64_t q) const {
+    if (size_ - q < kRecordPrefixBytes) return false;
+    const std::uint8_t op = data_[q];
+    return known_opcode(op) && op != kOpHeader && le64(data_ + q + 1) <= size_ - q - kRecordPrefixBytes;
+  }
+
+  // Whether valid records start at `q`: a strong record (a chunk that decodes
+  // and matches its CRC, a Data End whose CRC matches, the Footer before the
+  // closing magic), or kWeakChain well-formed records in a row, or well-formed
+  // records up to an anchor or exactly to the end of the file. No record may
+  // run across an anchor.
+  // `after_record`: `q` is the declared end of a record being read, not a
+  // scan candidate: records with private opcodes (0x80 and up) count as well
+  // formed there (a scan does not start at one: garbage has many such bytes),
+  // and so does a chain that ends in a record cut by the end of the file or in
+  // zeros, when the file has no closing magic (a scan would find the records
+  // of a cut chunk that way).
+  bool probe(std::uint64_t q, bool after_record = false) {
+    std::uint64_t at = q;
+    int weak = 0;
+    for (;;) {
+      if (at == size_) return weak > 0;
+      if (at != q && anchors_.count(at) > 0) return true;
+      if (after_record && at != q && !closing_magic_ && (cut_looking(at) || zeros_from(at))) return true;
+      const bool private_record = (after_record || at != q) && size_ - at >= kRecordPrefixBytes &&
+                                  data_[at] >= 0x80 && le64(data_ + at + 1) <= size_ - at - kRecordPrefixBytes;
+      if (!private_record && !plausible_start(at)) return false;
+      const std::uint8_t op = data_[at];
+      const std::uint64_t len = le64(data_ + at + 1);
+      const std::uint64_t end = at + kRecordPrefixBytes + len;
+      if (next_anchor_after(at) < end) return false;
+      switch (private_record ? Candidate::kWeak : candidate(at, op, len)) {
+        case Candidate::kStrong: return true;
+        case Candidate::kBad: return false;
+        case Candidate::kWeak: break;
+      }
+      if (++weak >= kWeakChain) return true;
+      at = end;
+    }
+  }
+
+  // How convincing a record of opcode `op` with `len` content bytes at `at` is.
+  Candidate candidate(std::uint64_t at, std::uint8_t op, std::uint64_t len) {
+    ByteSource s(data_ + at + kRecordPrefixBytes, static_cast<std::size_t>(len));
+    auto exact = [&s]() { return s.remaining() == 0 ? Candidate::kWeak : Candidate::kBad; };
+    try {
+      switch (op) {
+        case kOpChunk:
+          if (cheap_chunks_) {  // its header agrees with its length: enough to take it as the next record
+            const std::optional<std::uint64_t> own = chunk_length_from_header(at);
+            if (own && *own == kRecordPrefixBytes + len) return Candidate::kStrong;
+          }
+          return chunk_verifies(at, len) ? Candidate::kStrong : Candidate::kBad;
+        case kOpFooter:
+          return len == kFooterContentBytes && at + kRecordPrefixBytes + len + kMagic.size() == size_ &&
+                         magic_at(at + kRecordPrefixBytes + len)
+                     ? Candidate::kStrong
+                     : Candidate::kBad;
+        case kOpDataEnd: {
+          if (len != 4) return Candidate::kBad;
+          const std::uint32_t stored = s.u32();
+          if (stored == 0) return Candidate::kWeak;
+          return crc32(data_, static_cast<std::size_t>(at)) == stored ? Candidate::kStrong : Candidate::kBad;
+        }
+        case kOpSchema:
+          if (s.u16() == 0) return Candidate::kBad;
+          skip_string(s);
+          skip_string(s);
+          skip_string(s);
+          return exact();
+        case kOpChannel:
+          s.u16();
+          s.u16();
+          skip_string(s);
+          skip_string(s);
+          skip_string_map(s);
+          return exact();
+        case kOpMessage: return len >= 22 ? Candidate::kWeak : Candidate::kBad;
+        case kOpMessageIndex:
+          s.u16();
+          take_prefixed(s, 16, "records array");
+          return exact();
+        case kOpChunkIndex:
+          for (int i = 0; i < 4; ++i) s.u64();
+          take_prefixed(s, 10, "Map<uint16, uint64>");
+          s.u64();
+          skip_string(s);
+          s.u64();
+          s.u64();
+          return exact();
+        case kOpAttachment:
+          s.u64();
+          s.u64();
+          skip_string(s);
+          skip_string(s);
+          s.take(static_cast<std::size_t>(std::min<std::uint64_t>(s.u64(), len)));
+          s.u32();
+          return exact();
+        case kOpAttachmentIndex:
+          for (int i = 0; i < 5; ++i) s.u64();
+          skip_string(s);
+          skip_string(s);
+          return exact();
+        case kOpStatistics:
+          s.u64();
+          s.u16();
+          for (int i = 0; i < 4; ++i) s.u32();
+          s.u64();
+          s.u64();
+          take_prefixed(s, 10, "Map<uint16, uint64>");
+          return exact();
+        case kOpMetadata:
+          skip_string(s);
+          skip_string_map(s);
+          return exact();
+        case kOpMetadataIndex:
+          s.u64();
+          s.u64();
+          skip_string(s);
+          return exact();
+        case kOpSummaryOffset:
+          return len == 17 && known_opcode(s.u8()) ? Candidate::kWeak : Candidate::kBad;
+        default: return Candidate::kBad;
+      }
+    } catch (const FieldOverrun&) {
+      return Candidate::kBad;
+    } catch (const RecordError&) {
+      return Candidate::kBad;
+    }
+  }
+
+  // Whether a Chunk record with `len` content bytes at `at` decodes and
+  // matches its CRC. Remembered per offset; the bytes checked this way are
+  // bounded (a file made of fake chunk headers must not take quadratic time).
+  bool chunk_verifies(std::uint64_t at, std::uint64_t len) {
+    const auto key = std::make_pair(at, len);
+    const auto known = verified_.find(key);
+    if (known != verified_.end()) return known->second;
+    bool ok = false;
+    // The uncompressed size as the header states it (decoding fails past kMaxChunkUncompressedBytes).
+    const std::uint64_t plain =
+        len >= 24 ? std::min(le64(data_ + at + kRecordPrefixBytes + 16), kMaxChunkUncompressedBytes) : 0;
+    if (verify_budget_ >= len + plain) {
+      verify_budget_ -= len + plain;
+      ChunkContent c;
+      decode_chunk_content(data_ + at + kRecordPrefixBytes, static_cast<std::size_t>(len), c, false);
+      ok = c.problem.empty();
+    }
+    verified_[key] = ok;
+    return ok;
+  }
+
+  // The whole length of the Chunk record at `pos` as its own header gives it
+  // (prefix, fixed fields, compression name, compressed_size), if those fields
+  // are inside the file.
+  std::optional<std::uint64_t> chunk_length_from_header(std::uint64_t pos) const {
+    if (size_ - pos < kRecordPrefixBytes) return std::nullopt;
+    ByteSource s(data_ + pos + kRecordPrefixBytes, static_cast<std::size_t>(size_ - pos - kRecordPrefixBytes));
+    try {
+      s.u64();
+      s.u64();
+      s.u64();
+      s.u32();
+      const std::uint32_t name = s.u32();
+      if (name > 64) return std::nullopt;
+      s.take(name);
+      const std::uint64_t compressed = s.u64();
+      const std::uint64_t fixed = kRecordPrefixBytes + s.pos();
+      if (compressed > (std::uint64_t{1} << 62)) return std::nullopt;
+      return fixed + compressed;
+    } catch (const FieldOverrun&) {
+      return std::nullopt;
+    }
+  }
+
+  // Whether a record of `length` bytes at `pos` stays inside the file, runs
+  // across no anchor and is followed by a valid record.
+  bool extent_ok(std::uint64_t pos, std::uint64_t length) {
+    if (length <= kRecordPrefixBytes || length > size_ - pos) return false;
+    return next_anchor_after(pos) >= pos + length && end_ok(pos + length);
+  }
+
+  // A Chunk record (not named by the chunk index) whose length field disagrees
+  // with its header or runs past the end of the file. When the length its
+  // header gives is followed by a valid record, it is read with that length
+  // (and rejected unless it decodes and matches its CRC). Returns where to go
+  // on, size_ + 1 for a chunk cut by the end of the file, or nothing to read it
+  // as an ordinary record.
+  std::optional<std::uint64_t> chunk_with_bad_length(std::uint64_t pos, std::uint64_t len) {
+    const std::uint64_t remaining = size_ - pos;
+    const bool fits = len <= remaining - kRecordPrefixBytes;
+    const std::optional<std::uint64_t> own = chunk_length_from_header(pos);
+    if (!own || (fits && *own == kRecordPrefixBytes + len)) return std::nullopt;
+    const bool own_ok = extent_ok(pos, *own);
+    const bool declared_ok = fits && extent_ok(pos, kRecordPrefixBytes + len);
+    const bool own_verifies = own_ok && chunk_verifies(pos, *own - kRecordPrefixBytes);
+    if ((own_verifies && !(declared_ok && chunk_verifies(pos, len))) || (own_ok && !declared_ok)) {
+      finish_pending_chunk(true);
+      const std::string what = "Chunk record length field says " + std::to_string(len) +
+                               " content bytes, its header " + std::to_string(*own - kRecordPrefixBytes) +
+                               " (length field damaged; read with its header's length" +
+                               (own_verifies ? ", CRC checked)" : ")");
+      diag(pos, what);
+      note_damage(pos, pos + *own, what);
+      if (!read_chunk(pos, data_ + pos + kRecordPrefixBytes, static_cast<std::size_t>(*own - kRecordPrefixBytes))) {
+        note_damage(pos, pos + *own, "Chunk rejected");
+      }
+      valid_end_ = pos + *own;
+      return pos + *own;
+    }
+    if (!fits && !closing_magic_ && *own > remaining) {  // the header agrees: a chunk cut by the end of the file
+      finish_pending_chunk(false);
+      end_of_data(pos, "Chunk record cut short");
+      return size_ + 1;
+    }
+    return std::nullopt;
+  }
+
+  // The Chunk the chunk index puts at `pos`, `length` bytes: read as the index
+  // says even when its opcode or length field is damaged (the CRC checks it).
+  std::uint64_t read_indexed_chunk(std::uint64_t pos, std::uint64_t length) {
+    finish_pending_chunk(true);
+    const std::uint8_t op = data_[pos];
+    const std::uint64_t len = le64(data_ + pos + 1);
+    if (op != kOpChunk || len != length - kRecordPrefixBytes) {
+      const std::string what = "the chunk index says a Chunk of " + std::to_string(length - kRecordPrefixBytes) +
+                               " content bytes is here, the record has opcode " + op_text(op) +
+                               " and length field " + std::to_string(len) + " (read as the index says)";
+      diag(pos, what);
+      note_damage(pos, pos + length, what);
+    }
+    if (!read_chunk(pos, data_ + pos + kRecordPrefixBytes, static_cast<std::size_t>(length - kRecordPrefixBytes))) {
+      note_damage(pos, pos + length, "Chunk rejected");
+    }
+    valid_end_ = pos + length;
+    return pos + length;
+  }
+
+  // When the Footer record at `pos` is the file's own: followed by the closing
+  // magic (or, cut short, by part of it).
+  FooterEnd footer_end(std::uint64_t pos) const {
+    const std::uint64_t end = pos + kRecordPrefixBytes + kFooterContentBytes;
+    if (le64(data_ + pos + 1) != kFooterContentBytes) return FooterEnd::kNotTheFooter;
+    if (magic_at(end)) return FooterEnd::kClosed;
+    if (size_ - end < kMagic.size() && std::equal(data_ + end, data_ + size_, kMagic.begin())) {
+      return FooterEnd::kCutInMagic;
+    }
+    return FooterEnd::kNotTheFooter;
+  }
+
+  void finish_damage() {
+    McapDamage& d = r_.damage_;
+    d.closed = r_.recovery_.footer_present && valid_end_ == size_;
+    d.footer_found = footer_at_ != 0 || r_.recovery_.footer_present;
+    d.summary_found = summary_ok_;
+    d.chunk_index_used = index_used_;
+    std::sort(d.records.begin(), d.records.end(),
+              [](const McapDamagedRecord& a, const McapDamagedRecord& b) { return a.offset < b.offset; });
+    if (r_.clean()) {
+      d.state = McapFileState::kComplete;
+      d.intact_until = size_;
+    } else if (!closing_magic_ && !r_.recovery_.footer_present && d.records.empty() && suppressed_ == 0 &&
+               r_.diagnostics_.size() == tail_diagnostics_) {
+      d.state = McapFileState::kNotClosed;
+      d.intact_until = valid_end_;
+    } else {
+      d.state = McapFileState::kDamaged;
+      d.intact_until = std::min(first_problem_, size_);
+    }
+  }
+
+  // ---- records -------------------------------------------------------------------------------
+
+  // Reads one record whose length fits; false when it is unusable (malformed,
+  // a rejected chunk, a Header after the start).
+  bool handle(std::uint8_t op, std::uint64_t pos, const std::uint8_t* content, std::size_t len) {
     ByteSource s(content, len);
     if (in_summary_ && op != kOpFooter) {
       summary_records_[pos] = {op, kRecordPrefixBytes + len};
@@ -257,7 +1032,7 @@ class McapReader::Parser {
         case kOpHeader:
           if (pos != kMagic.size()) {
             diag(pos, "Header record after the start of the file (ignored)");
-            break;
+            return false;
           }
           r_.profile_ = s.str();
           r_.library_ = s.str();
@@ -275,7 +1050,7 @@ class McapReader::Parser {
           r_.messages_.push_back(std::move(m));
           break;
         }
-        case kOpChunk: read_chunk(s, pos, len); break;
+        case kOpChunk: return read_chunk(pos, content, len);
         case kOpMessageIndex: check_message_index(s, pos, len); break;
         case kOpChunkIndex: check_chunk_index(s, pos); break;
         case kOpAttachment: ++attachments_; break;
@@ -313,18 +1088,21 @@ class McapReader::Parser {
           footer_.summary_crc = s.u32();
           break;
         }
-        default: break;  // Attachment/Metadata Index, future and application records
+        default: break;  // Attachment/Metadata Index
       }
       if (op == kOpFooter && len != kFooterContentBytes) {
         diag(pos, "Footer of " + std::to_string(len) + " content bytes, expected 20");
       }
     } catch (const FieldOverrun& e) {
       diag(pos, "malformed " + op_text(op) + " record: a field of " + std::to_string(e.wanted) +
-                    " bytes at content offset " + std::to_string(e.at) + " runs past its " +
-                    std::to_string(len) + " bytes (record skipped)");
+                    " bytes at content offset " + std::to_string(e.at) + " runs past its " + std::to_string(len) +
+                    " bytes (record skipped)");
+      return false;
     } catch (const RecordError& e) {
       diag(pos, "malformed " + op_text(op) + " record: " + e.message + " (record skipped)");
+      return false;
     }
+    return true;
   }
 
   void add_schema(McapSchema schema, std::uint64_t pos) {
@@ -344,144 +1122,51 @@ class McapReader::Parser {
   void add_channel(McapChannel channel, std::uint64_t pos) {
     for (const McapChannel& c : r_.channels_) {
       if (c.id == channel.id) {
-        if (!same(c, channel))
-          diag(pos, "Channel id " + std::to_string(channel.id) + " redefined differently");
+        if (!same(c, channel)) diag(pos, "Channel id " + std::to_string(channel.id) + " redefined differently");
         return;
       }
     }
     r_.channels_.push_back(std::move(channel));
   }
 
-  void read_chunk(ByteSource& s, std::uint64_t pos, std::size_t len) {
-    McapChunkInfo info;
-    info.offset = pos;
-    info.length = kRecordPrefixBytes + len;
+  // The Chunk record at `pos` with `len` content bytes; false when rejected.
+  bool read_chunk(std::uint64_t pos, const std::uint8_t* content, std::size_t len) {
+    ChunkContent c;
+    c.info.offset = pos;
+    c.info.length = kRecordPrefixBytes + len;
     pending_ = ChunkCheck{};
-    pending_.end = pos + info.length;
+    pending_.end = pos + c.info.length;
     pending_.message_index_end = pending_.end;
     pending_valid_ = false;
     have_pending_ = true;
 
-    std::string problem;
-    std::uint32_t stored_crc = 0;
-    const std::uint8_t* records = nullptr;
-    try {
-      info.message_start_time_ns = s.u64();
-      info.message_end_time_ns = s.u64();
-      info.uncompressed_size = s.u64();
-      stored_crc = s.u32();
-      info.compression = s.str();
-      info.compressed_size = s.u64();
-      if (info.compressed_size > s.remaining()) {
-        problem = "records field of " + std::to_string(info.compressed_size) + " bytes, only " +
-                  std::to_string(s.remaining()) + " in the record";
-      } else {
-        records = s.take(static_cast<std::size_t>(info.compressed_size));
-      }
-    } catch (const FieldOverrun&) {
-      problem = "malformed Chunk record header";
-    }
-
-    std::vector<std::uint8_t> decoded;
-    const std::uint8_t* plain = records;
-    if (problem.empty()) problem = decode_chunk(info, records, decoded, plain);
-    const auto plain_size = static_cast<std::size_t>(info.uncompressed_size);
-    if (problem.empty() && stored_crc != 0) {
-      const std::uint32_t computed = crc32(plain, plain_size);
-      if (computed != stored_crc) {
-        problem = "CRC mismatch: chunk says " + hex32(stored_crc) + ", records give " + hex32(computed);
-      }
-    }
-    std::vector<McapSchema> schemas;
-    std::vector<McapChannel> channels;
-    std::vector<McapMessage> messages;
-    if (problem.empty()) problem = parse_chunk_records(plain, plain_size, schemas, channels, messages);
-
-    if (!problem.empty()) {
+    decode_chunk_content(content, len, c, true);
+    McapChunkInfo& info = c.info;
+    if (!c.problem.empty()) {
       ++r_.recovery_.rejected_chunks;
-      diag(pos, "Chunk rejected, its records are skipped: " + problem);
+      diag(pos, "Chunk rejected, its records are skipped: " + c.problem);
       r_.chunks_.push_back(std::move(info));
-      return;
+      return false;
     }
-    for (McapSchema& sc : schemas) add_schema(std::move(sc), pos);
-    for (McapChannel& ch : channels) add_channel(std::move(ch), pos);
+    for (McapSchema& sc : c.schemas) add_schema(std::move(sc), pos);
+    for (McapChannel& ch : c.channels) add_channel(std::move(ch), pos);
     bool out_of_range = false;
-    for (McapMessage& m : messages) {
+    for (std::size_t i = 0; i < c.messages.size(); ++i) {
+      McapMessage& m = c.messages[i];
+      pending_.messages[c.message_offsets[i]] = {m.channel_id, m.log_time_ns};
       first_use_of_channel_.emplace(m.channel_id, pos);
       out_of_range = out_of_range || m.log_time_ns < info.message_start_time_ns ||
                      m.log_time_ns > info.message_end_time_ns;
       r_.messages_.push_back(std::move(m));
     }
     if (out_of_range) diag(pos, "Chunk holds messages outside its message_start_time..message_end_time");
-    info.message_count = messages.size();
+    info.message_count = c.messages.size();
     info.valid = true;
     pending_valid_ = true;
     ++r_.recovery_.complete_chunks;
     chunk_at_[pos] = r_.chunks_.size();
     r_.chunks_.push_back(std::move(info));
-  }
-
-  // Points `plain` at the uncompressed records (into the file or into `decoded`);
-  // returns "" or what is wrong.
-  static std::string decode_chunk(const McapChunkInfo& info, const std::uint8_t* records,
-                                  std::vector<std::uint8_t>& decoded, const std::uint8_t*& plain) {
-    if (info.uncompressed_size > kMaxChunkUncompressedBytes) {
-      return "uncompressed_size " + std::to_string(info.uncompressed_size) + " is implausibly large";
-    }
-    if (info.compression.empty()) {
-      if (info.uncompressed_size == info.compressed_size) return "";
-      return "uncompressed chunk of " + std::to_string(info.compressed_size) +
-             " bytes, uncompressed_size says " + std::to_string(info.uncompressed_size);
-    }
-    try {
-      decoded = decompress_chunk(info.compression, records, static_cast<std::size_t>(info.compressed_size),
-                                 info.uncompressed_size);
-      plain = decoded.data();
-      return "";
-    } catch (const std::exception& e) {
-      return std::string("cannot decompress: ") + e.what();
-    }
-  }
-
-  // Parses the records inside a chunk; returns "" or what is wrong (the chunk is then rejected whole).
-  std::string parse_chunk_records(const std::uint8_t* p, std::size_t n, std::vector<McapSchema>& schemas,
-                                  std::vector<McapChannel>& channels, std::vector<McapMessage>& messages) {
-    std::size_t pos = 0;
-    while (pos < n) {
-      if (n - pos < kRecordPrefixBytes)
-        return "inner record at chunk offset " + std::to_string(pos) + " cut short";
-      const std::uint8_t op = p[pos];
-      const std::uint64_t len = le64(p + pos + 1);
-      if (len > n - pos - kRecordPrefixBytes) {
-        return "inner " + op_text(op) + " record at chunk offset " + std::to_string(pos) +
-               " overruns the chunk";
-      }
-      ByteSource s(p + pos + kRecordPrefixBytes, static_cast<std::size_t>(len));
-      try {
-        switch (op) {
-          case kOpSchema: schemas.push_back(parse_schema(s)); break;
-          case kOpChannel: channels.push_back(parse_channel(s)); break;
-          case kOpMessage: {
-            McapMessage m = parse_message(s);
-            pending_.messages[pos] = {m.channel_id, m.log_time_ns};
-            messages.push_back(std::move(m));
-            break;
-          }
-          default:
-            if (op == 0 || op == kOpHeader || op == kOpFooter || op == kOpChunk || op == kOpDataEnd) {
-              return op_text(op) + " record inside a chunk at chunk offset " + std::to_string(pos);
-            }
-            break;  // other records are not expected here but harmless
-        }
-      } catch (const FieldOverrun&) {
-        return "malformed inner " + op_text(op) + " record at chunk offset " + std::to_string(pos);
-      } catch (const RecordError& e) {
-        return "malformed inner " + op_text(op) + " record at chunk offset " + std::to_string(pos) + ": " +
-               e.message;
-      }
-      pos += kRecordPrefixBytes + static_cast<std::size_t>(len);
-    }
-    return "";
+    return true;
   }
 
   void check_message_index(ByteSource& s, std::uint64_t pos, std::size_t len) {
@@ -509,15 +1194,16 @@ class McapReader::Parser {
     }
   }
 
-  // Called when the records after a chunk stop being Message Index records.
-  void finish_pending_chunk() {
+  // Called when the records after a chunk stop being Message Index records;
+  // `check` false when they stop because the file is cut.
+  void finish_pending_chunk(bool check) {
     if (!have_pending_) return;
     have_pending_ = false;
     if (pending_valid_) {
       const std::uint64_t chunk_offset = r_.chunks_.back().offset;
-      if (pending_.any_index && pending_.indexed != pending_.messages.size()) {
-        diag(chunk_offset, "Message Index records cover " + std::to_string(pending_.indexed) +
-                               " of the chunk's " + std::to_string(pending_.messages.size()) + " messages");
+      if (check && pending_.any_index && pending_.indexed != pending_.messages.size()) {
+        diag(chunk_offset, "Message Index records cover " + std::to_string(pending_.indexed) + " of the chunk's " +
+                               std::to_string(pending_.messages.size()) + " messages");
       }
       chunk_message_index_end_[chunk_offset] = pending_.message_index_end;
     }
@@ -542,10 +1228,24 @@ class McapReader::Parser {
       return;
     }
     const McapChunkInfo& c = r_.chunks_[it->second];
-    if (c.length != chunk_length || c.compression != compression || c.compressed_size != compressed_size ||
-        c.uncompressed_size != uncompressed_size || c.message_start_time_ns != start_time ||
-        c.message_end_time_ns != end_time) {
-      diag(pos, "Chunk Index disagrees with the Chunk at offset " + std::to_string(chunk_offset));
+    std::string differ;
+    auto compare = [&differ](const char* field, bool same_value) {
+      if (!same_value) differ += std::string(differ.empty() ? "" : ", ") + field;
+    };
+    compare("length", c.length == chunk_length);
+    compare("compression", c.compression == compression);
+    compare("compressed_size", c.compressed_size == compressed_size);
+    compare("uncompressed_size", c.uncompressed_size == uncompressed_size);
+    compare("message_start_time", c.message_start_time_ns == start_time);
+    compare("message_end_time", c.message_end_time_ns == end_time);
+    if (!differ.empty()) {
+      if (summary_ok_) {  // the summary's CRC matched: the chunk's header is what changed
+        diag(chunk_offset, "Chunk header disagrees with its Chunk Index at offset " + std::to_string(pos) + " (" +
+                               differ + ")");
+      } else {
+        diag(pos, "Chunk Index disagrees with the Chunk at offset " + std::to_string(chunk_offset) + " (" + differ +
+                      ")");
+      }
     }
     for (const auto& [channel_id, offset] : index_offsets) {
       const auto mi = message_index_at_.find(offset);
@@ -681,11 +1381,26 @@ class McapReader::Parser {
   const std::uint8_t* data_;
   std::size_t size_;
   std::size_t suppressed_ = 0;
+  std::size_t tail_diagnostics_ = 0;  // diagnostics a writer that did not close the file explains
+  std::uint64_t first_problem_ = ~std::uint64_t{0};
+  std::uint64_t valid_end_ = kMagic.size();  // end of the last complete record
+  bool footer_seen_ = false;
   bool in_summary_ = false;
   std::uint64_t attachments_ = 0;
   std::uint64_t metadata_ = 0;
   std::uint64_t chunk_indexes_ = 0;
   std::uint64_t statistics_offset_ = 0;
+
+  // From the end of the file (locate_footer).
+  bool closing_magic_ = false;   // the file ends with the magic
+  std::uint64_t footer_at_ = 0;  // the Footer right before it, 0 if none
+  bool summary_ok_ = false;      // the summary it points at parses (CRC ok when set)
+  std::uint64_t summary_start_ = 0;
+  bool index_used_ = false;  // chunks located by the Chunk Index records
+  std::map<std::uint64_t, Anchor> anchors_;
+  std::map<std::pair<std::uint64_t, std::uint64_t>, bool> verified_;  // (offset, length) -> chunk verifies
+  std::uint64_t verify_budget_ = 0;
+  bool cheap_chunks_ = false;  // probe(): a Chunk whose header agrees with its length is enough
 
   ChunkCheck pending_;
   bool have_pending_ = false;

@@ -79,9 +79,59 @@ struct McapRecovery {
   std::uint64_t bytes_ignored_at_end = 0;  // file_size - valid_bytes: a cut record, garbage, zeros
 };
 
+// What the file as a whole is, as `pixyslam_log info` reports it.
+enum class McapFileState {
+  kComplete,   // Footer and closing magic present, no diagnostics
+  kNotClosed,  // no Footer and no closing magic, nothing else wrong: what a writer that did not close
+               // the file leaves (killed, still writing, a copy of an open file). Every record before
+               // McapDamage::intact_until is intact; only what follows (a cut record, or zeros) is lost
+  kDamaged,    // anything else: corrupt records, bytes skipped, CRC / index / Statistics mismatches
+};
+
+// "complete", "not closed", "damaged".
+const char* mcap_file_state_name(McapFileState state);
+
+struct McapByteRange {
+  std::uint64_t begin = 0;
+  std::uint64_t end = 0;  // one past the last byte
+};
+
+// A record the reader could not use as it stood, or a run of bytes that is no
+// record. [offset, end) is what it spans as far as the reader could tell.
+struct McapDamagedRecord {
+  std::uint64_t offset = 0;
+  std::uint64_t end = 0;
+  std::string what;
+};
+
+// Where the file is damaged and how the reader got past it. The reader
+// resynchronises after a bad record (bad opcode, a length past the end of the
+// file or across a record the chunk index names, a chunk failing its CRC or
+// decompression, a malformed record): at the next record the chunk index names
+// when the summary is intact, else at the next offset where a valid record
+// starts (a chunk that decodes and matches its CRC, the Data End whose CRC
+// matches, the Footer before the closing magic, or a run of well-formed
+// records). A Chunk whose length field alone is wrong is read at the length
+// its own header (and the chunk index) gives, checked by its CRC.
+struct McapDamage {
+  McapFileState state = McapFileState::kNotClosed;
+  bool closed = false;            // the file ends with a Footer and the closing magic
+  bool footer_found = false;      // a Footer record right before the closing magic at the end
+  bool summary_found = false;     // the summary section that Footer points at parses (CRC ok when set)
+  bool chunk_index_used = false;  // chunks were located by its Chunk Index records
+  // Every byte before this offset belongs to intact records: the first damage
+  // (kDamaged), the end of the last complete record (kNotClosed), the file size.
+  std::uint64_t intact_until = 0;
+  std::vector<McapDamagedRecord> records;  // in file order
+  std::vector<McapByteRange> skipped;      // bytes passed over to reach the next valid record
+  std::uint64_t bytes_skipped = 0;         // sum of `skipped`
+};
+
 // Reads a whole MCAP file (https://mcap.dev/spec) into memory and parses it
-// front to back, the way a file from a killed writer must be read: no use of
-// the summary or index to find data.
+// front to back, the way a file from a killed writer must be read. When the
+// file ends with a Footer whose summary is intact, its Chunk Index records say
+// where each chunk is, so that a damaged chunk loses only itself; otherwise
+// the reader scans past a bad record for the next valid one (McapDamage).
 //
 // Verified: magic at both ends, every record length, chunk CRCs, the Data End
 // CRC and the summary CRC (when non-zero), duplicate Schema/Channel records
@@ -93,8 +143,11 @@ struct McapRecovery {
 // throwing: a file cut anywhere after the leading magic (no Footer, a record or
 // chunk cut short), zeros or garbage at the end, a chunk failing its CRC or
 // decompression (its messages are dropped, the rest is kept), malformed
-// records (skipped), unknown opcodes (skipped silently). Messages are returned
-// in file order from every complete valid record.
+// records, bad opcodes and lengths (reading resumes at the next valid record),
+// reserved opcodes (reported, skipped), private opcodes (skipped silently).
+// Messages are returned in file order from every complete valid record.
+// state() says whether the file is complete, not closed (only cut short) or
+// damaged; damage() says where.
 //
 // Throws std::runtime_error naming the file if it cannot be read, or if it is
 // shorter than the 8-byte magic or does not begin with it (not MCAP).
@@ -116,6 +169,9 @@ class McapReader {
   // The summary's Statistics record, if there was one.
   const std::optional<McapStatistics>& statistics() const { return statistics_; }
   const McapRecovery& recovery() const { return recovery_; }
+  // Complete, not closed, or damaged, and where the damage is.
+  const McapDamage& damage() const { return damage_; }
+  McapFileState state() const { return damage_.state; }
   const std::vector<McapDiagnostic>& diagnostics() const { return diagnostics_; }
   // True when the file is complete and nothing was wrong with it.
   bool clean() const { return diagnostics_.empty() && recovery_.footer_present; }
@@ -138,6 +194,7 @@ class McapReader {
   std::vector<McapChunkInfo> chunks_;
   std::optional<McapStatistics> statistics_;
   McapRecovery recovery_;
+  McapDamage damage_;
   std::vector<McapDiagnostic> diagnostics_;
 };
 
