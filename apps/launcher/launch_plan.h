@@ -15,11 +15,11 @@ struct ProcessSpec {
   std::vector<std::string> command;
   double delay_s = 0.0;
   bool ends_run = false;
+  std::vector<std::pair<std::string, std::string>> environment;  // set in the child (deployment)
   // `role: essential` (default: the run stops when it fails) or `optional`
   // (logger, viewers, evaluators: a failure is reported and the process
   // restarted with back-off, the others go on).
   bool optional = false;
-  std::vector<std::pair<std::string, std::string>> environment;  // set in the child (deployment)
 };
 
 // A run as a launch file describes it (config/launch_*.yaml).
