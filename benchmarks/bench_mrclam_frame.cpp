@@ -6,9 +6,9 @@
 // --frames F runs only the first F camera frames (and the odometry up to the
 // last of them). Per M it prints the camera frames and odometry samples fed, the
 // filter time (run_filter's wall time: every add_odometry/add_observations and
-// the pose_estimate recorded after each step), the time per camera frame, the
-// pose ATE against the ground truth (when present) and the time ratio to the
-// previous M.
+// the pose_estimate recorded after each step) and its CPU time (steadier on a
+// shared machine), the wall time per camera frame, the pose ATE against the
+// ground truth (when present) and the wall time ratio to the previous M.
 //
 // Instructions per camera frame (deterministic), one M per process:
 //   valgrind --tool=callgrind --callgrind-out-file=/tmp/x
@@ -143,8 +143,8 @@ int main(int argc, char** argv) {
     std::printf("MRCLAM %s robot %d, config %s, seed %llu: %zu of %zu camera frames%s, %zu odometry samples\n",
                 dataset.c_str(), robot, args["config"].c_str(), static_cast<unsigned long long>(options.seed),
                 frames, frames_all, frames_limit > 0 ? " (--frames)" : " (whole run)", odometry);
-    std::printf("%8s %8s %9s %12s %14s %10s %9s\n", "M", "frames", "odometry", "filter_s", "us_per_frame",
-                "ATE_m", "ratio");
+    std::printf("%8s %8s %9s %12s %10s %14s %10s %9s\n", "M", "frames", "odometry", "filter_s", "cpu_s",
+                "us_per_frame", "ATE_m", "ratio");
     double previous_s = 0.0;
     for (const int m : particles) {
       slam::FilterOptions o = options;
@@ -156,7 +156,7 @@ int main(int argc, char** argv) {
       if (report.has_truth) std::snprintf(ate, sizeof ate, "%.3f", report.filter.ate_rmse_m);
       char ratio[32] = "-";
       if (previous_s > 0.0) std::snprintf(ratio, sizeof ratio, "%.2fx", t / previous_s);
-      std::printf("%8d %8zu %9zu %12.3f %14.1f %10s %9s\n", m, frames, odometry, t,
+      std::printf("%8d %8zu %9zu %12.3f %10.3f %14.1f %10s %9s\n", m, frames, odometry, t, result.cpu_time_s,
                   1e6 * t / static_cast<double>(frames), ate, ratio);
       std::fflush(stdout);
       previous_s = t;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <iterator>
@@ -13,6 +14,15 @@
 #include "pixyslam/eval/rigid_alignment.h"
 
 namespace pixyslam::offline {
+namespace {
+
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+}  // namespace
 
 RunResult run_filter(const slam::FilterOptions& options, const RunInput& input) {
   RunResult result;
@@ -38,6 +48,7 @@ RunResult run_filter(const slam::FilterOptions& options, const RunInput& input) 
   result.covariance.reserve(steps);
   result.dead_reckoning.reserve(steps);
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = thread_cpu_seconds();
   filter.add_odometry(control);  // sets the filter's clock to the start time
   std::size_t i = 0;
   std::size_t k = 0;
@@ -65,6 +76,7 @@ RunResult run_filter(const slam::FilterOptions& options, const RunInput& input) 
     }
   }
   result.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.cpu_time_s = thread_cpu_seconds() - cpu_start;
   for (const slam::LandmarkEstimate& lm : filter.landmarks_of_best()) {
     result.landmarks.push_back({lm.id, lm.mean.x(), lm.mean.y(), lm.cov(0, 0), lm.cov(0, 1), lm.cov(1, 1)});
   }

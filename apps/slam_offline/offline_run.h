@@ -28,6 +28,7 @@ struct RunResult {
   std::vector<eval::LandmarkRow> landmarks;       // best particle
   slam::FilterCounters counters;
   double wall_time_s = 0.0;
+  double cpu_time_s = 0.0;  // this thread's CPU time over the same span (steadier on a shared machine)
   double final_effective_sample_size = 0.0;
 };
 

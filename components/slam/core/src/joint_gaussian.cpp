@@ -165,34 +165,36 @@ JointFit fit_observation(const JointGaussian& g, int index, const Eigen::Vector2
 bool apply_observation(JointGaussian& g, const JointFit& fit) {
   const Eigen::Index j = 3 + 2 * fit.index;
   const Eigen::Index n = g.cov.rows();
-  // Scratch without an allocation per update: P H^T, K and K nu.
+  // Scratch without an allocation per update: P H^T, K, A and K nu.
   thread_local std::vector<double> scratch;
-  scratch.resize(static_cast<std::size_t>(5 * n));
+  scratch.resize(static_cast<std::size_t>(7 * n));
   using Columns2 = Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 2>>;
   Columns2 pht(scratch.data(), n, 2);
   Columns2 k(scratch.data() + 2 * n, n, 2);
-  Eigen::Map<Eigen::VectorXd> step(scratch.data() + 4 * n, n);
+  Columns2 a(scratch.data() + 4 * n, n, 2);
+  Eigen::Map<Eigen::VectorXd> step(scratch.data() + 6 * n, n);
   // P H^T touches only the pose and landmark columns of H.
   pht.noalias() = g.cov.leftCols<3>() * fit.h_pose.transpose();
   pht.noalias() += g.cov.middleCols<2>(j) * fit.h_landmark.transpose();
-  k.noalias() = pht * fit.s.inverse();
+  const Eigen::Matrix2d s_inverse = fit.s.inverse();
+  k.noalias() = pht * s_inverse;
   step.noalias() = k * fit.innovation;
+  // K S K^T = (P H^T) S^-1 (P H^T)^T = A A^T with A = P H^T L, S^-1 = L L^T:
+  // a sum of products that is the same for (r, c) and (c, r), so P stays
+  // exactly symmetric with a plain column-by-column update.
+  const Eigen::LLT<Eigen::Matrix2d> llt(s_inverse);
+  if (llt.info() != Eigen::Success) return false;
+  a.noalias() = pht * llt.matrixL().toDenseMatrix();
   // Checked before anything changes (O(n)): the state after the update must be
   // healthy() (finite, variances in [0, kMaxVariance]).
-  if (!std::isfinite(step.sum()) || !std::isfinite(k.sum())) return false;
+  if (!std::isfinite(step.sum()) || !std::isfinite(a.sum())) return false;
   for (Eigen::Index r = 0; r < n; ++r) {
-    const double v = g.cov(r, r) - (k(r, 0) * pht(r, 0) + k(r, 1) * pht(r, 1));
+    const double v = g.cov(r, r) - (a(r, 0) * a(r, 0) + a(r, 1) * a(r, 1));
     if (!(v >= 0.0 && v <= kMaxVariance)) return false;
   }
   g.mean += step;
   g.mean(2) = wrap_angle(g.mean(2));
-  // P -= K (P H^T)^T: a symmetric rank-2 update, computed on the lower
-  // triangle and mirrored (keeps P exactly symmetric).
-  for (Eigen::Index c = 0; c < n; ++c) {
-    const double p0 = pht(c, 0), p1 = pht(c, 1);
-    for (Eigen::Index r = c; r < n; ++r) g.cov(r, c) -= k(r, 0) * p0 + k(r, 1) * p1;
-  }
-  g.cov.triangularView<Eigen::StrictlyUpper>() = g.cov.transpose();
+  for (Eigen::Index c = 0; c < n; ++c) g.cov.col(c) -= a.col(0) * a(c, 0) + a.col(1) * a(c, 1);
   return true;
 }
 
