@@ -11,6 +11,13 @@
 // (METRES driven, measured) or one turn in place (DEGREES turned, > 0
 // counter-clockwise). --out: the config with the fitted keys replaced
 // (comments kept), checked by the bridge's own option reader.
+//   pixyslam_calibrate noise --mrclam DIR --robot N --config BASE.yaml --out FILE.yaml [--ground-truth]
+//                            [--fit-range-scale]
+// noise: the odometry noise densities, range and bearing sigmas, range scale and
+// command lag of a robot from the filter's own innovations over a recording
+// (repeated filter passes, never the ground truth); BASE with those keys
+// replaced. --ground-truth also fits them against the ground truth and prints
+// both with their relative difference.
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -20,11 +27,15 @@
 
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/app/process_main.h"
+#include "mrclam_dataset.h"
+#include "offline_run.h"
 #include "pixyslam/calibration/calibration.h"
+#include "pixyslam/calibration/noise_calibration.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/yaml_text.h"
 #include "pixyslam/encoder/encoder_options.h"
 #include "pixyslam/pixy/pixy_options.h"
+#include "pixyslam/slam/slam_options_yaml.h"
 #ifdef PIXYSLAM_HAS_CAMERA
 #include "pixyslam/calibration/pole_images.h"
 #include "pixyslam/camera/camera_byte_source.h"
@@ -38,7 +49,12 @@ constexpr const char* kUsage =
     "usage: pixyslam_calibrate camera (--samples POLES.csv | --images PHOTOS.csv) --config PIXY_BRIDGE.yaml\n"
     "                                 [--out FILE]\n"
     "       pixyslam_calibrate odometry --straight REC=METRES[,...] --turn REC=DEGREES[,...]\n"
-    "                                   --config ENCODER_BRIDGE.yaml [--out FILE]\n";
+    "                                   --config ENCODER_BRIDGE.yaml [--out FILE]\n"
+    "       pixyslam_calibrate noise --mrclam DIR --robot N --config BASE.yaml --out FILE.yaml [--ground-truth]\n"
+    "                                [--fit-range-scale]\n"
+    "           (odometry noise densities, range/bearing sigmas, command lag (and with --fit-range-scale\n"
+    "            the range scale) from the filter's innovations, without ground truth; --ground-truth\n"
+    "            also fits them with it and prints both with the relative difference)\n";
 
 std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -184,15 +200,135 @@ int odometry(const app::CommandLine& args) {
   return 0;
 }
 
+// Rounded to 4 significant digits for the config file.
+std::string rounded(double value) {
+  if (value == 0.0 || !std::isfinite(value)) return config::yaml_number(value);
+  const double digits = std::pow(10.0, 3 - std::floor(std::log10(std::abs(value))));
+  return config::yaml_number(std::round(value * digits) / digits);
+}
+
+void print_parameters(const char* title, const calibration::NoiseParameters& p) {
+  std::printf("%s: v_sigma %.5f m/sqrt(s), w_sigma %.5f rad/sqrt(s), range_sigma %.4f m, bearing_sigma %.4f rad, "
+              "range_scale %.4f, odometry_delay %.3f s\n",
+              title, p.v_sigma_m_per_sqrt_s, p.w_sigma_rad_per_sqrt_s, p.range_sigma_m, p.bearing_sigma_rad,
+              p.range_scale, p.odometry_delay_s);
+}
+
+int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_scale) {
+  const std::string config_path = args.get("config");
+  const std::string base_text = read_file(config_path);
+  config::YamlReader root = config::YamlReader::from_string(base_text, config_path);
+  config::YamlReader filter_yaml = root.child("filter");
+  const slam::FilterOptions base = slam::read_filter_options(filter_yaml);
+  offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
+  calibration::NoiseParameters start;
+  start.v_sigma_m_per_sqrt_s = base.motion.v_sigma_m_per_sqrt_s;
+  start.w_sigma_rad_per_sqrt_s = base.motion.w_sigma_rad_per_sqrt_s;
+  start.range_sigma_m = base.range_sigma_m;
+  start.bearing_sigma_rad = base.bearing_sigma_rad;
+  start.range_scale = model.range_scale;
+  start.odometry_delay_s = model.odometry_delay_s;
+  // The calibration applies its own range scale and delay to the raw input.
+  model.range_scale = 1.0;
+  model.odometry_delay_s = 0.0;
+
+  const double robot = args.number("robot", 0.0);
+  const mrclam::RobotData data = mrclam::load_robot(args.get("mrclam"), static_cast<int>(robot));
+  mrclam::RobotData blind_data = data;
+  blind_data.groundtruth.clear();  // a new robot has none: start at the origin
+  blind_data.landmarks.clear();
+  const offline::RunInput blind = offline::mrclam_input(blind_data, model);
+  std::printf("robot %d: %zu odometry samples, %zu frames; %d particles\n", data.robot, blind.odometry.size(),
+              blind.frames.size(), base.particles);
+  print_parameters("start", start);
+  int pass = 0;
+  calibration::NoiseCalibrationOptions noise_options;
+  // Blind, the range scale comes from landmark pairs against the odometry; the
+  // MRCLAM robots' odometry (commanded speeds, slower while turning) makes it
+  // wrong there (docs/calibration.md): only on request.
+  noise_options.fit_range_scale = fit_range_scale;
+  const calibration::NoiseCalibration result = calibration::calibrate_noise(
+      blind, base, start, noise_options, [&](const calibration::NoiseIteration& it) {
+        char title[96];
+        std::snprintf(title, sizeof title, "pass %d (%zu innovations, %zu outliers, mean NIS %.2f)", ++pass,
+                      it.statistics.innovations, it.statistics.outliers, it.statistics.mean_nis);
+        print_parameters(title, it.parameters);
+      });
+  const calibration::NoiseParameters& p = result.parameters;
+  print_parameters(result.converged ? "calibrated (settled)" : "calibrated (not settled)", p);
+  if (!result.iterations.empty()) {
+    std::printf("mean range innovation %.4f m (a range bias; not written)\n",
+                result.iterations.back().statistics.range_bias_m);
+  }
+
+  if (with_ground_truth) {
+    const offline::RunInput with_truth = offline::mrclam_input(data, model);
+    const calibration::NoiseCalibration fit = calibration::calibrate_noise_with_truth(with_truth, start, {});
+    print_parameters("fit with ground truth", fit.parameters);
+    const calibration::NoiseParameters& g = fit.parameters;
+    const auto row = [](const char* name, double blind_value, double truth_value) {
+      std::printf("  %-24s %10.5f %10.5f %+8.1f %%\n", name, blind_value, truth_value,
+                  truth_value != 0.0 ? 100.0 * (blind_value - truth_value) / std::abs(truth_value) : 0.0);
+    };
+    std::printf("  %-24s %10s %10s %9s\n", "value", "blind", "truth", "relative");
+    row("v_sigma_m_per_sqrt_s", p.v_sigma_m_per_sqrt_s, g.v_sigma_m_per_sqrt_s);
+    row("w_sigma_rad_per_sqrt_s", p.w_sigma_rad_per_sqrt_s, g.w_sigma_rad_per_sqrt_s);
+    row("range_sigma_m", p.range_sigma_m, g.range_sigma_m);
+    row("bearing_sigma_rad", p.bearing_sigma_rad, g.bearing_sigma_rad);
+    row("range_scale", p.range_scale, g.range_scale);
+    row("odometry_delay_s", p.odometry_delay_s, g.odometry_delay_s);
+  }
+
+  std::string out = base_text;
+  out = calibration::replace_yaml_value(out, "filter", "v_sigma_m_per_sqrt_s", rounded(p.v_sigma_m_per_sqrt_s));
+  out = calibration::replace_yaml_value(out, "filter", "w_sigma_rad_per_sqrt_s", rounded(p.w_sigma_rad_per_sqrt_s));
+  out = calibration::replace_yaml_value(out, "filter", "range_sigma_m", rounded(p.range_sigma_m));
+  out = calibration::replace_yaml_value(out, "filter", "bearing_sigma_rad", rounded(p.bearing_sigma_rad));
+  out = calibration::replace_yaml_value(out, "mrclam", "range_scale", rounded(p.range_scale));
+  out = calibration::replace_yaml_value(out, "mrclam", "odometry_delay_s",
+                                        config::yaml_number(std::round(p.odometry_delay_s * 1000.0) / 1000.0));
+  // Read back with the programs' own readers before writing.
+  config::YamlReader check = config::YamlReader::from_string(out, args.get("out"));
+  config::YamlReader check_filter = check.child("filter");
+  slam::read_filter_options(check_filter);
+  offline::read_mrclam_sensor_model(check);
+  write_file(args.get("out"), out);
+  std::printf("wrote %s\n", args.get("out").c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const std::vector<std::string> all(argv + 1, argv + argc);
   if (const auto status = app::usage_exit(all, kUsage)) return *status;
   const std::string command = all[0];
-  if (command != "camera" && command != "odometry") {
+  if (command != "camera" && command != "odometry" && command != "noise") {
     std::fprintf(stderr, "pixyslam_calibrate: unknown command '%s'\n%s", command.c_str(), kUsage);
     return 2;
+  }
+  if (command == "noise") {
+    // --ground-truth takes no value: taken out before the `--key value` flags.
+    std::vector<char*> rest;
+    bool with_ground_truth = false, fit_range_scale = false;
+    for (int i = 1; i < argc; ++i) {
+      if (std::string(argv[i]) == "--ground-truth") {
+        with_ground_truth = true;
+      } else if (std::string(argv[i]) == "--fit-range-scale") {
+        fit_range_scale = true;
+      } else {
+        rest.push_back(argv[i]);
+      }
+    }
+    return app::run_main("pixyslam_calibrate", [&] {
+      const app::CommandLine args(static_cast<int>(rest.size()), rest.data(),
+                                  std::set<std::string>{"mrclam", "robot", "config", "out"});
+      if (args.help()) {
+        std::printf("%s", kUsage);
+        return 0;
+      }
+      return noise(args, with_ground_truth, fit_range_scale);
+    });
   }
   return app::run_main("pixyslam_calibrate", [&] {
     const app::CommandLine args(argc - 1, argv + 1, command == "camera" ? std::set<std::string>{"samples", "images", "config", "out"}

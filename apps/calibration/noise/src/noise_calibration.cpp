@@ -1,0 +1,386 @@
+#include "pixyslam/calibration/noise_calibration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+
+#include "pixyslam/slam/fastslam2.h"
+#include "pixyslam/slam/motion_model.h"
+#include "pixyslam/slam/observation_model.h"
+#include "segment_eval.h"
+
+namespace pixyslam::calibration {
+
+offline::RunInput apply_parameters(const offline::RunInput& raw, const NoiseParameters& p) {
+  offline::RunInput in = raw;
+  for (slam::OdometrySample& s : in.odometry) s.t_s += p.odometry_delay_s;
+  for (slam::ObservationFrame& f : in.frames) {
+    for (slam::RangeBearing& d : f.detections) d.range_m /= p.range_scale;
+  }
+  return in;
+}
+
+slam::FilterOptions with_parameters(slam::FilterOptions options, const NoiseParameters& p) {
+  options.motion.v_sigma_m_per_sqrt_s = p.v_sigma_m_per_sqrt_s;
+  options.motion.w_sigma_rad_per_sqrt_s = p.w_sigma_rad_per_sqrt_s;
+  options.range_sigma_m = p.range_sigma_m;
+  options.bearing_sigma_rad = p.bearing_sigma_rad;
+  return options;
+}
+
+namespace {
+
+// Dead reckoning through time-sorted odometry (zero-order hold, stamps moved by
+// `shift`), carrying the pose covariance for a unit v density and for a unit w
+// density separately (from zero both are linear in the density squared).
+class Predictor {
+ public:
+  Predictor(const std::vector<slam::OdometrySample>& odometry, double shift) : odometry_(odometry), shift_(shift) {}
+
+  void reset(const slam::Pose2& pose, double t, const Eigen::Matrix3d& cov) {
+    gv_ = {pose, Eigen::Matrix3d::Zero()};
+    gw_ = gv_;
+    g0_ = {pose, cov};
+    t_ = t;
+    // The control held at t: last sample at or before t.
+    next_ = static_cast<std::size_t>(
+        std::upper_bound(odometry_.begin(), odometry_.end(), t - shift_,
+                         [](double time, const slam::OdometrySample& s) { return time < s.t_s; }) -
+        odometry_.begin());
+  }
+
+  void advance_to(double t) {
+    static const slam::MotionNoise unit_v{1.0, 0.0, 0.0, 0.0, 0.0};
+    static const slam::MotionNoise unit_w{0.0, 1.0, 0.0, 0.0, 0.0};
+    while (t_ < t) {
+      const double segment_end = next_ < odometry_.size() ? std::min(t, odometry_[next_].t_s + shift_) : t;
+      const double dt = segment_end - t_;
+      if (dt > 0.0) {
+        double v = 0.0, w = 0.0;
+        if (next_ > 0) {
+          v = odometry_[next_ - 1].v_mps;
+          w = odometry_[next_ - 1].w_radps;
+        }
+        const slam::Pose2 start = gv_.mean;
+        slam::propagate(gv_, v, w, dt, unit_v);
+        gw_.mean = start;
+        slam::propagate(gw_, v, w, dt, unit_w);
+        g0_.mean = start;
+        slam::propagate(g0_, v, w, dt, slam::MotionNoise{0.0, 0.0, 0.0, 0.0, 0.0});
+      }
+      t_ = segment_end;
+      if (next_ < odometry_.size() && odometry_[next_].t_s + shift_ <= t_) ++next_;
+    }
+  }
+
+  const slam::Pose2& mean() const { return gv_.mean; }
+  const Eigen::Matrix3d& cov_v() const { return gv_.cov; }
+  const Eigen::Matrix3d& cov_w() const { return gw_.cov; }
+  const Eigen::Matrix3d& cov_start() const { return g0_.cov; }
+
+ private:
+  const std::vector<slam::OdometrySample>& odometry_;
+  double shift_;
+  slam::PoseGaussian gv_, gw_, g0_;
+  double t_ = 0.0;
+  std::size_t next_ = 0;
+};
+
+// One observation predicted from an earlier reference pose.
+struct Row {
+  Eigen::Vector2d e;        // innovation (range, bearing)
+  Eigen::Vector2d a_v;      // diag of H A_v H^T
+  Eigen::Vector2d a_w;      // diag of H A_w H^T
+  Eigen::Vector2d dh_delay = Eigen::Vector2d::Zero(); // d predicted / d delay
+  Eigen::Vector2d known = Eigen::Vector2d::Zero();    // diag of H P_start H^T moved to the frame
+  double range_m = 0.0;     // measured range (scale applied)
+  // d e_range / d c for a relative range scale change c (scale * (1 + c)).
+  double de_range_dscale = 0.0;
+};
+
+constexpr double kDelayStep = 0.02;
+
+std::vector<Row> collect_rows(const offline::RunInput& in, const References& refs, const NoiseCalibrationOptions& o,
+                              std::size_t* start_frames, std::vector<Row>* pair_rows) {
+  std::vector<Row> rows;
+  std::vector<slam::OdometrySample> odometry = in.odometry;
+  std::stable_sort(odometry.begin(), odometry.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  Predictor base(odometry, 0.0), shifted(odometry, kDelayStep);
+  const std::size_t n = in.frames.size();
+  *start_frames = 0;
+  std::size_t window_begin = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (j >= refs.has_pose.size() || !refs.has_pose[j]) continue;
+    const double t0 = in.frames[j].t_s;
+    // Target frames in (t0 + min_lag, t0 + max_lag].
+    window_begin = std::max(window_begin, j + 1);
+    while (window_begin < n && in.frames[window_begin].t_s < t0 + o.min_lag_s) ++window_begin;
+    std::size_t window_end = window_begin;
+    while (window_end < n && in.frames[window_end].t_s <= t0 + o.max_lag_s) ++window_end;
+    const std::size_t count = window_end - window_begin;
+    if (count == 0) continue;
+    ++*start_frames;
+    const std::size_t stride =
+        std::max<std::size_t>(1, (count + static_cast<std::size_t>(o.max_lags_per_frame) - 1) /
+                                     static_cast<std::size_t>(o.max_lags_per_frame));
+    const Eigen::Matrix3d start_cov = j < refs.frame_cov.size() ? refs.frame_cov[j] : Eigen::Matrix3d::Zero();
+    base.reset(refs.frame_pose[j], t0, start_cov);
+    shifted.reset(refs.frame_pose[j], t0, Eigen::Matrix3d::Zero());
+    for (std::size_t k = window_begin; k < window_end; k += stride) {
+      const slam::ObservationFrame& f = in.frames[k];
+      base.advance_to(f.t_s);
+      shifted.advance_to(f.t_s);
+      for (const slam::RangeBearing& d : f.detections) {
+        // The same landmark seen at the start frame: its position from that
+        // observation, moved by the odometry, against this observation. Ranges
+        // at both ends scale, the odometry does not: the range scale without a map.
+        for (const slam::RangeBearing& d0 : in.frames[j].detections) {
+          if (d0.landmark_id != d.landmark_id) continue;
+          const slam::Pose2& x0 = refs.frame_pose[j];
+          const Eigen::Vector2d rel(d0.range_m * std::cos(x0.z() + d0.bearing_rad),
+                                    d0.range_m * std::sin(x0.z() + d0.bearing_rad));
+          const slam::PredictedObservation p = slam::predict_observation(base.mean(), x0.head<2>() + rel);
+          Row r;
+          r.e = slam::innovation(Eigen::Vector2d(d.range_m, d.bearing_rad), p.z);
+          r.a_v = (p.h_pose * base.cov_v() * p.h_pose.transpose()).diagonal();
+          r.a_w = (p.h_pose * base.cov_w() * p.h_pose.transpose()).diagonal();
+          r.range_m = d.range_m;
+          r.de_range_dscale = -d.range_m + (p.h_landmark * rel).x();
+          if (std::isfinite(r.e.x())) pair_rows->push_back(r);
+        }
+        const auto it = refs.landmarks.find(d.landmark_id);
+        if (it == refs.landmarks.end()) continue;
+        const slam::PredictedObservation p = slam::predict_observation(base.mean(), it->second);
+        const slam::PredictedObservation q = slam::predict_observation(shifted.mean(), it->second);
+        Row r;
+        r.e = slam::innovation(Eigen::Vector2d(d.range_m, d.bearing_rad), p.z);
+        r.a_v = (p.h_pose * base.cov_v() * p.h_pose.transpose()).diagonal();
+        r.a_w = (p.h_pose * base.cov_w() * p.h_pose.transpose()).diagonal();
+        r.known = (p.h_pose * base.cov_start() * p.h_pose.transpose()).diagonal();
+        r.dh_delay = Eigen::Vector2d(q.z.x() - p.z.x(), slam::wrap_angle(q.z.y() - p.z.y())) / kDelayStep;
+        r.range_m = d.range_m;
+        r.de_range_dscale = -d.range_m;
+        if (std::isfinite(r.e.x()) && std::isfinite(r.e.y())) rows.push_back(r);
+      }
+    }
+  }
+  return rows;
+}
+
+}  // namespace
+
+NoiseParameters fit_noise(const offline::RunInput& raw, const References& references, const NoiseParameters& current,
+                          const NoiseCalibrationOptions& options, FitStatistics* statistics) {
+  const offline::RunInput in = apply_parameters(raw, current);
+  FitStatistics stats;
+  std::vector<Row> pair_rows;
+  const std::vector<Row> rows = collect_rows(in, references, options, &stats.start_frames, &pair_rows);
+  if (rows.size() < 20) {
+    throw std::invalid_argument("noise calibration: only " + std::to_string(rows.size()) +
+                                " innovations (needs landmarks seen at frames less than max_lag_s apart)");
+  }
+  // u = (range var, bearing var, v density^2, w density^2).
+  Eigen::Vector4d u(current.range_sigma_m * current.range_sigma_m, current.bearing_sigma_rad * current.bearing_sigma_rad,
+                    current.v_sigma_m_per_sqrt_s * current.v_sigma_m_per_sqrt_s,
+                    current.w_sigma_rad_per_sqrt_s * current.w_sigma_rad_per_sqrt_s);
+  // A pass moves no sigma by more than a factor 3, nor below a floor (a fit on
+  // a few hundred innovations can drive one variance to zero, and the next
+  // filter pass, trusting that sensor completely, diverges).
+  const Eigen::Vector4d floor =
+      (u / 9.0).cwiseMax(Eigen::Vector4d(options.min_range_sigma_m * options.min_range_sigma_m,
+                                         options.min_bearing_sigma_rad * options.min_bearing_sigma_rad,
+                                         options.min_odometry_sigma * options.min_odometry_sigma,
+                                         options.min_odometry_sigma * options.min_odometry_sigma));
+  const Eigen::Vector4d ceiling = (u * 9.0).cwiseMax(floor);
+  const double gate2 = options.outlier_sigmas * options.outlier_sigmas;
+  std::vector<bool> inlier(rows.size(), true);
+  const auto variances = [&](const Row& r) {
+    return Eigen::Vector2d(r.known.x() + u(0) + u(2) * r.a_v.x() + u(3) * r.a_w.x(),
+                           r.known.y() + u(1) + u(2) * r.a_v.y() + u(3) * r.a_w.y());
+  };
+  // Iteratively reweighted least squares: weights 1 / S^2 (the variance of e^2
+  // is 2 S^2), the outlier gate re-drawn with every new estimate.
+  for (int pass = 0; pass < 6; ++pass) {
+    Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const Row& r = rows[i];
+      const Eigen::Vector2d s = variances(r);
+      inlier[i] = r.e.x() * r.e.x() <= gate2 * s.x() && r.e.y() * r.e.y() <= gate2 * s.y();
+      if (!inlier[i]) continue;
+      const Eigen::Vector4d range_row(1.0, 0.0, r.a_v.x(), r.a_w.x());
+      const Eigen::Vector4d bearing_row(0.0, 1.0, r.a_v.y(), r.a_w.y());
+      normal += range_row * range_row.transpose() / (s.x() * s.x());
+      rhs += range_row * (r.e.x() * r.e.x() - r.known.x()) / (s.x() * s.x());
+      normal += bearing_row * bearing_row.transpose() / (s.y() * s.y());
+      rhs += bearing_row * (r.e.y() * r.e.y() - r.known.y()) / (s.y() * s.y());
+    }
+    const Eigen::Vector4d next = normal.ldlt().solve(rhs);
+    if (!next.allFinite()) break;
+    u = next.cwiseMax(floor).cwiseMin(ceiling);
+  }
+  NoiseParameters out = current;
+  out.range_sigma_m = std::sqrt(u(0));
+  out.bearing_sigma_rad = std::sqrt(u(1));
+  out.v_sigma_m_per_sqrt_s = std::sqrt(u(2));
+  out.w_sigma_rad_per_sqrt_s = std::sqrt(u(3));
+
+  // Range scale and delay: a Gauss-Newton step on the innovations, weights 1 / S.
+  // A relative range scale change c moves the measured range by -c * range; a
+  // delay change moves the prediction by dh_delay.
+  Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d rhs = Eigen::Vector2d::Zero();
+  double nis = 0.0, bias = 0.0, bias_weight = 0.0;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const Row& r = rows[i];
+    const Eigen::Vector2d s = variances(r);
+    if (r.e.x() * r.e.x() > gate2 * s.x() || r.e.y() * r.e.y() > gate2 * s.y()) {
+      ++stats.outliers;
+      continue;
+    }
+    ++stats.innovations;
+    nis += r.e.x() * r.e.x() / s.x() + r.e.y() * r.e.y() / s.y();
+    bias += r.e.x() / s.x();
+    bias_weight += 1.0 / s.x();
+    // e ~ J (c, d): range row (-de/dc, dh_r), bearing row (0, dh_b).
+    const bool scale_here = options.fit_range_scale && !options.range_scale_from_pairs;
+    const Eigen::Vector2d range_row(scale_here ? -r.de_range_dscale : 0.0,
+                                    options.fit_odometry_delay ? r.dh_delay.x() : 0.0);
+    const Eigen::Vector2d bearing_row(0.0, options.fit_odometry_delay ? r.dh_delay.y() : 0.0);
+    normal += range_row * range_row.transpose() / s.x() + bearing_row * bearing_row.transpose() / s.y();
+    rhs += range_row * r.e.x() / s.x() + bearing_row * r.e.y() / s.y();
+  }
+  if (options.fit_range_scale && options.range_scale_from_pairs) {
+    // Both observations carry range noise.
+    for (const Row& r : pair_rows) {
+      const double s = 2.0 * u(0) + u(2) * r.a_v.x() + u(3) * r.a_w.x();
+      if (r.e.x() * r.e.x() > gate2 * s) continue;
+      normal(0, 0) += r.de_range_dscale * r.de_range_dscale / s;
+      rhs(0) += -r.de_range_dscale * r.e.x() / s;
+    }
+  }
+  if (!options.fit_range_scale || normal(0, 0) <= 0.0) normal(0, 0) = 1.0;
+  if (!options.fit_odometry_delay || normal(1, 1) <= 0.0) normal(1, 1) = 1.0;
+  const Eigen::Vector2d step = normal.ldlt().solve(rhs);
+  if (step.allFinite()) {
+    // measured = scale * true; the corrected range raw / scale has error c * range:
+    // the new scale is scale * (1 + c).
+    const double c = std::clamp(step.x(), -0.2, 0.2);
+    out.range_scale = current.range_scale * (1.0 + c);
+    out.odometry_delay_s = current.odometry_delay_s + std::clamp(step.y(), -0.2, 0.2);
+  }
+  stats.mean_nis = stats.innovations > 0 ? nis / static_cast<double>(stats.innovations) : 0.0;
+  stats.range_bias_m = bias_weight > 0.0 ? bias / bias_weight : 0.0;
+  if (statistics) *statistics = stats;
+  return out;
+}
+
+References truth_references(const offline::RunInput& raw) {
+  if (raw.truth.empty() || raw.landmarks.empty()) {
+    throw std::invalid_argument("noise calibration with ground truth: needs robot and landmark ground truth");
+  }
+  std::vector<eval::TimedPose> truth = raw.truth;
+  std::stable_sort(truth.begin(), truth.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  References refs;
+  refs.frame_pose.resize(raw.frames.size(), slam::Pose2::Zero());
+  refs.has_pose.resize(raw.frames.size(), false);
+  for (std::size_t k = 0; k < raw.frames.size(); ++k) {
+    const std::optional<eval::TimedPose> g = offline::interpolate_pose(truth, raw.frames[k].t_s, 0.5);
+    if (!g) continue;
+    refs.frame_pose[k] = slam::Pose2(g->x_m, g->y_m, g->theta_rad);
+    refs.has_pose[k] = true;
+  }
+  for (const eval::LandmarkPoint& l : raw.landmarks) refs.landmarks[l.id] = Eigen::Vector2d(l.x_m, l.y_m);
+  return refs;
+}
+
+References filter_references(const offline::RunInput& raw, const slam::FilterOptions& base, const NoiseParameters& p) {
+  const offline::RunInput in = apply_parameters(raw, p);
+  slam::FilterOptions options = with_parameters(base, p);
+  options.frame_uncertainty = false;  // the pose covariance relative to the map
+  slam::FastSlam2 filter(options, in.initial_pose);
+  References refs;
+  refs.frame_pose.resize(in.frames.size(), slam::Pose2::Zero());
+  refs.has_pose.resize(in.frames.size(), false);
+  refs.frame_cov.resize(in.frames.size(), Eigen::Matrix3d::Zero());
+  // Time order as offline::run_filter: odometry first on equal stamps.
+  std::vector<slam::OdometrySample> odometry = in.odometry;
+  std::stable_sort(odometry.begin(), odometry.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  filter.add_odometry({in.start_time_s, 0.0, 0.0});
+  std::size_t i = 0, k = 0;
+  while (i < odometry.size() || k < in.frames.size()) {
+    if (k == in.frames.size() || (i < odometry.size() && odometry[i].t_s <= in.frames[k].t_s)) {
+      slam::OdometrySample s = odometry[i++];
+      if (s.t_s < in.start_time_s) s.t_s = in.start_time_s;
+      filter.add_odometry(s);
+    } else {
+      const slam::ObservationFrame& f = in.frames[k];
+      if (f.t_s >= in.start_time_s) {
+        filter.add_observations(f);
+        const slam::PoseEstimate e = filter.pose_estimate();
+        refs.frame_pose[k] = e.mean;
+        refs.frame_cov[k] = e.cov;
+        refs.has_pose[k] = true;
+      }
+      ++k;
+    }
+  }
+  for (const slam::LandmarkEstimate& l : filter.landmarks_mixture()) refs.landmarks[l.id] = l.mean;
+  return refs;
+}
+
+namespace {
+
+bool settled(const NoiseParameters& a, const NoiseParameters& b, const NoiseCalibrationOptions& o) {
+  const auto close = [&](double x, double y) { return std::abs(x - y) <= o.relative_tolerance * std::abs(y); };
+  return close(a.v_sigma_m_per_sqrt_s, b.v_sigma_m_per_sqrt_s) && close(a.w_sigma_rad_per_sqrt_s, b.w_sigma_rad_per_sqrt_s) &&
+         close(a.range_sigma_m, b.range_sigma_m) && close(a.bearing_sigma_rad, b.bearing_sigma_rad) &&
+         close(a.range_scale, b.range_scale) && std::abs(a.odometry_delay_s - b.odometry_delay_s) <= o.delay_tolerance_s;
+}
+
+template <typename Refs>
+NoiseCalibration iterate(const offline::RunInput& raw, const NoiseParameters& start, const NoiseCalibrationOptions& o,
+                         const Refs& references, const std::function<void(const NoiseIteration&)>& on_iteration) {
+  NoiseCalibration result;
+  NoiseParameters p = start;
+  for (int it = 0; it < o.max_iterations; ++it) {
+    NoiseIteration step;
+    step.parameters = fit_noise(raw, references(p), p, o, &step.statistics);
+    result.iterations.push_back(step);
+    if (on_iteration) on_iteration(step);
+    const bool done = settled(step.parameters, p, o);
+    p = step.parameters;
+    if (done) {
+      result.converged = true;
+      break;
+    }
+  }
+  result.parameters = p;
+  return result;
+}
+
+}  // namespace
+
+NoiseCalibration calibrate_noise(const offline::RunInput& raw, const slam::FilterOptions& base,
+                                 const NoiseParameters& start, const NoiseCalibrationOptions& options,
+                                 const std::function<void(const NoiseIteration&)>& on_iteration) {
+  offline::RunInput blind = raw;
+  blind.truth.clear();
+  blind.landmarks.clear();
+  NoiseCalibrationOptions o = options;
+  o.range_scale_from_pairs = true;
+  return iterate(blind, start, o,
+                 [&](const NoiseParameters& p) { return filter_references(blind, base, p); }, on_iteration);
+}
+
+NoiseCalibration calibrate_noise_with_truth(const offline::RunInput& raw, const NoiseParameters& start,
+                                            const NoiseCalibrationOptions& options) {
+  const References refs = truth_references(raw);
+  NoiseCalibrationOptions o = options;
+  o.max_iterations = std::max(o.max_iterations, 12);
+  return iterate(raw, start, o, [&](const NoiseParameters&) -> const References& { return refs; }, {});
+}
+
+}  // namespace pixyslam::calibration
