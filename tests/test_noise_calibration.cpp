@@ -76,7 +76,7 @@ void print(const char* what, const NoiseParameters& p) {
               p.w_sigma_rad_per_sqrt_s, p.range_sigma_m, p.bearing_sigma_rad, p.range_scale, p.odometry_delay_s);
 }
 
-// Blind, v_sigma comes out 25-75 % high (the filter's references: see
+// Blind, v_sigma comes out 25-45 % high (the filter's references: see
 // docs/calibration.md); checked within a factor 2 there.
 void expect_recovered(const NoiseParameters& got, const NoiseParameters& want, bool blind = false) {
   if (blind) {

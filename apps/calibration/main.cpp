@@ -12,7 +12,7 @@
 // counter-clockwise). --out: the config with the fitted keys replaced
 // (comments kept), checked by the bridge's own option reader.
 //   pixyslam_calibrate noise --mrclam DIR --robot N --config BASE.yaml --out FILE.yaml [--ground-truth]
-//                            [--fit-range-scale]
+//                            [--fit-range-scale] [--keys LIST]
 // noise: the odometry noise densities, range and bearing sigmas, range scale and
 // command lag of a robot from the filter's own innovations over a recording
 // (repeated filter passes, never the ground truth); BASE with those keys
@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -51,10 +52,11 @@ constexpr const char* kUsage =
     "       pixyslam_calibrate odometry --straight REC=METRES[,...] --turn REC=DEGREES[,...]\n"
     "                                   --config ENCODER_BRIDGE.yaml [--out FILE]\n"
     "       pixyslam_calibrate noise --mrclam DIR --robot N --config BASE.yaml --out FILE.yaml [--ground-truth]\n"
-    "                                [--fit-range-scale]\n"
+    "                                [--fit-range-scale] [--keys v_sigma,w_sigma,range_sigma,bearing_sigma,...]\n"
     "           (odometry noise densities, range/bearing sigmas, command lag (and with --fit-range-scale\n"
     "            the range scale) from the filter's innovations, without ground truth; --ground-truth\n"
-    "            also fits them with it and prints both with the relative difference)\n";
+    "            also fits them with it and prints both with the relative difference; --keys: write only\n"
+    "            these of v_sigma, w_sigma, range_sigma, bearing_sigma, range_scale, odometry_delay)\n";
 
 std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -279,14 +281,31 @@ int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_s
     row("odometry_delay_s", p.odometry_delay_s, g.odometry_delay_s);
   }
 
+  // --keys: which of the values to write (default all that were fitted).
+  std::set<std::string> keys{"v_sigma", "w_sigma", "range_sigma", "bearing_sigma", "odometry_delay"};
+  if (fit_range_scale) keys.insert("range_scale");
+  if (args.has("keys")) {
+    keys.clear();
+    for (const std::string& key : config::split_comma_list(args.get("keys"))) {
+      if (key != "v_sigma" && key != "w_sigma" && key != "range_sigma" && key != "bearing_sigma" &&
+          key != "range_scale" && key != "odometry_delay") {
+        throw std::invalid_argument("--keys: unknown value '" + key +
+                                    "' (v_sigma, w_sigma, range_sigma, bearing_sigma, range_scale, odometry_delay)");
+      }
+      keys.insert(key);
+    }
+  }
   std::string out = base_text;
-  out = calibration::replace_yaml_value(out, "filter", "v_sigma_m_per_sqrt_s", rounded(p.v_sigma_m_per_sqrt_s));
-  out = calibration::replace_yaml_value(out, "filter", "w_sigma_rad_per_sqrt_s", rounded(p.w_sigma_rad_per_sqrt_s));
-  out = calibration::replace_yaml_value(out, "filter", "range_sigma_m", rounded(p.range_sigma_m));
-  out = calibration::replace_yaml_value(out, "filter", "bearing_sigma_rad", rounded(p.bearing_sigma_rad));
-  out = calibration::replace_yaml_value(out, "mrclam", "range_scale", rounded(p.range_scale));
-  out = calibration::replace_yaml_value(out, "mrclam", "odometry_delay_s",
-                                        config::yaml_number(std::round(p.odometry_delay_s * 1000.0) / 1000.0));
+  const auto replace = [&](const char* key, const char* section, const char* yaml_key, const std::string& value) {
+    if (keys.count(key)) out = calibration::replace_yaml_value(out, section, yaml_key, value);
+  };
+  replace("v_sigma", "filter", "v_sigma_m_per_sqrt_s", rounded(p.v_sigma_m_per_sqrt_s));
+  replace("w_sigma", "filter", "w_sigma_rad_per_sqrt_s", rounded(p.w_sigma_rad_per_sqrt_s));
+  replace("range_sigma", "filter", "range_sigma_m", rounded(p.range_sigma_m));
+  replace("bearing_sigma", "filter", "bearing_sigma_rad", rounded(p.bearing_sigma_rad));
+  replace("range_scale", "mrclam", "range_scale", rounded(p.range_scale));
+  replace("odometry_delay", "mrclam", "odometry_delay_s",
+          config::yaml_number(std::round(p.odometry_delay_s * 1000.0) / 1000.0));
   // Read back with the programs' own readers before writing.
   config::YamlReader check = config::YamlReader::from_string(out, args.get("out"));
   config::YamlReader check_filter = check.child("filter");
@@ -322,7 +341,7 @@ int main(int argc, char** argv) {
     }
     return app::run_main("pixyslam_calibrate", [&] {
       const app::CommandLine args(static_cast<int>(rest.size()), rest.data(),
-                                  std::set<std::string>{"mrclam", "robot", "config", "out"});
+                                  std::set<std::string>{"mrclam", "robot", "config", "out", "keys"});
       if (args.help()) {
         std::printf("%s", kUsage);
         return 0;

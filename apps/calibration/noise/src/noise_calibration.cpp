@@ -150,15 +150,27 @@ std::vector<Row> collect_rows(const offline::RunInput& in, const References& ref
           r.de_range_dscale = -d.range_m + (p.h_landmark * rel).x();
           if (std::isfinite(r.e.x())) pair_rows->push_back(r);
         }
-        const auto it = refs.landmarks.find(d.landmark_id);
-        if (it == refs.landmarks.end()) continue;
-        const slam::PredictedObservation p = slam::predict_observation(base.mean(), it->second);
-        const slam::PredictedObservation q = slam::predict_observation(shifted.mean(), it->second);
+        Eigen::Vector2d landmark;
+        Eigen::Matrix2d landmark_cov = Eigen::Matrix2d::Zero();
+        if (j < refs.frame_landmarks.size()) {
+          const auto it = refs.frame_landmarks[j].find(d.landmark_id);
+          if (it == refs.frame_landmarks[j].end()) continue;
+          landmark = it->second.mean;
+          landmark_cov = it->second.cov;
+        } else {
+          const auto it = refs.landmarks.find(d.landmark_id);
+          if (it == refs.landmarks.end()) continue;
+          landmark = it->second;
+        }
+        const slam::PredictedObservation p = slam::predict_observation(base.mean(), landmark);
+        const slam::PredictedObservation q = slam::predict_observation(shifted.mean(), landmark);
         Row r;
         r.e = slam::innovation(Eigen::Vector2d(d.range_m, d.bearing_rad), p.z);
         r.a_v = (p.h_pose * base.cov_v() * p.h_pose.transpose()).diagonal();
         r.a_w = (p.h_pose * base.cov_w() * p.h_pose.transpose()).diagonal();
-        r.known = (p.h_pose * base.cov_start() * p.h_pose.transpose()).diagonal();
+        r.known = (p.h_pose * base.cov_start() * p.h_pose.transpose() +
+                   p.h_landmark * landmark_cov * p.h_landmark.transpose())
+                      .diagonal();
         r.dh_delay = Eigen::Vector2d(q.z.x() - p.z.x(), slam::wrap_angle(q.z.y() - p.z.y())) / kDelayStep;
         r.range_m = d.range_m;
         r.de_range_dscale = -d.range_m;
@@ -181,43 +193,57 @@ NoiseParameters fit_noise(const offline::RunInput& raw, const References& refere
     throw std::invalid_argument("noise calibration: only " + std::to_string(rows.size()) +
                                 " innovations (needs landmarks seen at frames less than max_lag_s apart)");
   }
-  // u = (range var, bearing var, v density^2, w density^2).
-  Eigen::Vector4d u(current.range_sigma_m * current.range_sigma_m, current.bearing_sigma_rad * current.bearing_sigma_rad,
-                    current.v_sigma_m_per_sqrt_s * current.v_sigma_m_per_sqrt_s,
-                    current.w_sigma_rad_per_sqrt_s * current.w_sigma_rad_per_sqrt_s);
+  // u = (range var, bearing var, v density^2, w density^2, alpha): alpha scales
+  // the reference's own part of the variance (the filter's covariances hold the
+  // map frame's uncertainty, which cancels between pose and map).
+  using Vector5d = Eigen::Matrix<double, 5, 1>;
+  using Matrix5d = Eigen::Matrix<double, 5, 5>;
+  Vector5d u;
+  u << current.range_sigma_m * current.range_sigma_m, current.bearing_sigma_rad * current.bearing_sigma_rad,
+      current.v_sigma_m_per_sqrt_s * current.v_sigma_m_per_sqrt_s,
+      current.w_sigma_rad_per_sqrt_s * current.w_sigma_rad_per_sqrt_s, 1.0;
   // A pass moves no sigma by more than a factor 3, nor below a floor (a fit on
   // a few hundred innovations can drive one variance to zero, and the next
   // filter pass, trusting that sensor completely, diverges).
-  const Eigen::Vector4d floor =
-      (u / 9.0).cwiseMax(Eigen::Vector4d(options.min_range_sigma_m * options.min_range_sigma_m,
+  Vector5d floor, ceiling;
+  floor.head<4>() = (u.head<4>() / 9.0).cwiseMax(Eigen::Vector4d(options.min_range_sigma_m * options.min_range_sigma_m,
                                          options.min_bearing_sigma_rad * options.min_bearing_sigma_rad,
                                          options.min_odometry_sigma * options.min_odometry_sigma,
                                          options.min_odometry_sigma * options.min_odometry_sigma));
-  const Eigen::Vector4d ceiling = (u * 9.0).cwiseMax(floor);
+  ceiling.head<4>() = (u.head<4>() * 9.0).cwiseMax(floor.head<4>());
+  floor(4) = 0.0;
+  ceiling(4) = 1.0;
   const double gate2 = options.outlier_sigmas * options.outlier_sigmas;
   std::vector<bool> inlier(rows.size(), true);
   const auto variances = [&](const Row& r) {
-    return Eigen::Vector2d(r.known.x() + u(0) + u(2) * r.a_v.x() + u(3) * r.a_w.x(),
-                           r.known.y() + u(1) + u(2) * r.a_v.y() + u(3) * r.a_w.y());
+    return Eigen::Vector2d(u(4) * r.known.x() + u(0) + u(2) * r.a_v.x() + u(3) * r.a_w.x(),
+                           u(4) * r.known.y() + u(1) + u(2) * r.a_v.y() + u(3) * r.a_w.y());
   };
   // Iteratively reweighted least squares: weights 1 / S^2 (the variance of e^2
   // is 2 S^2), the outlier gate re-drawn with every new estimate.
   for (int pass = 0; pass < 6; ++pass) {
-    Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
-    Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
+    Matrix5d normal = Matrix5d::Zero();
+    Vector5d rhs = Vector5d::Zero();
     for (std::size_t i = 0; i < rows.size(); ++i) {
       const Row& r = rows[i];
       const Eigen::Vector2d s = variances(r);
       inlier[i] = r.e.x() * r.e.x() <= gate2 * s.x() && r.e.y() * r.e.y() <= gate2 * s.y();
       if (!inlier[i]) continue;
-      const Eigen::Vector4d range_row(1.0, 0.0, r.a_v.x(), r.a_w.x());
-      const Eigen::Vector4d bearing_row(0.0, 1.0, r.a_v.y(), r.a_w.y());
+      Vector5d range_row, bearing_row;
+      range_row << 1.0, 0.0, r.a_v.x(), r.a_w.x(), r.known.x();
+      bearing_row << 0.0, 1.0, r.a_v.y(), r.a_w.y(), r.known.y();
       normal += range_row * range_row.transpose() / (s.x() * s.x());
-      rhs += range_row * (r.e.x() * r.e.x() - r.known.x()) / (s.x() * s.x());
+      rhs += range_row * (r.e.x() * r.e.x()) / (s.x() * s.x());
       normal += bearing_row * bearing_row.transpose() / (s.y() * s.y());
-      rhs += bearing_row * (r.e.y() * r.e.y() - r.known.y()) / (s.y() * s.y());
+      rhs += bearing_row * (r.e.y() * r.e.y()) / (s.y() * s.y());
     }
-    const Eigen::Vector4d next = normal.ldlt().solve(rhs);
+    if (normal(4, 4) <= 0.0) {  // exact references (ground truth): no known part
+      normal.row(4).setZero();
+      normal.col(4).setZero();
+      normal(4, 4) = 1.0;
+      rhs(4) = u(4);
+    }
+    const Vector5d next = normal.ldlt().solve(rhs);
     if (!next.allFinite()) break;
     u = next.cwiseMax(floor).cwiseMin(ceiling);
   }
@@ -308,21 +334,28 @@ References filter_references(const offline::RunInput& raw, const slam::FilterOpt
   // Time order as offline::run_filter: odometry first on equal stamps.
   std::vector<slam::OdometrySample> odometry = in.odometry;
   std::stable_sort(odometry.begin(), odometry.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
-  filter.add_odometry({in.start_time_s, 0.0, 0.0});
+  refs.frame_landmarks.resize(in.frames.size());
+  slam::OdometrySample control{in.start_time_s, 0.0, 0.0};
+  filter.add_odometry(control);
   std::size_t i = 0, k = 0;
   while (i < odometry.size() || k < in.frames.size()) {
     if (k == in.frames.size() || (i < odometry.size() && odometry[i].t_s <= in.frames[k].t_s)) {
       slam::OdometrySample s = odometry[i++];
       if (s.t_s < in.start_time_s) s.t_s = in.start_time_s;
       filter.add_odometry(s);
+      control = s;
     } else {
       const slam::ObservationFrame& f = in.frames[k];
       if (f.t_s >= in.start_time_s) {
-        filter.add_observations(f);
+        // Before the update: the predictive pose and map.
         const slam::PoseEstimate e = filter.pose_estimate();
-        refs.frame_pose[k] = e.mean;
+        refs.frame_pose[k] = slam::move(e.mean, control.v_mps, control.w_radps, std::max(0.0, f.t_s - filter.time_s()));
         refs.frame_cov[k] = e.cov;
         refs.has_pose[k] = true;
+        for (const slam::LandmarkEstimate& l : filter.landmarks_of_best()) {
+          refs.frame_landmarks[k][l.id] = References::Landmark{l.mean, l.cov};
+        }
+        filter.add_observations(f);
       }
       ++k;
     }

@@ -59,6 +59,13 @@ struct References {
   // The reference pose's covariance (the filter's; empty: exact poses). Its
   // part of the innovation variance, moved through the odometry, is known.
   std::vector<Eigen::Matrix3d> frame_cov;
+  // Per frame, the landmarks as known at that frame (the filter's map before
+  // the frame's update, with covariances); empty: `landmarks` for every frame.
+  struct Landmark {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  };
+  std::vector<std::unordered_map<int, Landmark>> frame_landmarks;
   std::unordered_map<int, Eigen::Vector2d> landmarks;
 };
 
@@ -93,10 +100,13 @@ slam::FilterOptions with_parameters(slam::FilterOptions options, const NoisePara
 // innovations of the raw input's observations predicted from the reference pose
 // at earlier frames (current.range_scale and delay applied). The variances come
 // from a weighted least-squares fit of the squared range and bearing innovations
-// against their predicted variance R + v_sigma^2 A_v + w_sigma^2 A_w (A from
-// propagating the pose through the odometry over the lag); range scale and
-// delay from a Gauss-Newton step on the innovations. Throws
-// std::invalid_argument when there are too few innovations.
+// against their predicted variance R + v_sigma^2 A_v + w_sigma^2 A_w +
+// alpha (H P H^T + G M G^T) (A from propagating the pose through the odometry
+// over the lag; P, M the references' pose and landmark covariances, alpha in
+// [0, 1] fitted: they hold the map frame's uncertainty, which cancels); range
+// scale (from the map, or from landmark pairs) and delay from a Gauss-Newton
+// step on the innovations. Throws std::invalid_argument when there are too few
+// innovations.
 NoiseParameters fit_noise(const offline::RunInput& raw, const References& references, const NoiseParameters& current,
                           const NoiseCalibrationOptions& options, FitStatistics* statistics = nullptr);
 
@@ -104,8 +114,10 @@ NoiseParameters fit_noise(const offline::RunInput& raw, const References& refere
 // true landmarks); throws std::invalid_argument without them.
 References truth_references(const offline::RunInput& raw);
 
-// References from one filter pass over the input with these parameters: the
-// posterior mean pose after every frame and the final landmark mixture.
+// References from one filter pass over the input with these parameters,
+// predictive: at every frame the pose before the frame's update (the mean moved
+// to the frame's time) with its covariance, and the best particle's map then;
+// later observations are independent of them.
 References filter_references(const offline::RunInput& raw, const slam::FilterOptions& base,
                              const NoiseParameters& p);
 
