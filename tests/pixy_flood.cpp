@@ -58,14 +58,8 @@ int main(int argc, char** argv) {
       }
       units_per_s = rate / static_cast<double>(unit.size());
     } else {
-      pixy::PixyBlock b;
-      b.colour_code = true;
-      b.signature = 012;
-      b.x = 160;
-      b.y = 100;
-      b.width = 20;
-      b.height = 42;
-      b.angle_deg = -3;
+      // {signature, x, y, width, height, angle_deg, colour_code}: a landmark of the shipped map.
+      const pixy::PixyBlock b{012, 160, 100, 20, 42, -3, true};
       const std::vector<std::uint8_t> frame = pixy::encode_frame({b});
       const std::size_t per_write = rate < 100.0 ? 1 : static_cast<std::size_t>(rate / 100.0);
       for (std::size_t i = 0; i < per_write; ++i) unit.insert(unit.end(), frame.begin(), frame.end());

@@ -33,29 +33,9 @@ using std::chrono::milliseconds;
 using test_support::LogLines;
 
 // Blocks of the shipped signature map (config/pixy_bridge.yaml): "12" -> 1, "13" -> 2.
-pixy::PixyBlock landmark_1() {
-  pixy::PixyBlock b;
-  b.colour_code = true;
-  b.signature = 012;
-  b.x = 160;
-  b.y = 100;
-  b.width = 20;
-  b.height = 42;  // height/width 2.1
-  b.angle_deg = -3;
-  return b;
-}
-
-pixy::PixyBlock landmark_2() {
-  pixy::PixyBlock b;
-  b.colour_code = true;
-  b.signature = 013;
-  b.x = 80;
-  b.y = 90;
-  b.width = 10;
-  b.height = 21;
-  b.angle_deg = 5;
-  return b;
-}
+// {signature, x, y, width, height, angle_deg, colour_code}: height/width 2.1.
+pixy::PixyBlock landmark_1() { return {012, 160, 100, 20, 42, -3, true}; }
+pixy::PixyBlock landmark_2() { return {013, 80, 90, 10, 21, 5, true}; }
 
 pixy::PixyBlock unknown_code() {  // tags 7, 7: not in the map
   pixy::PixyBlock b = landmark_1();

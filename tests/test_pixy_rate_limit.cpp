@@ -25,17 +25,8 @@ namespace {
 constexpr std::uint64_t kBaseNs = 1700000000000000000ull;
 constexpr std::uint64_t kSecondNs = 1000000000ull;
 
-PixyBlock landmark_block() {
-  PixyBlock b;
-  b.colour_code = true;
-  b.signature = 012;
-  b.x = 160;
-  b.y = 100;
-  b.width = 20;
-  b.height = 42;
-  b.angle_deg = -3;
-  return b;
-}
+// {signature, x, y, width, height, angle_deg, colour_code}.
+PixyBlock landmark_block() { return {012, 160, 100, 20, 42, -3, true}; }
 
 // A parser and a limiter wired like PixyNode: every completed frame is offered
 // at the arrival time of the chunk that completed it; warnings are collected.
