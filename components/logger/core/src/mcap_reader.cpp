@@ -1009,7 +1009,7 @@ class McapReader::Parser {
       d.intact_until = valid_end_;
     } else {
       d.state = McapFileState::kDamaged;
-      d.intact_until = std::min(first_problem_, size_);
+      d.intact_until = std::min<std::uint64_t>(first_problem_, size_);
     }
   }
 
