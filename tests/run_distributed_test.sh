@@ -260,11 +260,20 @@ else
   echo "no tcpdump/tshark: traffic capture not checked"
 fi
 # Health: the robot's processes seen from the log host, and the killed one LOST.
-grep -qE "^\[health\] encoder_bridge@.*: joined" "$work/$log_host.log" || fail "no health report of the robot's encoder_bridge"
-grep -qE "^\[health\] encoder_bridge@.*: left" "$work/$log_host.log" || fail "the robot's encoder_bridge stopping was not reported"
+# With DDS Security the processes announce no identity (dds.announce_identity
+# auto): they are seen, joining, leaving and lost, but not named.
+if [[ $profile == secure ]]; then
+  anonymous="'pixyslam' \(identity not announced: dds.announce_identity\)"
+  encoder=$anonymous spy=$anonymous
+  grep -qE "^\[health\] encoder_bridge@" "$work/$log_host.log" && fail "a secure process announced its identity"
+else
+  encoder="encoder_bridge@.*" spy="pixyslam_spy@.* pid $doomed"
+fi
+grep -qE "^\[health\] $encoder: joined" "$work/$log_host.log" || fail "no health report of the robot's encoder_bridge"
+grep -qE "^\[health\] $encoder: left" "$work/$log_host.log" || fail "the robot's encoder_bridge stopping was not reported"
 # Through a discovery server the lease expiry arrives as a removal: "left".
 if [[ $profile == discovery_client ]]; then gone="(LOST|left)"; else gone="LOST"; fi
-grep -qE "^\[health\] pixyslam_spy@.* pid $doomed: $gone" "$work/$log_host.log" ||
+grep -qE "^\[health\] $spy: $gone" "$work/$log_host.log" ||
   fail "the killed process on the robot was not reported $gone"
 echo "health: $(grep -cE '^\[health\]' "$work/$log_host.log") reports on $log_host, the killed robot process $gone"
 if [[ $profile == secure ]]; then

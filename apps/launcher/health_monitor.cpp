@@ -19,10 +19,13 @@ class HealthMonitor::Listener : public fdds::DomainParticipantListener {
     for (const auto& p : info.info.m_properties) properties[p.first()] = p.second();
     std::lock_guard<std::mutex> lock(mutex_);
     std::string& who = names_[info.info.m_guid.guidPrefix];
+    const std::string name = info.info.m_participantName.to_string();
     if (properties.count("pixyslam.process") != 0) {
       who = properties["pixyslam.process"] + "@" + properties["pixyslam.host"] + " pid " + properties["pixyslam.pid"];
+    } else if (who.empty() && name == "pixyslam") {
+      who = "'pixyslam' (identity not announced: dds.announce_identity)";
     } else if (who.empty()) {
-      who = "'" + info.info.m_participantName.to_string() + "' (not a pixyslam process)";
+      who = "'" + name + "' (not a pixyslam process)";
     }
     switch (info.status) {
       case ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT:
