@@ -97,6 +97,11 @@ int usage(const char* why) {
 int main(int argc, char** argv) {
   std::map<std::string, std::string> args;
   for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
+      std::printf("usage: bench_mrclam_frame --dataset DIR --robot N --config FILE --particles M1,M2,... "
+                  "[--frames F] [--seed S]\n");
+      return 0;
+    }
     const std::string key = argv[i];
     if (key.rfind("--", 0) != 0 || i + 1 >= argc) return usage(("bad argument '" + key + "'").c_str());
     args[key.substr(2)] = argv[++i];

@@ -455,6 +455,9 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   try {
     return run(argc, argv);
+  } catch (const std::invalid_argument& e) {  // a command-line error
+    std::fprintf(stderr, "mrclam_eval: %s\n", e.what());
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mrclam_eval: %s\n", e.what());
     return 1;
