@@ -5,6 +5,7 @@
 # report or broken invariant (the input is kept and its path printed).
 #   tests/fuzz/run_fuzz.sh [SECONDS] [TARGET...]
 # Longer campaign, e.g. one hour each:  tests/fuzz/run_fuzz.sh 3600
+# FUZZ_JOBS: build jobs and targets run at once (default: the number of cores).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 seconds=${1:-60}
@@ -12,6 +13,7 @@ shift || true
 targets=("$@")
 ((${#targets[@]})) || targets=(fuzz_arduino_parser fuzz_pixy_parser fuzz_yaml_options fuzz_mcap_reader fuzz_cdr_topics)
 build_dir=${FUZZ_BUILD_DIR:-$root/build-fuzz}
+jobs=${FUZZ_JOBS:-$(nproc)}
 if ! command -v clang++-14 >/dev/null || ! compgen -G "/usr/lib/llvm-14/lib/clang/*/lib/linux/libclang_rt.fuzzer-*.a" >/dev/null; then
   echo "run_fuzz: clang-14 with libFuzzer (libclang-rt-14-dev) not installed, skipping"
   exit 77
@@ -20,7 +22,7 @@ if [[ ! -f $build_dir/CMakeCache.txt ]]; then
   cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DPIXYSLAM_FUZZ=ON -DBUILD_TESTING=OFF -DPIXYSLAM_BUILD_BENCHMARKS=OFF -DPIXYSLAM_BUILD_MAP_VIEW=OFF >/dev/null
 fi
-cmake --build "$build_dir" --target pixyslam_fuzzers --parallel "$(nproc)" >/dev/null
+cmake --build "$build_dir" --target pixyslam_fuzzers --parallel "$jobs" >/dev/null
 
 work=$(mktemp -d /tmp/pixyslam_fuzz.XXXXXX)
 trap 'rm -rf "$work"' EXIT
@@ -44,5 +46,4 @@ run_one() {
 }
 export -f run_one
 export build_dir work seconds artifacts root
-# Two at a time: the machines have 2 cores.
-printf '%s\n' "${targets[@]}" | xargs -P "$(nproc)" -I{} bash -c 'run_one {}'
+printf '%s\n' "${targets[@]}" | xargs -P "$jobs" -I{} bash -c 'run_one {}'

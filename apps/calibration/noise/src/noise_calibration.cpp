@@ -34,15 +34,18 @@ namespace {
 
 // Dead reckoning through time-sorted odometry (zero-order hold, stamps moved by
 // `shift`), carrying the pose covariance for a unit v density and for a unit w
-// density separately (from zero both are linear in the density squared).
+// density separately (from zero both are linear in the density squared), and the
+// start covariance moved along. One motion step (one sin/cos) serves all three.
 class Predictor {
  public:
-  Predictor(const std::vector<slam::OdometrySample>& odometry, double shift) : odometry_(odometry), shift_(shift) {}
+  Predictor(const std::vector<slam::OdometrySample>& odometry, double shift, bool with_covariance)
+      : odometry_(odometry), shift_(shift), with_covariance_(with_covariance) {}
 
   void reset(const slam::Pose2& pose, double t, const Eigen::Matrix3d& cov) {
-    gv_ = {pose, Eigen::Matrix3d::Zero()};
-    gw_ = gv_;
-    g0_ = {pose, cov};
+    mean_ = pose;
+    cov_v_.setZero();
+    cov_w_.setZero();
+    cov_start_ = cov;
     t_ = t;
     // The control held at t: last sample at or before t.
     next_ = static_cast<std::size_t>(
@@ -53,7 +56,6 @@ class Predictor {
 
   void advance_to(double t) {
     static const slam::MotionNoise unit_v{1.0, 0.0, 0.0, 0.0, 0.0};
-    static const slam::MotionNoise unit_w{0.0, 1.0, 0.0, 0.0, 0.0};
     while (t_ < t) {
       const double segment_end = next_ < odometry_.size() ? std::min(t, odometry_[next_].t_s + shift_) : t;
       const double dt = segment_end - t_;
@@ -63,27 +65,34 @@ class Predictor {
           v = odometry_[next_ - 1].v_mps;
           w = odometry_[next_ - 1].w_radps;
         }
-        const slam::Pose2 start = gv_.mean;
-        slam::propagate(gv_, v, w, dt, unit_v);
-        gw_.mean = start;
-        slam::propagate(gw_, v, w, dt, unit_w);
-        g0_.mean = start;
-        slam::propagate(g0_, v, w, dt, slam::MotionNoise{0.0, 0.0, 0.0, 0.0, 0.0});
+        const slam::MotionStep step = slam::motion_step(mean_, v, w, dt, unit_v);
+        if (with_covariance_) {
+          // V Q V^T for a unit w density: the rotation's column of V,
+          // (-d/2 sin, d/2 cos, 1) = (F(0,2)/2, F(1,2)/2, 1).
+          const Eigen::Vector3d v_a(0.5 * step.f(0, 2), 0.5 * step.f(1, 2), 1.0);
+          cov_v_ = step.f * cov_v_ * step.f.transpose() + step.q;
+          cov_w_ = step.f * cov_w_ * step.f.transpose() + dt * v_a * v_a.transpose();
+          cov_start_ = step.f * cov_start_ * step.f.transpose();
+        }
+        mean_ = step.mean;
       }
       t_ = segment_end;
       if (next_ < odometry_.size() && odometry_[next_].t_s + shift_ <= t_) ++next_;
     }
   }
 
-  const slam::Pose2& mean() const { return gv_.mean; }
-  const Eigen::Matrix3d& cov_v() const { return gv_.cov; }
-  const Eigen::Matrix3d& cov_w() const { return gw_.cov; }
-  const Eigen::Matrix3d& cov_start() const { return g0_.cov; }
+  const slam::Pose2& mean() const { return mean_; }
+  const Eigen::Matrix3d& cov_v() const { return cov_v_; }
+  const Eigen::Matrix3d& cov_w() const { return cov_w_; }
+  const Eigen::Matrix3d& cov_start() const { return cov_start_; }
 
  private:
   const std::vector<slam::OdometrySample>& odometry_;
   double shift_;
-  slam::PoseGaussian gv_, gw_, g0_;
+  bool with_covariance_;
+  slam::Pose2 mean_ = slam::Pose2::Zero();
+  Eigen::Matrix3d cov_v_ = Eigen::Matrix3d::Zero(), cov_w_ = Eigen::Matrix3d::Zero(),
+                  cov_start_ = Eigen::Matrix3d::Zero();
   double t_ = 0.0;
   std::size_t next_ = 0;
 };
@@ -107,7 +116,7 @@ std::vector<Row> collect_rows(const offline::RunInput& in, const References& ref
   std::vector<Row> rows;
   std::vector<slam::OdometrySample> odometry = in.odometry;
   std::stable_sort(odometry.begin(), odometry.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
-  Predictor base(odometry, 0.0), shifted(odometry, kDelayStep);
+  Predictor base(odometry, 0.0, true), shifted(odometry, kDelayStep, false);
   const std::size_t n = in.frames.size();
   *start_frames = 0;
   std::size_t window_begin = 0;
