@@ -19,6 +19,10 @@
 // RMSE of each, per robot (means over the seeds) and the mean over robots. The
 // fit on all robots with ground truth is printed first. With --segments, the
 // segment statistics of the three corrections per robot too.
+// --blind-return adds, per robot with ground truth and seed, the blind-stretch
+// cases of blind_return.h restarted from the truth every 60 s (the heading bias
+// alternating in sign): heading error at the return, after it and at the end
+// (docs/mrclam.md, "Blind stretch and return").
 // Exit codes: 0 done, 77 dataset folder absent (skip), 1 error,
 // 3 a robot's mean ATE is not better than dead reckoning.
 #include <algorithm>
@@ -33,6 +37,7 @@
 #include <utility>
 #include <vector>
 
+#include "blind_return.h"
 #include "mrclam_dataset.h"
 #include "mrclam_fit.h"
 #include "offline_run.h"
@@ -59,7 +64,7 @@ std::vector<int> parse_list(const std::string& text) {
 
 constexpr const char* kUsage =
     "usage: mrclam_eval --dataset DIR --config FILE [--robots 1,2] [--seeds 1,2] "
-    "[--association known_id|maximum_likelihood] [--segments SECONDS] [--loro]\n"
+    "[--association known_id|maximum_likelihood] [--segments SECONDS] [--loro] [--blind-return]\n"
     "  --dataset DIR      MRCLAM data set folder (exit 77 when absent)\n"
     "  --config FILE      filter options (filter:) and corrections (mrclam:)\n"
     "  --robots LIST      robots to run, default 1,2,3,4,5\n"
@@ -69,7 +74,10 @@ constexpr const char* kUsage =
     "  --loro             leave one robot out: per robot with ground truth, the mrclam:\n"
     "                     corrections fitted on the other robots with ground truth;\n"
     "                     ATE and heading RMSE with that fit, with the config's mrclam:\n"
-    "                     values and with neutral corrections (1, 0, 0, 1, 0)";
+    "                     values and with neutral corrections (1, 0, 0, 1, 0)\n"
+    "  --blind-return     restarts every 60 s with a blind stretch (heading bias on the\n"
+    "                     odometry), then only far new landmarks, then the first ones\n"
+    "                     again: the heading error before and after they return";
 
 double parse_seconds(const std::string& text) {
   char* end = nullptr;
@@ -307,11 +315,73 @@ void run_loro(const std::string& dataset, slam::FilterOptions options, const off
   }
 }
 
+// mrclam_eval --blind-return (see the top of this file).
+void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<int, offline::RunInput>>& inputs,
+                      const std::vector<int>& seeds) {
+  constexpr double kDeg = 180.0 / M_PI;
+  constexpr double kEveryS = 60.0;
+  const offline::BlindReturnOptions cases;
+  std::printf("\nBLIND RETURN: restarted from the truth every %.0f s; landmarks for %.0f s, then %.0f s blind with "
+              "+-%.3f rad/s added to the turn rate, then %.0f s of new landmarks beyond %.1f m only, then all; "
+              "scored %.0f s from the first landmark of the first stretch seen again\n",
+              kEveryS, cases.seen_s, cases.blind_s, cases.heading_bias_radps, cases.far_s, cases.far_min_range_m,
+              cases.after_s);
+  std::printf("%-5s %-5s %8s %8s %9s %9s %9s %9s %9s %9s\n", "robot", "seed", "start_s", "return_s", "DR_ret",
+              "DR_end", "err_ret", "rmse_aft", "err_end", "ATE_aft");
+  std::vector<double> at_return, after, at_end, ate_after, dr_at_return, dr_at_end;
+  std::size_t skipped = 0;
+  for (const auto& [robot, input] : inputs) {
+    if (input.truth.empty()) continue;
+    std::vector<eval::TimedPose> truth = input.truth;
+    std::stable_sort(truth.begin(), truth.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+    const std::vector<double> starts = offline::segment_starts(truth, kEveryS);
+    for (int seed : seeds) {
+      options.seed = static_cast<std::uint64_t>(seed);
+      for (std::size_t k = 0; k < starts.size(); ++k) {
+        offline::BlindReturnOptions o = cases;
+        if (k % 2 == 1) o.heading_bias_radps = -o.heading_bias_radps;
+        const std::optional<offline::BlindReturnCase> c =
+            offline::make_blind_return(offline::restart_at_truth(input, starts[k]), o);
+        if (!c) {
+          if (seed == seeds.front()) ++skipped;
+          continue;
+        }
+        const offline::RunResult res = offline::run_filter(options, c->input);
+        const offline::ReturnScore score = offline::score_return(*c, res.trajectory);
+        const offline::ReturnScore dr = offline::score_return(*c, res.dead_reckoning);
+        std::printf("%-5d %-5d %8.1f %8.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.3f\n", robot, seed,
+                    starts[k] - truth.front().t_s, c->return_s - starts[k], dr.heading_error_at_return_rad * kDeg,
+                    dr.heading_error_end_rad * kDeg, score.heading_error_at_return_rad * kDeg, score.heading_rmse_after_rad * kDeg,
+                    score.heading_error_end_rad * kDeg, score.ate_after_m);
+        std::fflush(stdout);
+        dr_at_return.push_back(dr.heading_error_at_return_rad * kDeg);
+        dr_at_end.push_back(dr.heading_error_end_rad * kDeg);
+        at_return.push_back(score.heading_error_at_return_rad * kDeg);
+        after.push_back(score.heading_rmse_after_rad * kDeg);
+        at_end.push_back(score.heading_error_end_rad * kDeg);
+        ate_after.push_back(score.ate_after_m);
+      }
+    }
+  }
+  const auto line = [](const char* label, const std::vector<double>& v, const char* unit) {
+    const offline::Summary x = offline::summarize(v);
+    std::printf("  %-36s mean %7.3f median %7.3f p90 %7.3f worst %7.3f %s\n", label, x.mean, x.median, x.p90, x.max,
+                unit);
+  };
+  std::printf("BLIND RETURN: %zu cases (%zu starts without a return skipped)\n", at_return.size(), skipped);
+  line("dead-reckoning heading error at return", dr_at_return, "deg");
+  line("dead-reckoning heading error, last 10 s", dr_at_end, "deg");
+  line("heading error at return", at_return, "deg");
+  line("heading RMSE after return", after, "deg");
+  line("heading error, last 10 s", at_end, "deg");
+  line("ATE after return", ate_after, "m");
+}
+
 int run(int argc, char** argv) {
   std::string dataset, config_path, association;
   std::vector<int> robots{1, 2, 3, 4, 5}, seeds{1, 2, 3};
   double segment_every_s = 0.0;  // 0: no segments
-  bool loro = false;
+  bool loro = false, blind_return = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
@@ -321,8 +391,8 @@ int run(int argc, char** argv) {
   }
   for (int i = 1; i < argc; ++i) {
     const std::string key = argv[i];
-    if (key == "--loro") {
-      loro = true;
+    if (key == "--loro" || key == "--blind-return") {
+      (key == "--loro" ? loro : blind_return) = true;
       continue;
     }
     if (i + 1 >= argc) throw std::invalid_argument(kUsage);
@@ -365,7 +435,7 @@ int run(int argc, char** argv) {
   for (int robot : robots) {
     const mrclam::RobotData data = mrclam::load_robot(dataset, robot);
     const offline::RunInput input = offline::mrclam_input(data, model);
-    if (segment_every_s > 0.0) inputs.emplace_back(robot, input);
+    if (segment_every_s > 0.0 || blind_return) inputs.emplace_back(robot, input);
     double robot_ate = 0, robot_dr = 0;
     for (int seed : seeds) {
       options.seed = static_cast<std::uint64_t>(seed);
@@ -440,6 +510,7 @@ int run(int argc, char** argv) {
                   worst.seed, worst.start_s, worst.errors.ate_rmse_m, worst.errors.heading_rmse_rad * kDeg);
     }
   }
+  if (blind_return) run_blind_return(options, inputs, seeds);
   if (loro) {
     run_loro(dataset, options, model, robots, seeds, segment_every_s, config_scores, config_segments);
   }
