@@ -454,10 +454,21 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
       decision_[k] = Decision::kInvalid;
       continue;
     }
-    const JointFit fit = fit_observation(g, i, z_[k], r_[k]);
+    JointFit fit = fit_observation(g, i, z_[k], r_[k]);
     if (!std::isfinite(fit.mahalanobis2) || !std::isfinite(fit.log_likelihood)) {
       decision_[k] = Decision::kInvalid;
       continue;
+    }
+    if (options_.gate_enabled && fit.mahalanobis2 > gate_d2_) {
+      // Outside the gate at the frame's linearisation: maybe only because a
+      // large correction (the heading drifted while blind) is not linear. The
+      // re-linearised fit decides; an outlier stays outside.
+      const JointFit iterated = fit_observation_iterated(g, i, z_[k], r_[k]);
+      if (std::isfinite(iterated.mahalanobis2) && std::isfinite(iterated.log_likelihood) &&
+          iterated.mahalanobis2 <= gate_d2_) {
+        fit = iterated;
+        ++counters_.joint_iterated_updates;
+      }
     }
     if (options_.gate_enabled && fit.mahalanobis2 > gate_d2_) {
       // No readmission inside the joint state (one EKF update far outside its

@@ -1,5 +1,6 @@
 #include "pixyslam/slam/joint_gaussian.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -157,6 +158,45 @@ JointFit fit_observation(const JointGaussian& g, int index, const Eigen::Vector2
   const Eigen::Matrix2d cross = p.h_pose * g.cov.block<3, 2>(0, j) * p.h_landmark.transpose();
   fit.s = pose_rows_x * p.h_pose.transpose() + cross + cross.transpose() +
           p.h_landmark * g.cov.block<2, 2>(j, j) * p.h_landmark.transpose() + r;
+  fit.mahalanobis2 = fit.innovation.dot(fit.s.inverse() * fit.innovation);
+  fit.log_likelihood = -0.5 * fit.mahalanobis2 - std::log(2.0 * M_PI) - 0.5 * std::log(fit.s.determinant());
+  return fit;
+}
+
+JointFit fit_observation_iterated(const JointGaussian& g, int index, const Eigen::Vector2d& z,
+                                  const Eigen::Matrix2d& r, int max_iterations) {
+  const Eigen::Index j = 3 + 2 * index;
+  // The pose and landmark blocks are all the iteration needs: x = (pose, landmark).
+  using Vector5d = Eigen::Matrix<double, 5, 1>;
+  using Matrix5d = Eigen::Matrix<double, 5, 5>;
+  Vector5d x0;
+  x0 << g.mean.head<3>(), g.mean.segment<2>(j);
+  Matrix5d p;
+  p.topLeftCorner<3, 3>() = g.cov.block<3, 3>(0, 0);
+  p.topRightCorner<3, 2>() = g.cov.block<3, 2>(0, j);
+  p.bottomLeftCorner<2, 3>() = g.cov.block<2, 3>(j, 0);
+  p.bottomRightCorner<2, 2>() = g.cov.block<2, 2>(j, j);
+  JointFit fit;
+  fit.index = index;
+  Vector5d x = x0;
+  for (int k = 0; k < std::max(1, max_iterations); ++k) {
+    const PredictedObservation pred = predict_observation(x.head<3>(), x.tail<2>());
+    Eigen::Matrix<double, 2, 5> h;
+    h << pred.h_pose, pred.h_landmark;
+    Vector5d dx = x0 - x;
+    dx(2) = wrap_angle(dx(2));
+    fit.h_pose = pred.h_pose;
+    fit.h_landmark = pred.h_landmark;
+    fit.innovation = innovation(z, pred.z) - h * dx;
+    fit.s = h * p * h.transpose() + r;
+    Vector5d next = x0 + p * h.transpose() * fit.s.ldlt().solve(fit.innovation);
+    next(2) = wrap_angle(next(2));
+    Vector5d change = next - x;
+    change(2) = wrap_angle(change(2));
+    x = next;
+    if (!x.allFinite()) break;
+    if (change.cwiseAbs().maxCoeff() < 1e-9) break;
+  }
   fit.mahalanobis2 = fit.innovation.dot(fit.s.inverse() * fit.innovation);
   fit.log_likelihood = -0.5 * fit.mahalanobis2 - std::log(2.0 * M_PI) - 0.5 * std::log(fit.s.determinant());
   return fit;

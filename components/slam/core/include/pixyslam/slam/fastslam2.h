@@ -61,6 +61,7 @@ struct FilterCounters {
   std::uint64_t resamples = 0;
   std::uint64_t delayed_sampling_starts = 0;  // particle-frames that began a joint state
   std::uint64_t joint_breakdowns = 0;  // joint-state updates refused as numerically broken
+  std::uint64_t joint_iterated_updates = 0;  // outside the gate linearised once, inside re-linearised
 };
 
 // FastSLAM 2.0 (Montemerlo, Thrun, Koller, Wegbreit 2003) with known data

@@ -77,6 +77,16 @@ struct JointFit {
   double log_likelihood = 0.0;
 };
 JointFit fit_observation(const JointGaussian& g, int index, const Eigen::Vector2d& z, const Eigen::Matrix2d& r);
+// The same fit re-linearised at the updated state (iterated EKF, Gauss-Newton on
+// the MAP of this one observation): from x_0 = mean, x_{k+1} = mean + K_k nu_k
+// with H_k at x_k, nu_k = z - h(x_k) - H_k (mean - x_k), until the pose and
+// landmark move less than 1e-9 or after max_iterations. The fit holds the last
+// H_k and nu_k, so apply_observation() makes the iterated update. For a large
+// innovation (a landmark seen again after the heading drifted by tens of
+// degrees) the single linearisation at the frame pose under-corrects and
+// exaggerates the Mahalanobis distance; this one does not.
+JointFit fit_observation_iterated(const JointGaussian& g, int index, const Eigen::Vector2d& z,
+                                  const Eigen::Matrix2d& r, int max_iterations = 10);
 // EKF update with a fit: K = P H^T S^-1, mean += K nu, P -= K S K^T. Returns
 // false and leaves g unchanged when the result would not be healthy().
 [[nodiscard]] bool apply_observation(JointGaussian& g, const JointFit& fit);
