@@ -134,8 +134,16 @@ int run(const std::string& dir, int count) {
 }  // namespace pixyslam
 
 int main(int argc, char** argv) {
+  constexpr const char* kUsage =
+      "usage: mcap_damage_fixture DIR [MESSAGES]\n"
+      "  writes closed, not closed and damaged MCAP files of MESSAGES odometry samples\n"
+      "  (default 4436) into DIR, and DIR/expected.cmake with their offsets and counts\n";
+  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+    std::fputs(kUsage, stdout);
+    return 0;
+  }
   if (argc < 2 || argc > 3) {
-    std::fprintf(stderr, "usage: mcap_damage_fixture DIR [MESSAGES]\n");
+    std::fputs(kUsage, stderr);
     return 2;
   }
   try {

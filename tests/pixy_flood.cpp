@@ -27,8 +27,13 @@
 
 namespace {
 
+constexpr const char* kUsage =
+    "usage: pixy_flood LINK sync|frames RATE SECONDS [START_DELAY_S]\n"
+    "  plays a hostile Pixy on a pty linked at LINK: the sync word at RATE bytes/s\n"
+    "  (sync) or valid one-block frames at RATE frames/s (frames) for SECONDS\n";
+
 int usage() {
-  std::fprintf(stderr, "usage: pixy_flood LINK sync|frames RATE SECONDS [START_DELAY_S]\n");
+  std::fputs(kUsage, stderr);
   return 2;
 }
 
@@ -37,6 +42,10 @@ int usage() {
 int main(int argc, char** argv) {
   using namespace pixyslam;
   using Clock = std::chrono::steady_clock;
+  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+    std::fputs(kUsage, stdout);
+    return 0;
+  }
   if (argc < 5 || argc > 6) return usage();
   const std::string link = argv[1];
   const std::string pattern = argv[2];
