@@ -40,6 +40,11 @@ std::string own_folder() {
 int run(int argc, char** argv) {
   const std::string source_config = std::string(PIXYSLAM_CONFIG_DIR) + "/slam_estimator.yaml";
   const app::CommandLine args(argc, argv, {"config", "duration"});
+  if (args.help()) {
+    std::printf("usage: bench_latency [--config config/slam_estimator.yaml] [--duration S]\n"
+                "  end-to-end latency Odometry -> MapState through a separate slam_estimator on loopback\n");
+    return 0;
+  }
   const std::string config = args.get("config", source_config);
   const double duration_s = args.number("duration", 60.0);
 

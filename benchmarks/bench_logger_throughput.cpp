@@ -73,6 +73,11 @@ double cpu_seconds(int pid) {
 
 int run(int argc, char** argv) {
   const app::CommandLine args(argc, argv, {"rate", "duration", "compression", "out", "domain"});
+  if (args.help()) {
+    std::printf("usage: bench_logger_throughput [--rate 10000] [--duration 10] [--compression zstd] [--out FILE.mcap] "
+                "[--domain D]\n  Odometry at RATE/s to a separate logger on loopback; its CPU use and what it lost\n");
+    return 0;
+  }
   const double rate_hz = args.number("rate", 10000.0);
   const double duration_s = args.number("duration", 10.0);
   const std::string compression = args.get("compression", "zstd");

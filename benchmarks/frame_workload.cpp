@@ -3,11 +3,16 @@
 //     build/benchmarks/frame_workload M K FRAMES
 // Instructions per frame = Ir of the collected part / FRAMES.
 #include <cstdio>
+#include <string>
 #include <cstdlib>
 
 #include "frame_setup.h"
 
 int main(int argc, char** argv) {
+  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+    std::printf("usage: frame_workload PARTICLES LANDMARKS FRAMES\n");
+    return 0;
+  }
   if (argc != 4) {
     std::fprintf(stderr, "usage: frame_workload PARTICLES LANDMARKS FRAMES\n");
     return 2;

@@ -105,6 +105,11 @@ int main(int argc, char** argv) {
     unsigned seed = 1;
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
+      if (arg == "--help" || arg == "-h") {
+        std::printf("usage: link_emulator --a NETNS:DEV --b NETNS:DEV [--schedule T:LOSS:DELAY_MS,...] [--seed S]\n"
+                    "  forwards frames between two TAP devices with scheduled loss and delay\n");
+        return 0;
+      }
       if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
       const std::string value = argv[++i];
       if (arg == "--a") {

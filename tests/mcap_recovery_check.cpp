@@ -21,6 +21,10 @@ namespace pixyslam {
 namespace {
 
 int run(int argc, char** argv) {
+  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+    std::printf("usage: mcap_recovery_check FILE --topic T [--sent S --max-loss L] [--expect-footer 0|1]\n");
+    return 0;
+  }
   if (argc < 2 || argv[1][0] == '-') {
     std::fprintf(stderr, "usage: mcap_recovery_check FILE --topic T [--sent S --max-loss L] [--expect-footer 0|1]\n");
     return 2;

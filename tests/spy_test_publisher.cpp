@@ -18,6 +18,10 @@ namespace {
 
 int run(int argc, char** argv) {
     const app::CommandLine args(argc, argv, {"dds-config", "rate-hz"});
+    if (args.help()) {
+      std::printf("usage: spy_test_publisher --dds-config FILE [--rate-hz HZ]\n");
+      return 0;
+    }
     const std::string file = args.get("dds-config");
     config::YamlReader root = config::YamlReader::from_file(file);
     config::YamlReader dds_yaml = root.child("dds");

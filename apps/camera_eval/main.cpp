@@ -17,6 +17,11 @@ int main(int argc, char** argv) {
   using namespace pixyslam;
   return app::run_main("camera_eval", [&] {
     const app::CommandLine args(argc, argv, {"config-dir", "seed"});
+    if (args.help()) {
+      std::printf("usage: camera_eval --config-dir config [--seed S]\n"
+                  "  the colour-code detector on the synthetic camera through the simulated world\n");
+      return 0;
+    }
     const std::string dir = args.get("config-dir");
     config::YamlReader pixy_root = config::YamlReader::from_file(dir + "/pixy_bridge.yaml");
     config::YamlReader pixy_yaml = pixy_root.child("pixy");

@@ -134,6 +134,13 @@ int run(const Args& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+  }
   try {
     return run(parse_args(argc, argv));
   } catch (const std::invalid_argument& e) {
