@@ -84,7 +84,15 @@ class Writer {
                                participant.options().profiles_file + "'?");
     }
   }
-  ~Writer() { participant_.publisher().delete_datawriter(writer_); }
+  // The last samples reach the readers that matched: a process that stops right
+  // after publishing (the estimator's last MapStates before the logger stops)
+  // waits up to kFinalAckTimeout for their acknowledgement before the writer
+  // goes (best-effort writers and writers without readers return at once).
+  ~Writer() {
+    if (seq_ > 0 && matched_readers() > 0) wait_for_acknowledgments(kFinalAckTimeout);
+    participant_.publisher().delete_datawriter(writer_);
+  }
+  static constexpr std::chrono::milliseconds kFinalAckTimeout{500};
   Writer(const Writer&) = delete;
   Writer& operator=(const Writer&) = delete;
 
