@@ -83,14 +83,18 @@ TEST(BlindReturn, FarStretchKeepsOnlyNewLandmarksBeyondTheRange) {
   EXPECT_NEAR(c->return_s, 300.0, 1e-9);
   int far_frames = 0;
   for (const slam::ObservationFrame& f : c->input.frames) {
-    if (f.t_s >= 116.0 && f.t_s < 156.0) EXPECT_TRUE(f.detections.empty()) << f.t_s;
+    if (f.t_s >= 116.0 && f.t_s < 156.0) {
+      EXPECT_TRUE(f.detections.empty()) << f.t_s;
+    }
     if (f.t_s >= 156.0 && f.t_s < 300.0) {
       EXPECT_FALSE(sees(f, 1)) << f.t_s;
       EXPECT_FALSE(sees(f, 3)) << f.t_s;  // new but near
       EXPECT_TRUE(sees(f, 2)) << f.t_s;   // new and far
       ++far_frames;
     }
-    if (f.t_s >= 300.0) EXPECT_EQ(f.detections.size(), 3u) << f.t_s;
+    if (f.t_s >= 300.0) {
+      EXPECT_EQ(f.detections.size(), 3u) << f.t_s;
+    }
   }
   EXPECT_GT(far_frames, 1000);
 }
