@@ -54,12 +54,8 @@ std::optional<BlindReturnCase> make_blind_return(const RunInput& restarted, cons
   }
   if (!found || c.return_s > far_end + o.after_s) return std::nullopt;
   const double end = c.return_s + o.after_s;
-  if (restarted.truth.empty() ||
-      std::max_element(restarted.truth.begin(), restarted.truth.end(), [](const auto& a, const auto& b) {
-        return a.t_s < b.t_s;
-      })->t_s < end) {
-    return std::nullopt;
-  }
+  const std::vector<eval::TimedPose> truth = sorted_by_time(restarted.truth);
+  if (truth.empty() || truth.back().t_s < end) return std::nullopt;
 
   c.input = restarted;
   c.input.frames.clear();
@@ -83,15 +79,15 @@ std::optional<BlindReturnCase> make_blind_return(const RunInput& restarted, cons
     c.input.odometry.push_back(s);
   }
   c.input.truth.clear();
-  for (const eval::TimedPose& g : restarted.truth) {
-    if (g.t_s <= end) c.input.truth.push_back(g);
+  for (const eval::TimedPose& g : truth) {
+    if (g.t_s > end) break;
+    c.input.truth.push_back(g);
   }
   return c;
 }
 
 ReturnScore score_return(const BlindReturnCase& c, const std::vector<eval::TimedPose>& trajectory) {
-  std::vector<eval::TimedPose> truth = c.input.truth;
-  std::stable_sort(truth.begin(), truth.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  const std::vector<eval::TimedPose>& truth = c.input.truth;  // in time order (make_blind_return)
   ReturnScore s;
   double sum_h2 = 0.0, sum_p2 = 0.0, sum_end = 0.0;
   std::size_t n_end = 0;

@@ -31,7 +31,7 @@ struct BlindReturnOptions {
 void validate(const BlindReturnOptions& options);
 
 struct BlindReturnCase {
-  RunInput input;          // restarted input, modified and cut at return_s + after_s
+  RunInput input;          // restarted input, modified and cut at return_s + after_s; truth in time order
   double blind_start_s = 0.0;
   double far_start_s = 0.0;
   double return_s = 0.0;   // the first frame that sees a landmark of the first stretch again

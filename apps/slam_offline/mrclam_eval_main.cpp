@@ -125,8 +125,7 @@ void print_segment_summary(const std::string& label, const std::vector<Segment>&
 // The runs of one robot and seed restarted from the truth every every_s seconds.
 std::vector<Segment> run_segments(const slam::FilterOptions& options, const offline::RunInput& input, int robot,
                                   double every_s) {
-  std::vector<eval::TimedPose> truth = input.truth;
-  std::stable_sort(truth.begin(), truth.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  const std::vector<eval::TimedPose> truth = offline::sorted_by_time(input.truth);
   std::vector<Segment> out;
   for (double start : offline::segment_starts(truth, every_s)) {
     const offline::RunResult res = offline::run_filter(options, offline::restart_at_truth(input, start));
@@ -332,8 +331,7 @@ void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<i
   std::size_t skipped = 0;
   for (const auto& [robot, input] : inputs) {
     if (input.truth.empty()) continue;
-    std::vector<eval::TimedPose> truth = input.truth;
-    std::stable_sort(truth.begin(), truth.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+    const std::vector<eval::TimedPose> truth = offline::sorted_by_time(input.truth);
     const std::vector<double> starts = offline::segment_starts(truth, kEveryS);
     for (int seed : seeds) {
       options.seed = static_cast<std::uint64_t>(seed);
@@ -391,8 +389,12 @@ int run(int argc, char** argv) {
   }
   for (int i = 1; i < argc; ++i) {
     const std::string key = argv[i];
-    if (key == "--loro" || key == "--blind-return") {
-      (key == "--loro" ? loro : blind_return) = true;
+    if (key == "--loro") {
+      loro = true;
+      continue;
+    }
+    if (key == "--blind-return") {
+      blind_return = true;
       continue;
     }
     if (i + 1 >= argc) throw std::invalid_argument(kUsage);

@@ -85,15 +85,6 @@ RunResult run_filter(const slam::FilterOptions& options, const RunInput& input) 
   return result;
 }
 
-namespace {
-
-std::vector<eval::TimedPose> sorted_by_time(std::vector<eval::TimedPose> poses) {
-  std::stable_sort(poses.begin(), poses.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
-  return poses;
-}
-
-}  // namespace
-
 Report evaluate(const RunInput& input, const RunResult& result) {
   Report r;
   if (!input.truth.empty() && !result.trajectory.empty()) {

@@ -316,8 +316,7 @@ References truth_references(const offline::RunInput& raw) {
   if (raw.truth.empty() || raw.landmarks.empty()) {
     throw std::invalid_argument("noise calibration with ground truth: needs robot and landmark ground truth");
   }
-  std::vector<eval::TimedPose> truth = raw.truth;
-  std::stable_sort(truth.begin(), truth.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  const std::vector<eval::TimedPose> truth = offline::sorted_by_time(raw.truth);
   References refs;
   refs.frame_pose.resize(raw.frames.size(), slam::Pose2::Zero());
   refs.has_pose.resize(raw.frames.size(), false);
