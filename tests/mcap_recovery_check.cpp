@@ -9,6 +9,7 @@
 // passes, 1 otherwise, 2 on usage errors.
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -21,12 +22,11 @@ namespace pixyslam {
 namespace {
 
 int run(int argc, char** argv) {
-  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
-    std::printf("usage: mcap_recovery_check FILE --topic T [--sent S --max-loss L] [--expect-footer 0|1]\n");
-    return 0;
-  }
-  if (argc < 2 || argv[1][0] == '-') {
-    std::fprintf(stderr, "usage: mcap_recovery_check FILE --topic T [--sent S --max-loss L] [--expect-footer 0|1]\n");
+  constexpr const char* kUsage =
+      "usage: mcap_recovery_check FILE --topic T [--sent S --max-loss L] [--expect-footer 0|1]\n";
+  if (const std::optional<int> exit = app::usage_exit({argv + 1, argv + argc}, kUsage)) return *exit;
+  if (argv[1][0] == '-') {
+    std::fputs(kUsage, stderr);
     return 2;
   }
   const std::string path = argv[1];
