@@ -10,6 +10,7 @@ PACKAGES=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools default-jre-headless
   libzstd-dev liblz4-dev
   libopencv-dev
+  libceres-dev
   openssl iproute2 tcpdump
   podman runc debootstrap
   clang-14 libclang-rt-14-dev

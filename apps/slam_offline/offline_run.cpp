@@ -50,6 +50,36 @@ RunResult run_filter(const slam::FilterOptions& options, const RunInput& input) 
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_seconds();
   filter.add_odometry(control);  // sets the filter's clock to the start time
+  for_each_step(
+      input,
+      [&](const slam::OdometrySample& s, bool step) {
+        if (!step) {
+          control = s;
+          filter.add_odometry(control);
+          return;
+        }
+        advance_dead_reckoning(s.t_s);
+        control = s;
+        filter.add_odometry(s);
+        record(s.t_s);
+      },
+      [&](const slam::ObservationFrame& f) {
+        advance_dead_reckoning(f.t_s);
+        filter.add_observations(f);
+        record(f.t_s);
+      });
+  result.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.cpu_time_s = thread_cpu_seconds() - cpu_start;
+  for (const slam::LandmarkEstimate& lm : filter.landmarks_of_best()) {
+    result.landmarks.push_back({lm.id, lm.mean.x(), lm.mean.y(), lm.cov(0, 0), lm.cov(0, 1), lm.cov(1, 1)});
+  }
+  result.counters = filter.counters();
+  result.final_effective_sample_size = filter.pose_estimate().effective_sample_size;
+  return result;
+}
+
+void for_each_step(const RunInput& input, const std::function<void(const slam::OdometrySample&, bool step)>& on_odometry,
+                   const std::function<void(const slam::ObservationFrame&)>& on_frame) {
   std::size_t i = 0;
   std::size_t k = 0;
   while (i < input.odometry.size() || k < input.frames.size()) {
@@ -59,30 +89,15 @@ RunResult run_filter(const slam::FilterOptions& options, const RunInput& input) 
     if (take_odometry) {
       const slam::OdometrySample& s = input.odometry[i++];
       if (s.t_s < input.start_time_s) {
-        control = {input.start_time_s, s.v_mps, s.w_radps};
-        filter.add_odometry(control);
-        continue;
+        on_odometry({input.start_time_s, s.v_mps, s.w_radps}, false);
+      } else {
+        on_odometry(s, true);
       }
-      advance_dead_reckoning(s.t_s);
-      control = s;
-      filter.add_odometry(s);
-      record(s.t_s);
     } else {
       const slam::ObservationFrame& f = input.frames[k++];
-      if (f.t_s < input.start_time_s) continue;
-      advance_dead_reckoning(f.t_s);
-      filter.add_observations(f);
-      record(f.t_s);
+      if (f.t_s >= input.start_time_s) on_frame(f);
     }
   }
-  result.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  result.cpu_time_s = thread_cpu_seconds() - cpu_start;
-  for (const slam::LandmarkEstimate& lm : filter.landmarks_of_best()) {
-    result.landmarks.push_back({lm.id, lm.mean.x(), lm.mean.y(), lm.cov(0, 0), lm.cov(0, 1), lm.cov(1, 1)});
-  }
-  result.counters = filter.counters();
-  result.final_effective_sample_size = filter.pose_estimate().effective_sample_size;
-  return result;
 }
 
 Report evaluate(const RunInput& input, const RunResult& result) {
@@ -170,7 +185,7 @@ DataLimits data_limits(const RunInput& input) {
   return limits;
 }
 
-void print_report(const std::string& title, const Report& r, const RunResult& res) {
+void print_accuracy(const std::string& title, const Report& r) {
   constexpr double kDeg = 180.0 / M_PI;
   std::printf("== %s\n", title.c_str());
   if (r.has_truth) {
@@ -180,10 +195,12 @@ void print_report(const std::string& title, const Report& r, const RunResult& re
                 r.dead_reckoning.heading_rmse_rad * kDeg);
     std::printf("pose ATE after SE(2) alignment %.3f m, max position error %.3f m, %zu truth samples\n",
                 r.filter.ate_rmse_aligned_m, r.filter.max_position_error_m, r.filter.samples);
-    std::printf("pose NEES (3 dof)      mean %.2f (ideal 3), %.1f %% inside [%.4f, %.4f] (ideal 95), %.1f %% below "
-                "%.4f (ideal 97.5), %zu steps, %zu singular skipped\n",
-                r.nees.mean(), 100.0 * r.nees.fraction_inside(), kNees3Lower95, kNees3Upper95,
-                100.0 * r.nees.fraction_below_upper(), kNees3Upper95, r.nees.steps, r.nees.singular);
+    if (r.nees.steps > 0) {
+      std::printf("pose NEES (3 dof)      mean %.2f (ideal 3), %.1f %% inside [%.4f, %.4f] (ideal 95), %.1f %% below "
+                  "%.4f (ideal 97.5), %zu steps, %zu singular skipped\n",
+                  r.nees.mean(), 100.0 * r.nees.fraction_inside(), kNees3Lower95, kNees3Upper95,
+                  100.0 * r.nees.fraction_below_upper(), kNees3Upper95, r.nees.steps, r.nees.singular);
+    }
   } else {
     std::printf("no robot ground truth: pose error not evaluated\n");
   }
@@ -192,6 +209,10 @@ void print_report(const std::string& title, const Report& r, const RunResult& re
                 r.landmarks.rmse_m, r.landmarks.rmse_aligned_m, r.landmarks.matched, r.landmarks.missing,
                 r.landmarks.extra);
   }
+}
+
+void print_report(const std::string& title, const Report& r, const RunResult& res) {
+  print_accuracy(title, r);
   const slam::FilterCounters& c = res.counters;
   std::printf("observations           %llu used, %llu new landmark, %llu gated, %llu invalid\n",
               static_cast<unsigned long long>(c.observations_used),

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,13 @@ struct RunResult {
 // Feeds the filter in time order, skipping samples before start_time_s.
 RunResult run_filter(const slam::FilterOptions& options, const RunInput& input);
 
+// The input in the filter's order (odometry first on equal stamps): odometry
+// before start_time_s becomes the control held at the start (on_odometry with
+// step false), frames before it are skipped; every other call is one filter
+// step (step true, frames always), after which run_filter records a pose.
+void for_each_step(const RunInput& input, const std::function<void(const slam::OdometrySample&, bool step)>& on_odometry,
+                   const std::function<void(const slam::ObservationFrame&)>& on_frame);
+
 // Prints the evaluation (ATE, heading, landmarks, counts) and returns the pose
 // ATE RMSE (or -1 when there is no truth).
 struct Report {
@@ -63,6 +71,9 @@ struct DataLimits {
 // Throws std::invalid_argument without truth or frames.
 DataLimits data_limits(const RunInput& input);
 void print_report(const std::string& title, const Report& report, const RunResult& result);
+// The accuracy lines of print_report only (no filter counters; NEES only when
+// some step had a covariance).
+void print_accuracy(const std::string& title, const Report& report);
 
 // The run restarted at start_s from the truth pose then (interpolated): what a
 // segment of mrclam_eval --segments runs, from start_s to the end of the input.

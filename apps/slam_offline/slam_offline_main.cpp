@@ -1,17 +1,24 @@
 // slam_offline: runs the FastSLAM 2.0 core without DDS.
 //   slam_offline sim    --config FILE --out DIR [--seed S]
-//   slam_offline mrclam --dataset DIR --robot N --config FILE --out DIR [--seed S]
+//   slam_offline mrclam --dataset DIR --robot N --config FILE --out DIR [--seed S] [--optimise]
 // Writes DIR/trajectory.csv and DIR/landmarks.csv and prints the evaluation.
+// --optimise (any mode): the map optimiser over the whole run after the filter;
+// trajectory.csv and landmarks.csv are then its solution, the filter's go to
+// filter_trajectory.csv and filter_landmarks.csv, and both are evaluated.
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <map>
+#include <stdexcept>
 #include <string>
 
 #include "hardware_input.h"
 #include "mrclam_dataset.h"
 #include "offline_run.h"
+#ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
+#include "optimised_run.h"
+#endif
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/eval/csv_io.h"
 #include "pixyslam/sim/sim_world.h"
@@ -22,15 +29,19 @@ namespace {
 using namespace pixyslam;
 
 constexpr const char* kUsage =
-    "usage: slam_offline sim    --config FILE --out DIR [--seed S]\n"
-    "       slam_offline mrclam --dataset DIR --robot N --config FILE --out DIR [--seed S]\n"
-    "       slam_offline hardware --config FILE --sim-config FILE --out DIR [--seed S] [--duration S]\n"
+    "usage: slam_offline sim    --config FILE --out DIR [--seed S] [--optimise]\n"
+    "       slam_offline mrclam --dataset DIR --robot N --config FILE --out DIR [--seed S] [--optimise]\n"
+    "       slam_offline hardware --config FILE --sim-config FILE --out DIR [--seed S] [--duration S] [--optimise]\n"
     "         (hardware: the robot_sim hardware decoded by the bridges' parsers; the\n"
-    "          pixy/encoder configs are taken from beside --sim-config)\n";
+    "          pixy/encoder configs are taken from beside --sim-config)\n"
+    "  --optimise  also solve the whole run with the map optimiser (Ceres); its\n"
+    "              solution goes to trajectory.csv and landmarks.csv, the filter's\n"
+    "              to filter_trajectory.csv and filter_landmarks.csv\n";
 
 struct Args {
   std::string mode;
   std::map<std::string, std::string> values;
+  bool optimise = false;
   std::string get(const std::string& key) const {
     auto it = values.find(key);
     if (it == values.end()) throw std::invalid_argument("missing --" + key);
@@ -47,6 +58,10 @@ Args parse_args(int argc, char** argv) {
   }
   for (int i = 2; i < argc; ++i) {
     const std::string key = argv[i];
+    if (key == "--optimise") {
+      a.optimise = true;
+      continue;
+    }
     static const char* known[] = {"--config", "--out", "--seed", "--dataset", "--robot", "--sim-config", "--duration"};
     bool ok = false;
     for (const char* k : known) ok = ok || key == k;
@@ -74,6 +89,18 @@ offline::RunInput sim_input(const sim::WorldRun& run) {
   for (const sim::Pole& p : run.poles) in.landmarks.push_back({p.id, p.x_m, p.y_m});
   return in;
 }
+
+#ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
+void print_solve(const offline::OptimisedRun& opt) {
+  const map_optimizer::SolveSummary& s = opt.solve;
+  std::printf("map optimiser: %zu keyframes, %zu landmarks, %zu factors (%zu observations, %zu invalid); "
+              "%s after %d iterations, cost %.1f -> %.1f, solve %.3f s, %.3f s CPU in all; landmark covariances %s\n",
+              opt.counters.keyframes, s.landmarks_free, s.residuals, opt.counters.observations,
+              opt.counters.observations_invalid, s.converged ? "converged" : "NOT converged", s.iterations,
+              s.initial_cost, s.final_cost, s.solve_time_s, opt.result.cpu_time_s,
+              opt.landmark_covariances ? "computed" : "rank deficient");
+}
+#endif
 
 int run(const Args& args) {
   const std::string config_path = args.get("config");
@@ -121,13 +148,30 @@ int run(const Args& args) {
   std::printf("filter: %d particles, seed %llu, resample %s\n", options.particles,
               static_cast<unsigned long long>(options.seed), slam::to_string(options.resample_mode).c_str());
 
-  const offline::RunResult result = offline::run_filter(options, input);
+#ifndef PIXYSLAM_HAVE_MAP_OPTIMIZER
+  if (args.optimise) throw std::runtime_error("--optimise: this build has no map optimiser (built without Ceres)");
+#endif
   const std::filesystem::path out = args.get("out");
+  const offline::RunResult result = offline::run_filter(options, input);
   std::filesystem::create_directories(out);
-  eval::write_trajectory_csv((out / "trajectory.csv").string(), result.trajectory);
-  eval::write_landmarks_csv((out / "landmarks.csv").string(), result.landmarks);
+  const auto write = [&out](const std::string& prefix, const offline::RunResult& r) {
+    eval::write_trajectory_csv((out / (prefix + "trajectory.csv")).string(), r.trajectory);
+    eval::write_landmarks_csv((out / (prefix + "landmarks.csv")).string(), r.landmarks);
+    std::printf("wrote %s and %s\n", (out / (prefix + "trajectory.csv")).c_str(),
+                (out / (prefix + "landmarks.csv")).c_str());
+  };
   offline::print_report(title, offline::evaluate(input, result), result);
-  std::printf("wrote %s and %s\n", (out / "trajectory.csv").c_str(), (out / "landmarks.csv").c_str());
+#ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
+  if (args.optimise) {
+    const offline::OptimisedRun opt = offline::optimise_run(options, input, result);
+    offline::print_accuracy(title + ", map optimiser", offline::evaluate(input, opt.result));
+    print_solve(opt);
+    write("filter_", result);
+    write("", opt.result);
+    return 0;
+  }
+#endif
+  write("", result);
   return 0;
 }
 

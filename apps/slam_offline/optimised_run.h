@@ -1,0 +1,24 @@
+#pragma once
+
+#include "offline_run.h"
+#include "pixyslam/map_optimizer/map_optimizer.h"
+
+namespace pixyslam::offline {
+
+// The map optimiser over a whole run after the filter (slam_offline --optimise,
+// mrclam_eval --optimise): the same input in the filter's order, keyframes
+// started from the filter's poses at the camera frames and landmarks from its
+// map, one solve of the whole problem at the end.
+struct OptimisedRun {
+  // Same layout as the filter's: a pose at every filter step (its keyframe in
+  // the solution moved by the odometry since), covariances NaN (not computed),
+  // the filter's dead reckoning, the optimised landmarks with their marginal
+  // covariances; wall and CPU time of building and solving.
+  RunResult result;
+  map_optimizer::SolveSummary solve;
+  map_optimizer::OptimizerCounters counters;
+  bool landmark_covariances = false;
+};
+OptimisedRun optimise_run(const slam::FilterOptions& options, const RunInput& input, const RunResult& filter);
+
+}  // namespace pixyslam::offline

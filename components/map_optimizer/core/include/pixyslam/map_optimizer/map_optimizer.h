@@ -1,0 +1,173 @@
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <deque>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pixyslam/slam/motion_model.h"
+#include "pixyslam/slam/slam_options.h"
+#include "pixyslam/slam/types.h"
+
+namespace ceres {
+class LossFunction;
+class Problem;
+}  // namespace ceres
+
+namespace pixyslam::map_optimizer {
+
+// The full SLAM least-squares problem over keyframe poses and landmarks, solved
+// with Ceres beside the filter (as cartographer's global optimisation beside its
+// local SLAM): what the filter committed to (a map turned by a blind stretch's
+// heading drift) is corrected when old landmarks are seen again.
+//
+//   minimise  sum_k |odometry residual k|^2 + sum_j rho(|observation residual j|^2)
+//
+// - odometry factors between consecutive keyframes: the pose of keyframe b in
+//   the frame of keyframe a against the odometry composed between them with the
+//   filter's motion model (ComposedMotion: the same unicycle steps and noise
+//   densities), whitened by that covariance;
+// - range/bearing factors with the filter's observation model (paper Eq. 3) and
+//   its observation noise, under a Huber loss rho whose threshold is the 95 %
+//   chi-square quantile of 2 dof (inside it plain least squares);
+// - the first keyframe (the start pose the filter starts from) is held fixed: it
+//   defines the frame, as it does for the filter.
+// Keyframes: one at every camera frame with a valid detection, and one at least
+// every keyframe_interval_s in between, so a long blind stretch bends through
+// several factors instead of one badly linearised one.
+// Initial values: the pose guess given with a frame (the filter's estimate) or
+// dead reckoning from the previous keyframe; a landmark's guess, else its first
+// observation. Pure: no DDS, time passed in; one thread.
+struct MapOptimizerOptions {
+  slam::MotionNoise motion;
+  double control_timeout_s = 5.0;
+  double range_sigma_m = 0.07;
+  double range_sigma_per_m = 0.0;
+  double bearing_sigma_rad = 0.027;
+  double min_range_m = 0.05;
+  double max_range_m = 50.0;
+  double keyframe_interval_s = 1.0;
+  // Huber threshold on the whitened residual norm: sqrt(chi2_2(0.95)).
+  double huber_threshold = 2.4477;
+  int max_iterations = 100;
+  // Ceres stops when the cost changes by less than this fraction.
+  double function_tolerance = 1e-8;
+
+  // Motion and observation model exactly as the filter's.
+  static MapOptimizerOptions from_filter(const slam::FilterOptions& filter);
+};
+// Throws std::invalid_argument naming the field.
+void validate(const MapOptimizerOptions& options);
+
+struct Keyframe {
+  double t_s = 0.0;
+  slam::Pose2 pose = slam::Pose2::Zero();
+};
+
+struct LandmarkSolution {
+  int id = 0;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  // Marginal covariance from the last solve (Ceres' covariance of the solved
+  // problem); NaN when not computed or rank deficient.
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  std::size_t observations = 0;
+};
+
+struct SolveSummary {
+  bool converged = false;       // Ceres stopped on a tolerance, not on the iteration limit or an error
+  int iterations = 0;
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  double solve_time_s = 0.0;    // Ceres' own total time
+  std::size_t keyframes_free = 0;
+  std::size_t landmarks_free = 0;
+  std::size_t residuals = 0;
+  std::string message;
+};
+
+// Counts of what was given and what was dropped.
+struct OptimizerCounters {
+  std::size_t odometry = 0;
+  std::size_t odometry_dropped = 0;   // non-finite or before the last time
+  std::size_t frames = 0;
+  std::size_t frames_dropped = 0;     // non-finite time or before the last time
+  std::size_t observations = 0;       // range/bearing factors added
+  std::size_t observations_invalid = 0;  // non-finite or outside the range limits
+  std::size_t keyframes = 0;
+  std::size_t solves = 0;
+};
+
+class MapOptimizer {
+ public:
+  MapOptimizer(const MapOptimizerOptions& options, const slam::Pose2& start_pose, double start_time_s);
+  ~MapOptimizer();
+  MapOptimizer(const MapOptimizer&) = delete;
+  MapOptimizer& operator=(const MapOptimizer&) = delete;
+
+  // Odometry in time order: held from its time until the next sample's (the
+  // filter's zero-order hold; an unmeasured sample keeps the held control,
+  // up to control_timeout_s after the last measured one).
+  void add_odometry(const slam::OdometrySample& sample);
+  // A camera frame: a keyframe at frame.t_s with a factor per valid detection.
+  // `guess` (e.g. the filter's pose then) initialises the keyframe; without it,
+  // dead reckoning from the previous keyframe. A frame without a valid
+  // detection adds nothing but the odometry up to it.
+  void add_frame(const slam::ObservationFrame& frame, const std::optional<slam::Pose2>& guess = std::nullopt);
+  // The initial value of a landmark not in the problem yet (e.g. the filter's map).
+  void set_landmark_guess(int id, const Eigen::Vector2d& position);
+
+  // Solves for every keyframe and landmark, or, with window_keyframes, for the
+  // newest that many keyframes and the landmarks they see (the rest held).
+  SolveSummary solve(std::optional<std::size_t> window_keyframes = std::nullopt);
+  // Landmark marginal covariances of the current solution (one Ceres covariance
+  // computation; false and NaN covariances when the problem is rank deficient).
+  bool compute_landmark_covariances();
+
+  const std::vector<Keyframe>& keyframes() const { return keyframes_; }
+  std::vector<LandmarkSolution> landmarks() const;
+  const OptimizerCounters& counters() const { return counters_; }
+  // Where the robot is now, as the newest keyframe and the odometry since it
+  // (in that keyframe's frame): pose_of() gives the pose in the current
+  // solution, so a trajectory recorded as anchors follows every later solve.
+  struct PoseAnchor {
+    std::size_t keyframe = 0;
+    Eigen::Vector3d relative = Eigen::Vector3d::Zero();
+  };
+  PoseAnchor anchor_now() const;
+  slam::Pose2 pose_of(const PoseAnchor& anchor) const;
+  slam::Pose2 current_pose() const { return pose_of(anchor_now()); }
+
+ private:
+  struct LandmarkBlock {
+    std::array<double, 2> xy{};
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
+    std::size_t observations = 0;
+    std::size_t last_keyframe = 0;  // newest keyframe that sees it
+  };
+  void integrate_to(double t_s);
+  void close_keyframe(double t_s, const std::optional<slam::Pose2>& guess);
+  void sync_keyframes();
+
+  MapOptimizerOptions options_;
+  std::unique_ptr<ceres::Problem> problem_;
+  std::unique_ptr<ceres::LossFunction> loss_;  // shared by the observation factors
+  std::deque<std::array<double, 3>> pose_blocks_;  // stable addresses for Ceres
+  std::vector<Keyframe> keyframes_;                // pose_blocks_ as poses
+  std::map<int, LandmarkBlock> landmarks_;
+  std::map<int, Eigen::Vector2d> landmark_guesses_;
+  slam::ComposedMotion open_motion_;  // odometry since the newest keyframe
+  double last_time_s_ = 0.0;
+  double last_measured_s_ = 0.0;
+  double held_v_ = 0.0;
+  double held_w_ = 0.0;
+  OptimizerCounters counters_;
+};
+
+}  // namespace pixyslam::map_optimizer

@@ -1,0 +1,332 @@
+#include "pixyslam/map_optimizer/map_optimizer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include <Eigen/Cholesky>
+#include <ceres/ceres.h>
+
+namespace pixyslam::map_optimizer {
+namespace {
+
+// A numerical floor on an odometry factor's covariance (1 mm, 1 mrad): the
+// unicycle model gives no sideways noise, and a stationary robot none at all.
+constexpr double kOdometryCovarianceFloor = 1e-6;
+
+template <typename T>
+T wrapped(const T& a) {
+  using std::atan2;
+  using std::cos;
+  using std::sin;
+  return atan2(sin(a), cos(a));
+}
+
+// Keyframe b seen from keyframe a against the composed odometry (in a's frame).
+struct OdometryResidual {
+  Eigen::Vector3d delta;
+  Eigen::Matrix3d sqrt_information;
+
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* residual) const {
+    using std::cos;
+    using std::sin;
+    const T dx = b[0] - a[0];
+    const T dy = b[1] - a[1];
+    const T c = cos(a[2]);
+    const T s = sin(a[2]);
+    Eigen::Matrix<T, 3, 1> e;
+    e << c * dx + s * dy - T(delta.x()), -s * dx + c * dy - T(delta.y()), wrapped(b[2] - a[2] - T(delta.z()));
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> r(residual);
+    r = sqrt_information.cast<T>() * e;
+    return true;
+  }
+};
+
+// Paper Eq. 3: z = (|m - p|, atan2(m - p) - theta), whitened by the sigmas.
+struct RangeBearingResidual {
+  double range_m;
+  double bearing_rad;
+  double range_sigma_m;
+  double bearing_sigma_rad;
+
+  template <typename T>
+  bool operator()(const T* pose, const T* landmark, T* residual) const {
+    using std::atan2;
+    using std::sqrt;
+    const T dx = landmark[0] - pose[0];
+    const T dy = landmark[1] - pose[1];
+    const T q = dx * dx + dy * dy;
+    if (!(q > T(1e-12))) return false;  // landmark on the pose: the bearing is undefined
+    residual[0] = (T(range_m) - sqrt(q)) / T(range_sigma_m);
+    residual[1] = wrapped(T(bearing_rad) - (atan2(dy, dx) - pose[2])) / T(bearing_sigma_rad);
+    return true;
+  }
+};
+
+bool finite(const slam::Pose2& p) { return p.allFinite(); }
+
+}  // namespace
+
+MapOptimizerOptions MapOptimizerOptions::from_filter(const slam::FilterOptions& filter) {
+  MapOptimizerOptions o;
+  o.motion = filter.motion;
+  o.control_timeout_s = filter.control_timeout_s;
+  o.range_sigma_m = filter.range_sigma_m;
+  o.range_sigma_per_m = filter.range_sigma_per_m;
+  o.bearing_sigma_rad = filter.bearing_sigma_rad;
+  o.min_range_m = filter.min_range_m;
+  o.max_range_m = filter.max_range_m;
+  return o;
+}
+
+void validate(const MapOptimizerOptions& o) {
+  auto require = [](bool ok, const char* field, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("map optimiser option ") + field + ": " + what);
+  };
+  require(std::isfinite(o.control_timeout_s) && o.control_timeout_s > 0.0, "control_timeout_s", "must be > 0");
+  require(std::isfinite(o.range_sigma_m) && o.range_sigma_m > 0.0, "range_sigma_m", "must be > 0");
+  require(std::isfinite(o.range_sigma_per_m) && o.range_sigma_per_m >= 0.0, "range_sigma_per_m", "must be >= 0");
+  require(std::isfinite(o.bearing_sigma_rad) && o.bearing_sigma_rad > 0.0, "bearing_sigma_rad", "must be > 0");
+  require(std::isfinite(o.min_range_m) && o.min_range_m >= 0.0, "min_range_m", "must be >= 0");
+  require(std::isfinite(o.max_range_m) && o.max_range_m > o.min_range_m, "max_range_m", "must be > min_range_m");
+  require(std::isfinite(o.keyframe_interval_s) && o.keyframe_interval_s > 0.0, "keyframe_interval_s", "must be > 0");
+  require(std::isfinite(o.huber_threshold) && o.huber_threshold > 0.0, "huber_threshold", "must be > 0");
+  require(o.max_iterations >= 1, "max_iterations", "must be >= 1");
+  require(std::isfinite(o.function_tolerance) && o.function_tolerance > 0.0, "function_tolerance", "must be > 0");
+}
+
+MapOptimizer::MapOptimizer(const MapOptimizerOptions& options, const slam::Pose2& start_pose, double start_time_s)
+    : options_(options) {
+  validate(options_);
+  if (!finite(start_pose) || !std::isfinite(start_time_s)) {
+    throw std::invalid_argument("map optimiser: start pose and time must be finite");
+  }
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_ = std::make_unique<ceres::Problem>(problem_options);
+  loss_ = std::make_unique<ceres::HuberLoss>(options_.huber_threshold);
+  pose_blocks_.push_back({start_pose.x(), start_pose.y(), slam::wrap_angle(start_pose.z())});
+  problem_->AddParameterBlock(pose_blocks_.back().data(), 3);
+  problem_->SetParameterBlockConstant(pose_blocks_.back().data());
+  keyframes_.push_back({start_time_s, start_pose});
+  last_time_s_ = start_time_s;
+  last_measured_s_ = start_time_s;
+  counters_.keyframes = 1;
+}
+
+MapOptimizer::~MapOptimizer() = default;
+
+void MapOptimizer::integrate_to(double t_s) {
+  while (last_time_s_ < t_s) {
+    double next = t_s;
+    const double keyframe_due = keyframes_.back().t_s + options_.keyframe_interval_s;
+    next = std::min(next, keyframe_due);
+    const double timeout_at = last_measured_s_ + options_.control_timeout_s;
+    double v = held_v_;
+    double w = held_w_;
+    if (last_time_s_ >= timeout_at) {
+      v = 0.0;
+      w = 0.0;
+    } else {
+      next = std::min(next, timeout_at);
+    }
+    open_motion_.add(v, w, next - last_time_s_, options_.motion);
+    last_time_s_ = next;
+    if (next >= keyframe_due) close_keyframe(next, std::nullopt);
+  }
+}
+
+void MapOptimizer::close_keyframe(double t_s, const std::optional<slam::Pose2>& guess) {
+  std::array<double, 3>& previous = pose_blocks_.back();
+  const slam::Pose2 from(previous[0], previous[1], previous[2]);
+  const double c = std::cos(from.z());
+  const double s = std::sin(from.z());
+  slam::Pose2 initial = open_motion_.moved_mean(from, c, s);
+  if (guess && finite(*guess)) initial = *guess;
+  initial.z() = slam::wrap_angle(initial.z());
+
+  const Eigen::Vector3d delta(open_motion_.displacement().x(), open_motion_.displacement().y(),
+                              open_motion_.rotation());
+  const Eigen::Matrix3d cov =
+      open_motion_.noise(1.0, 0.0) + kOdometryCovarianceFloor * Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d lower = cov.llt().matrixL();
+  OdometryResidual residual{delta, lower.triangularView<Eigen::Lower>().solve(Eigen::Matrix3d::Identity())};
+
+  pose_blocks_.push_back({initial.x(), initial.y(), initial.z()});
+  double* const before = previous.data();
+  double* const after = pose_blocks_.back().data();
+  problem_->AddResidualBlock(new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(new OdometryResidual(residual)),
+                             nullptr, before, after);
+  keyframes_.push_back({t_s, initial});
+  open_motion_.clear();
+  ++counters_.keyframes;
+}
+
+void MapOptimizer::add_odometry(const slam::OdometrySample& sample) {
+  if (!std::isfinite(sample.t_s) || sample.t_s < last_time_s_ ||
+      (sample.measured && (!std::isfinite(sample.v_mps) || !std::isfinite(sample.w_radps)))) {
+    ++counters_.odometry_dropped;
+    return;
+  }
+  integrate_to(sample.t_s);
+  if (sample.measured) {
+    held_v_ = sample.v_mps;
+    held_w_ = sample.w_radps;
+    last_measured_s_ = sample.t_s;
+  }
+  ++counters_.odometry;
+}
+
+void MapOptimizer::add_frame(const slam::ObservationFrame& frame, const std::optional<slam::Pose2>& guess) {
+  if (!std::isfinite(frame.t_s) || frame.t_s < last_time_s_) {
+    ++counters_.frames_dropped;
+    return;
+  }
+  ++counters_.frames;
+  integrate_to(frame.t_s);
+  std::vector<const slam::RangeBearing*> valid;
+  for (const slam::RangeBearing& d : frame.detections) {
+    const bool ok = std::isfinite(d.range_m) && std::isfinite(d.bearing_rad) && d.range_m >= options_.min_range_m &&
+                    d.range_m <= options_.max_range_m && std::isfinite(d.range_sigma_m) &&
+                    std::isfinite(d.bearing_sigma_rad);
+    if (ok) {
+      valid.push_back(&d);
+    } else {
+      ++counters_.observations_invalid;
+    }
+  }
+  if (valid.empty()) return;
+  // A keyframe at the frame time, unless the newest one is already there.
+  if (!open_motion_.empty() || frame.t_s > keyframes_.back().t_s) close_keyframe(frame.t_s, guess);
+  const std::size_t k = keyframes_.size() - 1;
+  double* const pose = pose_blocks_.back().data();
+  const slam::Pose2 at(pose[0], pose[1], pose[2]);
+  for (const slam::RangeBearing* d : valid) {
+    auto [it, inserted] = landmarks_.try_emplace(d->landmark_id);
+    LandmarkBlock& lm = it->second;
+    if (inserted) {
+      const auto g = landmark_guesses_.find(d->landmark_id);
+      if (g != landmark_guesses_.end()) {
+        lm.xy = {g->second.x(), g->second.y()};
+      } else {
+        const double heading = at.z() + d->bearing_rad;
+        lm.xy = {at.x() + d->range_m * std::cos(heading), at.y() + d->range_m * std::sin(heading)};
+      }
+      problem_->AddParameterBlock(lm.xy.data(), 2);
+    }
+    const double range_sigma = d->range_sigma_m > 0.0
+                                   ? d->range_sigma_m
+                                   : options_.range_sigma_m + options_.range_sigma_per_m * d->range_m;
+    const double bearing_sigma = d->bearing_sigma_rad > 0.0 ? d->bearing_sigma_rad : options_.bearing_sigma_rad;
+    problem_->AddResidualBlock(new ceres::AutoDiffCostFunction<RangeBearingResidual, 2, 3, 2>(
+                                   new RangeBearingResidual{d->range_m, d->bearing_rad, range_sigma, bearing_sigma}),
+                               loss_.get(), pose, lm.xy.data());
+    ++lm.observations;
+    lm.last_keyframe = k;
+    ++counters_.observations;
+  }
+}
+
+void MapOptimizer::set_landmark_guess(int id, const Eigen::Vector2d& position) {
+  if (position.allFinite()) landmark_guesses_[id] = position;
+}
+
+SolveSummary MapOptimizer::solve(std::optional<std::size_t> window_keyframes) {
+  SolveSummary out;
+  const std::size_t n = pose_blocks_.size();
+  std::size_t first_free = 1;
+  if (window_keyframes) first_free = std::max<std::size_t>(1, n > *window_keyframes ? n - *window_keyframes : 0);
+  for (std::size_t i = 1; i < first_free; ++i) problem_->SetParameterBlockConstant(pose_blocks_[i].data());
+  for (auto& [id, lm] : landmarks_) {
+    if (lm.last_keyframe < first_free) {
+      problem_->SetParameterBlockConstant(lm.xy.data());
+    } else {
+      ++out.landmarks_free;
+    }
+  }
+  out.keyframes_free = n - first_free;
+  out.residuals = static_cast<std::size_t>(problem_->NumResidualBlocks());
+
+  ceres::Solver::Options solver;
+  solver.max_num_iterations = options_.max_iterations;
+  solver.function_tolerance = options_.function_tolerance;
+  solver.num_threads = 1;
+  solver.logging_type = ceres::SILENT;
+  solver.linear_solver_type = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ||
+                                      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE)
+                                  ? ceres::SPARSE_NORMAL_CHOLESKY
+                                  : ceres::DENSE_QR;
+  ceres::Solver::Summary summary;
+  if (out.keyframes_free > 0 || out.landmarks_free > 0) ceres::Solve(solver, problem_.get(), &summary);
+
+  for (std::size_t i = 1; i < first_free; ++i) problem_->SetParameterBlockVariable(pose_blocks_[i].data());
+  for (auto& [id, lm] : landmarks_) problem_->SetParameterBlockVariable(lm.xy.data());
+  sync_keyframes();
+  ++counters_.solves;
+  out.converged = summary.termination_type == ceres::CONVERGENCE;
+  out.iterations = static_cast<int>(summary.iterations.size());
+  out.initial_cost = summary.initial_cost;
+  out.final_cost = summary.final_cost;
+  out.solve_time_s = summary.total_time_in_seconds;
+  out.message = summary.message;
+  return out;
+}
+
+void MapOptimizer::sync_keyframes() {
+  for (std::size_t i = 0; i < pose_blocks_.size(); ++i) {
+    std::array<double, 3>& b = pose_blocks_[i];
+    b[2] = slam::wrap_angle(b[2]);
+    keyframes_[i].pose = slam::Pose2(b[0], b[1], b[2]);
+  }
+}
+
+bool MapOptimizer::compute_landmark_covariances() {
+  for (auto& [id, lm] : landmarks_) lm.cov.setConstant(std::numeric_limits<double>::quiet_NaN());
+  if (landmarks_.empty()) return true;
+  ceres::Covariance::Options options;
+  options.num_threads = 1;
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (const auto& [id, lm] : landmarks_) blocks.emplace_back(lm.xy.data(), lm.xy.data());
+  if (!covariance.Compute(blocks, problem_.get())) return false;
+  for (auto& [id, lm] : landmarks_) {
+    Eigen::Matrix<double, 2, 2, Eigen::RowMajor> c;
+    if (covariance.GetCovarianceBlock(lm.xy.data(), lm.xy.data(), c.data())) lm.cov = c;
+  }
+  return true;
+}
+
+std::vector<LandmarkSolution> MapOptimizer::landmarks() const {
+  std::vector<LandmarkSolution> out;
+  out.reserve(landmarks_.size());
+  for (const auto& [id, lm] : landmarks_) {
+    LandmarkSolution s;
+    s.id = id;
+    s.mean = Eigen::Vector2d(lm.xy[0], lm.xy[1]);
+    s.cov = lm.cov;
+    s.observations = lm.observations;
+    out.push_back(s);
+  }
+  return out;
+}
+
+MapOptimizer::PoseAnchor MapOptimizer::anchor_now() const {
+  PoseAnchor a;
+  a.keyframe = keyframes_.size() - 1;
+  a.relative = Eigen::Vector3d(open_motion_.displacement().x(), open_motion_.displacement().y(),
+                               open_motion_.rotation());
+  return a;
+}
+
+slam::Pose2 MapOptimizer::pose_of(const PoseAnchor& anchor) const {
+  const std::array<double, 3>& b = pose_blocks_.at(anchor.keyframe);
+  const double c = std::cos(b[2]);
+  const double s = std::sin(b[2]);
+  return slam::Pose2(b[0] + c * anchor.relative.x() - s * anchor.relative.y(),
+                     b[1] + s * anchor.relative.x() + c * anchor.relative.y(),
+                     slam::wrap_angle(b[2] + anchor.relative.z()));
+}
+
+}  // namespace pixyslam::map_optimizer
