@@ -23,6 +23,9 @@
 // cases of blind_return.h restarted from the truth every 60 s (the heading bias
 // alternating in sign): heading error at the return, after it and at the end
 // (docs/mrclam.md, "Blind stretch and return").
+// --optimise adds, to every full run and segment (and the LORO runs with the
+// held-out fit), the map optimiser over the whole run after the filter
+// (optimised_run.h): its ATE, heading RMSE and landmark errors beside the filter's.
 // Exit codes: 0 done, 77 dataset folder absent (skip), 1 error,
 // 3 a robot's mean ATE is not better than dead reckoning.
 #include <algorithm>
@@ -32,7 +35,9 @@
 #include <exception>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -41,6 +46,9 @@
 #include "mrclam_dataset.h"
 #include "mrclam_fit.h"
 #include "offline_run.h"
+#ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
+#include "optimised_run.h"
+#endif
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/slam/slam_options_yaml.h"
 #include "segment_eval.h"
@@ -64,7 +72,7 @@ std::vector<int> parse_list(const std::string& text) {
 
 constexpr const char* kUsage =
     "usage: mrclam_eval --dataset DIR --config FILE [--robots 1,2] [--seeds 1,2] "
-    "[--association known_id|maximum_likelihood] [--segments SECONDS] [--loro] [--blind-return]\n"
+    "[--association known_id|maximum_likelihood] [--segments SECONDS] [--loro] [--blind-return] [--optimise]\n"
     "  --dataset DIR      MRCLAM data set folder (exit 77 when absent)\n"
     "  --config FILE      filter options (filter:) and corrections (mrclam:)\n"
     "  --robots LIST      robots to run, default 1,2,3,4,5\n"
@@ -77,7 +85,8 @@ constexpr const char* kUsage =
     "                     values and with neutral corrections (1, 0, 0, 1, 0)\n"
     "  --blind-return     restarts every 60 s with a blind stretch (heading bias on the\n"
     "                     odometry), then only far new landmarks, then the first ones\n"
-    "                     again: the heading error before and after they return";
+    "                     again: the heading error before and after they return\n"
+    "  --optimise         also the map optimiser (Ceres) over every run after the filter";
 
 double parse_seconds(const std::string& text) {
   char* end = nullptr;
@@ -88,6 +97,17 @@ double parse_seconds(const std::string& text) {
   return v;
 }
 
+// The map optimiser's solution of a filter run, when asked for (--optimise).
+std::optional<offline::RunResult> optimised(bool optimise, const slam::FilterOptions& options,
+                                            const offline::RunInput& input, const offline::RunResult& filter) {
+#ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
+  if (optimise) return offline::optimise_run(options, input, filter).result;
+#else
+  if (optimise) throw std::runtime_error("--optimise: this build has no map optimiser (built without Ceres)");
+#endif
+  return std::nullopt;
+}
+
 // One restarted run of --segments.
 struct Segment {
   int robot = 0;
@@ -96,9 +116,11 @@ struct Segment {
   double length_s = 0.0;  // to the end of its trajectory
   eval::TrajectoryErrors errors;
   offline::NeesStats nees;
+  std::optional<eval::TrajectoryErrors> optimised;  // --optimise
 };
 
 void print_nees(const char* label, const offline::NeesStats& n) {
+  if (n.steps + n.singular == 0) return;
   std::printf("%s NEES mean %.2f (ideal 3), %.1f %% inside [%.4f, %.4f] (ideal 95), %.1f %% below %.4f "
               "(ideal 97.5); %zu steps, %zu singular skipped\n",
               label, n.mean(), 100.0 * n.fraction_inside(), offline::kNees3Lower95, offline::kNees3Upper95,
@@ -120,15 +142,27 @@ void print_segment_summary(const std::string& label, const std::vector<Segment>&
               "heading RMSE mean %.2f median %.2f p90 %.2f worst %.2f deg\n",
               label.c_str(), a.count, a.mean, a.median, a.p90, a.max, h.mean, h.median, h.p90, h.max);
   print_nees((label + ":").c_str(), nees);
+  std::vector<double> opt_ate, opt_heading;
+  for (const Segment& s : segments) {
+    if (!s.optimised) continue;
+    opt_ate.push_back(s.optimised->ate_rmse_m);
+    opt_heading.push_back(s.optimised->heading_rmse_rad * kDeg);
+  }
+  if (opt_ate.empty()) return;
+  const offline::Summary oa = offline::summarize(opt_ate), oh = offline::summarize(opt_heading);
+  std::printf("%s, map optimiser: %zu segments, ATE mean %.3f median %.3f p90 %.3f worst %.3f m; "
+              "heading RMSE mean %.2f median %.2f p90 %.2f worst %.2f deg\n",
+              label.c_str(), oa.count, oa.mean, oa.median, oa.p90, oa.max, oh.mean, oh.median, oh.p90, oh.max);
 }
 
 // The runs of one robot and seed restarted from the truth every every_s seconds.
 std::vector<Segment> run_segments(const slam::FilterOptions& options, const offline::RunInput& input, int robot,
-                                  double every_s) {
+                                  double every_s, bool optimise) {
   const std::vector<eval::TimedPose> truth = offline::sorted_by_time(input.truth);
   std::vector<Segment> out;
   for (double start : offline::segment_starts(truth, every_s)) {
-    const offline::RunResult res = offline::run_filter(options, offline::restart_at_truth(input, start));
+    const offline::RunInput restarted = offline::restart_at_truth(input, start);
+    const offline::RunResult res = offline::run_filter(options, restarted);
     if (res.trajectory.empty()) continue;
     Segment s;
     s.robot = robot;
@@ -137,6 +171,9 @@ std::vector<Segment> run_segments(const slam::FilterOptions& options, const offl
     s.length_s = res.trajectory.back().t_s - start;
     s.errors = eval::compare_trajectory(res.trajectory, truth);
     s.nees = offline::trajectory_nees(res.trajectory, res.covariance, truth);
+    if (const auto opt = optimised(optimise, options, restarted, res)) {
+      s.optimised = eval::compare_trajectory(opt->trajectory, truth);
+    }
     out.push_back(s);
   }
   return out;
@@ -185,7 +222,7 @@ void print_fit(const std::string& label, const mrclam::CorrectionFit& f) {
 // the main table's runs (config corrections, one per seed), `config_segments`
 // the segments run with them (empty without --segments).
 void run_loro(const std::string& dataset, slam::FilterOptions options, const offline::MrclamSensorModel& config_model,
-              const std::vector<int>& robots, const std::vector<int>& seeds, double segment_every_s,
+              const std::vector<int>& robots, const std::vector<int>& seeds, double segment_every_s, bool optimise,
               const std::map<int, std::vector<RunScore>>& config_scores,
               const std::map<int, std::vector<Segment>>& config_segments) {
   constexpr double kDeg = 180.0 / M_PI;
@@ -213,6 +250,7 @@ void run_loro(const std::string& dataset, slam::FilterOptions options, const off
     std::string fitted_on;
     offline::MrclamSensorModel fit;
     RunScore loro, config, neutral;  // means over the seeds
+    RunScore loro_optimised;          // --optimise: the map optimiser with the held-out fit
     std::vector<Segment> loro_segments, neutral_segments;
   };
   std::vector<RobotRow> rows;
@@ -245,6 +283,14 @@ void run_loro(const std::string& dataset, slam::FilterOptions options, const off
         const offline::RunResult res = offline::run_filter(options, *inputs[m]);
         const offline::Report rep = offline::evaluate(*inputs[m], res);
         score[m == 0 ? 0 : 2] = {rep.filter.ate_rmse_m, rep.filter.heading_rmse_rad * kDeg};
+        if (m != 0) continue;
+        if (const auto opt = optimised(optimise, options, *inputs[m], res)) {
+          const offline::Report o = offline::evaluate(*inputs[m], *opt);
+          std::printf("%-6d %-5d map optimiser with the held-out fit: ATE %.3f m, heading RMSE %.2f deg\n", robot,
+                      seeds[i], o.filter.ate_rmse_m, o.filter.heading_rmse_rad * kDeg);
+          row.loro_optimised.ate_m += o.filter.ate_rmse_m / static_cast<double>(seeds.size());
+          row.loro_optimised.heading_deg += o.filter.heading_rmse_rad * kDeg / static_cast<double>(seeds.size());
+        }
       }
       if (config_it != config_scores.end() && i < config_it->second.size()) score[1] = config_it->second[i];
       std::printf("%-6d %-5d %9.3f %9.3f %9.3f %10.2f %10.2f %10.2f\n", robot, seeds[i], score[0].ate_m,
@@ -258,8 +304,10 @@ void run_loro(const std::string& dataset, slam::FilterOptions options, const off
       row.neutral.ate_m += score[2].ate_m / n;
       row.neutral.heading_deg += score[2].heading_deg / n;
       if (segment_every_s > 0.0) {
-        for (const Segment& g : run_segments(options, with_fit, robot, segment_every_s)) row.loro_segments.push_back(g);
-        for (const Segment& g : run_segments(options, with_neutral, robot, segment_every_s)) {
+        for (const Segment& g : run_segments(options, with_fit, robot, segment_every_s, optimise)) {
+          row.loro_segments.push_back(g);
+        }
+        for (const Segment& g : run_segments(options, with_neutral, robot, segment_every_s, false)) {
           row.neutral_segments.push_back(g);
         }
       }
@@ -295,6 +343,17 @@ void run_loro(const std::string& dataset, slam::FilterOptions options, const off
               "neutral; heading RMSE %.2f / %.2f / %.2f deg\n",
               rows.size(), mean_loro.ate_m, mean_config.ate_m, mean_neutral.ate_m, mean_loro.heading_deg,
               mean_config.heading_deg, mean_neutral.heading_deg);
+  if (optimise) {
+    RunScore mean_optimised;
+    for (const RobotRow& r : rows) {
+      std::printf("LORO robot %d, map optimiser with the held-out fit: ATE %.3f m, heading RMSE %.2f deg\n", r.robot,
+                  r.loro_optimised.ate_m, r.loro_optimised.heading_deg);
+      mean_optimised.ate_m += r.loro_optimised.ate_m / n;
+      mean_optimised.heading_deg += r.loro_optimised.heading_deg / n;
+    }
+    std::printf("LORO MEAN over %zu robots, map optimiser with the held-out fit: ATE %.3f m, heading RMSE %.2f deg\n",
+                rows.size(), mean_optimised.ate_m, mean_optimised.heading_deg);
+  }
   if (segment_every_s > 0.0) {
     std::printf("\nLORO SEGMENTS (restarted from the truth every %.0f s):\n", segment_every_s);
     std::vector<Segment> all_loro, all_config, all_neutral;
@@ -379,7 +438,7 @@ int run(int argc, char** argv) {
   std::string dataset, config_path, association;
   std::vector<int> robots{1, 2, 3, 4, 5}, seeds{1, 2, 3};
   double segment_every_s = 0.0;  // 0: no segments
-  bool loro = false, blind_return = false;
+  bool loro = false, blind_return = false, optimise = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
@@ -395,6 +454,10 @@ int run(int argc, char** argv) {
     }
     if (key == "--blind-return") {
       blind_return = true;
+      continue;
+    }
+    if (key == "--optimise") {
+      optimise = true;
       continue;
     }
     if (i + 1 >= argc) throw std::invalid_argument(kUsage);
@@ -431,6 +494,20 @@ int run(int argc, char** argv) {
   double sum_ate = 0, sum_ate_aligned = 0, sum_head = 0, sum_lm = 0, sum_lma = 0, sum_wall = 0;
   int runs = 0;
   offline::NeesStats nees_all;
+  // --optimise: the same sums for the map optimiser's solutions.
+  struct Sums {
+    double ate = 0, ate_aligned = 0, head = 0, lm = 0, lma = 0, worst = 0;
+    int runs = 0;
+    void add(const offline::Report& r) {
+      ate += r.filter.ate_rmse_m;
+      ate_aligned += r.filter.ate_rmse_aligned_m;
+      head += r.filter.heading_rmse_rad * 180.0 / M_PI;
+      lm += r.landmarks.rmse_m;
+      lma += r.landmarks.rmse_aligned_m;
+      worst = std::max(worst, r.filter.ate_rmse_m);
+      ++runs;
+    }
+  } opt_sum;
   std::vector<std::pair<int, offline::RunInput>> inputs;  // kept for the segments
   std::map<int, std::vector<RunScore>> config_scores;     // kept for --loro
   std::map<int, std::vector<Segment>> config_segments;
@@ -451,6 +528,14 @@ int run(int argc, char** argv) {
                   100.0 * rep.nees.fraction_below_upper());
       std::fflush(stdout);
       config_scores[robot].push_back({rep.filter.ate_rmse_m, rep.filter.heading_rmse_rad * kDeg});
+      if (const auto opt = optimised(optimise, options, input, res)) {
+        const offline::Report o = offline::evaluate(input, *opt);
+        std::printf("%-6d %-5d %9.3f %9.3f %9s %10.2f %10s %11.3f %11.3f %8s %5zu %8.2f  (map optimiser)\n", robot,
+                    seed, o.filter.ate_rmse_m, o.filter.ate_rmse_aligned_m, "", o.filter.heading_rmse_rad * kDeg, "",
+                    o.landmarks.rmse_m, o.landmarks.rmse_aligned_m, "", opt->landmarks.size(), opt->wall_time_s);
+        std::fflush(stdout);
+        opt_sum.add(o);
+      }
       robot_ate += rep.filter.ate_rmse_m;
       robot_dr += rep.dead_reckoning.ate_rmse_m;
       sum_ate += rep.filter.ate_rmse_m;
@@ -476,6 +561,13 @@ int run(int argc, char** argv) {
               "%.3f m aligned, %.2f s per run\n",
               runs, sum_ate / runs, sum_ate_aligned / runs, sum_head / runs, sum_lm / runs, sum_lma / runs, sum_wall / runs);
   if (nees_all.steps + nees_all.singular > 0) print_nees("POOLED over the full runs: pose", nees_all);
+  if (opt_sum.runs > 0) {
+    const double n = opt_sum.runs;
+    std::printf("MEAN over %d runs, map optimiser: ATE %.3f m (%.3f m after SE(2) alignment, worst run %.3f m), "
+                "heading %.2f deg, landmarks %.3f m raw / %.3f m aligned\n",
+                opt_sum.runs, opt_sum.ate / n, opt_sum.ate_aligned / n, opt_sum.worst, opt_sum.head / n, opt_sum.lm / n,
+                opt_sum.lma / n);
+  }
 
   if (segment_every_s > 0.0) {
     std::printf("\nSEGMENTS: restarted from the ground truth every %.0f s, each to the end of the robot's data\n",
@@ -491,10 +583,15 @@ int run(int argc, char** argv) {
       std::vector<Segment> of_robot;
       for (int seed : seeds) {
         options.seed = static_cast<std::uint64_t>(seed);
-        for (const Segment& g : run_segments(options, input, robot, segment_every_s)) {
-          std::printf("%-7zu %-5d %-5d %8.1f %9.1f %9.3f %9.2f %7.2f %6.1f %6.1f\n", all.size() + of_robot.size() + 1,
+        for (const Segment& g : run_segments(options, input, robot, segment_every_s, optimise)) {
+          std::printf("%-7zu %-5d %-5d %8.1f %9.1f %9.3f %9.2f %7.2f %6.1f %6.1f", all.size() + of_robot.size() + 1,
                       g.robot, g.seed, g.start_s, g.length_s, g.errors.ate_rmse_m, g.errors.heading_rmse_rad * kDeg,
                       g.nees.mean(), 100.0 * g.nees.fraction_inside(), 100.0 * g.nees.fraction_below_upper());
+          if (g.optimised) {
+            std::printf("  optimised ATE %.3f m, heading %.2f deg", g.optimised->ate_rmse_m,
+                        g.optimised->heading_rmse_rad * kDeg);
+          }
+          std::printf("\n");
           std::fflush(stdout);
           of_robot.push_back(g);
         }
@@ -514,7 +611,7 @@ int run(int argc, char** argv) {
   }
   if (blind_return) run_blind_return(options, inputs, seeds);
   if (loro) {
-    run_loro(dataset, options, model, robots, seeds, segment_every_s, config_scores, config_segments);
+    run_loro(dataset, options, model, robots, seeds, segment_every_s, optimise, config_scores, config_segments);
   }
   if (!all_better) {
     std::printf("FAIL: some robot's mean ATE is not better than dead reckoning\n");
