@@ -375,7 +375,7 @@ void run_loro(const std::string& dataset, slam::FilterOptions options, const off
 
 // mrclam_eval --blind-return (see the top of this file).
 void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<int, offline::RunInput>>& inputs,
-                      const std::vector<int>& seeds) {
+                      const std::vector<int>& seeds, bool optimise) {
   constexpr double kDeg = 180.0 / M_PI;
   constexpr double kEveryS = 60.0;
   const offline::BlindReturnOptions cases;
@@ -386,7 +386,7 @@ void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<i
               cases.after_s);
   std::printf("%-5s %-5s %8s %8s %9s %9s %9s %9s %9s %9s\n", "robot", "seed", "start_s", "return_s", "DR_ret",
               "DR_end", "err_ret", "rmse_aft", "err_end", "ATE_aft");
-  std::vector<double> at_return, after, at_end, ate_after, dr_at_return, dr_at_end;
+  std::vector<double> at_return, after, at_end, ate_after, dr_at_return, dr_at_end, opt_after, opt_at_end, opt_ate_after;
   std::size_t skipped = 0;
   for (const auto& [robot, input] : inputs) {
     if (input.truth.empty()) continue;
@@ -406,10 +406,19 @@ void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<i
         const offline::RunResult res = offline::run_filter(options, c->input);
         const offline::ReturnScore score = offline::score_return(*c, res.trajectory);
         const offline::ReturnScore dr = offline::score_return(*c, res.dead_reckoning);
-        std::printf("%-5d %-5d %8.1f %8.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.3f\n", robot, seed,
+        std::printf("%-5d %-5d %8.1f %8.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.3f", robot, seed,
                     starts[k] - truth.front().t_s, c->return_s - starts[k], dr.heading_error_at_return_rad * kDeg,
                     dr.heading_error_end_rad * kDeg, score.heading_error_at_return_rad * kDeg, score.heading_rmse_after_rad * kDeg,
                     score.heading_error_end_rad * kDeg, score.ate_after_m);
+        if (const auto opt = optimised(optimise, options, c->input, res)) {
+          const offline::ReturnScore os = offline::score_return(*c, opt->trajectory);
+          std::printf("  optimised: rmse_aft %.1f err_end %.1f ATE_aft %.3f", os.heading_rmse_after_rad * kDeg,
+                      os.heading_error_end_rad * kDeg, os.ate_after_m);
+          opt_after.push_back(os.heading_rmse_after_rad * kDeg);
+          opt_at_end.push_back(os.heading_error_end_rad * kDeg);
+          opt_ate_after.push_back(os.ate_after_m);
+        }
+        std::printf("\n");
         std::fflush(stdout);
         dr_at_return.push_back(dr.heading_error_at_return_rad * kDeg);
         dr_at_end.push_back(dr.heading_error_end_rad * kDeg);
@@ -432,6 +441,11 @@ void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<i
   line("heading RMSE after return", after, "deg");
   line("heading error, last 10 s", at_end, "deg");
   line("ATE after return", ate_after, "m");
+  if (!opt_after.empty()) {
+    line("map optimiser: heading RMSE after return", opt_after, "deg");
+    line("map optimiser: heading error, last 10 s", opt_at_end, "deg");
+    line("map optimiser: ATE after return", opt_ate_after, "m");
+  }
 }
 
 int run(int argc, char** argv) {
@@ -609,7 +623,7 @@ int run(int argc, char** argv) {
                   worst.seed, worst.start_s, worst.errors.ate_rmse_m, worst.errors.heading_rmse_rad * kDeg);
     }
   }
-  if (blind_return) run_blind_return(options, inputs, seeds);
+  if (blind_return) run_blind_return(options, inputs, seeds, optimise);
   if (loro) {
     run_loro(dataset, options, model, robots, seeds, segment_every_s, optimise, config_scores, config_segments);
   }
