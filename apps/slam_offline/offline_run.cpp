@@ -14,15 +14,12 @@
 #include "pixyslam/eval/rigid_alignment.h"
 
 namespace pixyslam::offline {
-namespace {
 
 double thread_cpu_seconds() {
   timespec t{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
-
-}  // namespace
 
 RunResult run_filter(const slam::FilterOptions& options, const RunInput& input) {
   RunResult result;

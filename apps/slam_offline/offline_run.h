@@ -33,6 +33,9 @@ struct RunResult {
   double final_effective_sample_size = 0.0;
 };
 
+// This thread's CPU time in seconds (steadier than wall time on a shared machine).
+double thread_cpu_seconds();
+
 // Feeds the filter in time order, skipping samples before start_time_s.
 RunResult run_filter(const slam::FilterOptions& options, const RunInput& input);
 

@@ -1,19 +1,9 @@
 #include "optimised_run.h"
 
 #include <chrono>
-#include <ctime>
 #include <limits>
 
 namespace pixyslam::offline {
-namespace {
-
-double thread_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-}  // namespace
 
 OptimisedRun optimise_run(const slam::FilterOptions& options, const RunInput& input, const RunResult& filter) {
   OptimisedRun out;
