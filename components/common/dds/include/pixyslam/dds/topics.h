@@ -13,6 +13,8 @@
 #include "map_statePubSubTypes.h"
 #include "odometry.h"
 #include "odometryPubSubTypes.h"
+#include "optimised_map.h"
+#include "optimised_mapPubSubTypes.h"
 
 // The generated TypeObject registration functions (declared here rather than
 // by including the generated *TypeObject.h headers: those put
@@ -23,6 +25,7 @@ void registerlandmark_observationTypes();
 void registermap_stateTypes();
 void registerground_truthTypes();
 void registerdiagnosticsTypes();
+void registeroptimised_mapTypes();
 
 namespace pixyslam::msg {
 // IDL of idl/<stem>.idl with its includes inlined (an `omgidl` schema); "" if unknown.
@@ -39,6 +42,7 @@ inline constexpr std::string_view kLandmarkObservationTopic = "pixyslam/landmark
 inline constexpr std::string_view kMapStateTopic = "pixyslam/map_state";
 inline constexpr std::string_view kGroundTruthTopic = "pixyslam/ground_truth";
 inline constexpr std::string_view kDiagnosticsTopic = "pixyslam/diagnostics";
+inline constexpr std::string_view kOptimisedMapTopic = "pixyslam/optimised_map";
 
 // Message type -> its topic, generated TopicDataType and IDL file.
 template <class Message>
@@ -59,6 +63,7 @@ PIXYSLAM_MESSAGE_TRAITS(LandmarkObservation, kLandmarkObservationTopic, "landmar
 PIXYSLAM_MESSAGE_TRAITS(MapState, kMapStateTopic, "map_state", registermap_stateTypes)
 PIXYSLAM_MESSAGE_TRAITS(GroundTruth, kGroundTruthTopic, "ground_truth", registerground_truthTypes)
 PIXYSLAM_MESSAGE_TRAITS(Diagnostics, kDiagnosticsTopic, "diagnostics", registerdiagnosticsTypes)
+PIXYSLAM_MESSAGE_TRAITS(OptimisedMap, kOptimisedMapTopic, "optimised_map", registeroptimised_mapTypes)
 
 #undef PIXYSLAM_MESSAGE_TRAITS
 
