@@ -10,6 +10,9 @@ set(pixyslam_programs
 if(TARGET map_view)
   list(APPEND pixyslam_programs map_view)
 endif()
+if(TARGET map_optimizer)
+  list(APPEND pixyslam_programs map_optimizer)
+endif()
 install(TARGETS ${pixyslam_programs} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # Configuration lives in /etc whatever the prefix (the systemd units read it there).
 set(PIXYSLAM_SYSCONFDIR /etc CACHE PATH "Where config/ is installed (as pixyslam/)")

@@ -2,9 +2,13 @@
 // Subscribes to every topic, counts messages and sequence gaps per topic, and
 // when stopped (SIGINT/SIGTERM, e.g. by the launcher) prints the pose ATE RMSE
 // (estimate interpolated at the ground-truth times), heading RMSE, landmark
-// RMSE raw and aligned, and writes the trajectories to --out.
-//   sim_evaluator --dds-config config/slam_estimator.yaml [--out DIR] [--max-ate M]
-// Exit code 3 if the ATE exceeds --max-ate or nothing was estimated.
+// RMSE raw and aligned, and writes the trajectories to --out. When the map
+// optimiser runs (pixyslam/optimised_map), the same for its newest solution
+// (keyframes against the truth, its landmarks) and its CPU time.
+//   sim_evaluator --dds-config config/slam_estimator.yaml [--out DIR] [--max-ate M] [--max-optimised-ratio R]
+// Exit code 3 if the ATE exceeds --max-ate or nothing was estimated; with
+// --max-optimised-ratio also when no OptimisedMap arrived or its landmark RMSE
+// is above R times the filter's (1: at most the filter's).
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -34,6 +38,12 @@ struct Received {
   std::vector<eval::LandmarkPoint> map;
   double last_update_ms = 0.0;
   std::vector<double> update_ms;
+  // The newest OptimisedMap.
+  std::size_t optimised_maps = 0;
+  std::vector<eval::TimedPose> optimised_keyframes;
+  std::vector<eval::LandmarkPoint> optimised_landmarks;
+  double optimiser_cpu_s = 0.0;
+  std::uint64_t optimised_stamp_ns = 0;
 };
 
 template <class Message>
@@ -71,6 +81,19 @@ int run(const app::CommandLine& args) {
     r.map.clear();
     for (const msg::LandmarkEstimate& l : m.landmarks()) r.map.push_back({l.landmark_id(), l.x_m(), l.y_m()});
   });
+  dds::Reader<msg::OptimisedMap> optimised(participant, [&](const msg::OptimisedMap& m) {
+    std::lock_guard<std::mutex> lock(r.mutex);
+    if (r.optimised_maps > 0 && m.header().stamp_ns() < r.optimised_stamp_ns) return;  // an older solution
+    ++r.optimised_maps;
+    r.optimised_stamp_ns = m.header().stamp_ns();
+    r.optimised_keyframes.clear();
+    for (const msg::OptimisedKeyframe& k : m.keyframes()) {
+      r.optimised_keyframes.push_back({seconds(k.stamp_ns()), k.pose().x_m(), k.pose().y_m(), k.pose().theta_rad()});
+    }
+    r.optimised_landmarks.clear();
+    for (const msg::OptimisedLandmark& l : m.landmarks()) r.optimised_landmarks.push_back({l.landmark_id(), l.x_m(), l.y_m()});
+    r.optimiser_cpu_s = m.cpu_time_s();
+  });
   std::fprintf(stderr, "sim_evaluator: listening on DDS domain %d\n", dds_options.domain_id);
   while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
   }
@@ -81,6 +104,7 @@ int run(const app::CommandLine& args) {
   print_topic(observations);
   print_topic(maps);
   print_topic(truth);
+  print_topic(optimised);
   if (r.estimate.empty() || r.truth.empty()) {
     std::printf("sim_evaluator: no %s received: nothing to evaluate\n", r.estimate.empty() ? "MapState" : "GroundTruth");
     return 3;
@@ -95,6 +119,21 @@ int run(const app::CommandLine& args) {
   std::printf("  landmarks            %zu mapped of %zu, RMSE %.3f m raw, %.3f m aligned\n", landmarks.matched,
               r.true_landmarks.size(), landmarks.rmse_m, landmarks.rmse_aligned_m);
 
+  bool optimised_ok = false;
+  if (r.optimised_maps > 0 && !r.optimised_keyframes.empty()) {
+    const eval::TrajectoryErrors opt_pose = eval::compare_trajectory(r.optimised_keyframes, r.truth);
+    const eval::LandmarkErrors opt_landmarks = eval::compare_landmarks(r.optimised_landmarks, r.true_landmarks);
+    std::printf("  map optimiser        %zu solutions; newest: %zu keyframes, pose ATE %.3f m, heading RMSE %.2f deg; "
+                "landmarks %zu mapped, RMSE %.3f m raw, %.3f m aligned; optimiser CPU %.3f s\n",
+                r.optimised_maps, r.optimised_keyframes.size(), opt_pose.ate_rmse_m,
+                opt_pose.heading_rmse_rad * 180.0 / M_PI, opt_landmarks.matched, opt_landmarks.rmse_m,
+                opt_landmarks.rmse_aligned_m, r.optimiser_cpu_s);
+    optimised_ok = opt_landmarks.matched > 0 &&
+                   opt_landmarks.rmse_m <= args.number("max-optimised-ratio", 1.0) * landmarks.rmse_m;
+  } else {
+    std::printf("  map optimiser        no OptimisedMap received\n");
+  }
+
   if (args.has("out")) {
     const std::string out = args.get("out");
     std::filesystem::create_directories(out);
@@ -107,6 +146,11 @@ int run(const app::CommandLine& args) {
     std::printf("sim_evaluator: ATE %.3f m exceeds the limit %.3f m\n", pose.ate_rmse_m, max_ate);
     return 3;
   }
+  if (args.has("max-optimised-ratio") && !optimised_ok) {
+    std::printf("sim_evaluator: the map optimiser's landmarks are missing or above %.2f times the filter's RMSE\n",
+                args.number("max-optimised-ratio", 1.0));
+    return 3;
+  }
   return 0;
 }
 
@@ -116,9 +160,9 @@ int run(const app::CommandLine& args) {
 int main(int argc, char** argv) {
   pixyslam::app::StopSignal::install();
   return pixyslam::app::run_main("sim_evaluator", [&] {
-    const pixyslam::app::CommandLine args(argc, argv, {"dds-config", "out", "max-ate"});
+    const pixyslam::app::CommandLine args(argc, argv, {"dds-config", "out", "max-ate", "max-optimised-ratio"});
     if (args.help()) {
-      std::puts("usage: sim_evaluator --dds-config FILE [--out DIR] [--max-ate M]");
+      std::puts("usage: sim_evaluator --dds-config FILE [--out DIR] [--max-ate M] [--max-optimised-ratio R]");
       return 0;
     }
     return pixyslam::sim_evaluator::run(args);

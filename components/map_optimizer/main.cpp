@@ -1,0 +1,71 @@
+// map_optimizer: the map optimiser over DDS (components/map_optimizer): Odometry,
+// LandmarkObservation and the estimator's MapState in, OptimisedMap out, until
+// SIGINT/SIGTERM. Optional: the robot runs without it; it can run on another host.
+//   map_optimizer --config config/map_optimizer.yaml [--out DIR]
+// --out writes DIR/trajectory.csv (the final solution's keyframes) and
+// DIR/landmarks.csv at exit, in slam_offline's formats.
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/process_main.h"
+#include "pixyslam/app/stop_signal.h"
+#include "pixyslam/eval/csv_io.h"
+#include "pixyslam/map_optimizer_node/optimizer_node.h"
+
+namespace {
+
+void write_outputs(const std::string& dir, const pixyslam::msg::OptimisedMap& map) {
+  using namespace pixyslam;
+  std::filesystem::create_directories(dir);
+  std::vector<eval::TimedPose> poses;
+  for (const msg::OptimisedKeyframe& k : map.keyframes()) {
+    poses.push_back({static_cast<double>(k.stamp_ns()) * 1e-9, k.pose().x_m(), k.pose().y_m(), k.pose().theta_rad()});
+  }
+  eval::write_trajectory_csv(dir + "/trajectory.csv", poses);
+  std::vector<eval::LandmarkRow> rows;
+  for (const msg::OptimisedLandmark& l : map.landmarks()) {
+    rows.push_back({l.landmark_id(), l.x_m(), l.y_m(), l.cov_xx_m2(), l.cov_xy_m2(), l.cov_yy_m2()});
+  }
+  eval::write_landmarks_csv(dir + "/landmarks.csv", rows);
+  std::fprintf(stderr, "map_optimizer: wrote %s/trajectory.csv (%zu keyframes), %s/landmarks.csv (%zu)\n",
+               dir.c_str(), poses.size(), dir.c_str(), rows.size());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace pixyslam;
+  app::StopSignal::install();
+  return app::run_main("map_optimizer", [&] {
+    const app::CommandLine args(argc, argv, {"config", "out"});
+    if (args.help()) {
+      std::puts(
+          "usage: map_optimizer --config FILE [--out DIR]\n"
+          "  --config FILE  config/map_optimizer.yaml: filter_config (the estimator's file: its noise, limits and\n"
+          "                 start pose), optimizer: (keyframes, window and whole-problem solves), dds:\n"
+          "  --out DIR      at exit, DIR/trajectory.csv (final keyframes) and DIR/landmarks.csv");
+      return 0;
+    }
+    const map_optimizer_node::OptimizerNodeOptions options =
+        map_optimizer_node::read_optimizer_node_options_file(args.get("config"));
+    std::fprintf(stderr,
+                 "map_optimizer: keyframe every %.2f s at most, window of %zu keyframes every %.1f s, whole problem "
+                 "every %.1f s; DDS domain %d, profiles '%s'\n",
+                 options.optimizer.keyframe_interval_s, options.window_keyframes, options.window_period_s,
+                 options.whole_period_s, options.dds.domain_id, options.dds.profiles_file.c_str());
+    map_optimizer_node::OptimizerNode node(options);
+    node.start();
+    while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
+    }
+    node.stop();
+    const map_optimizer_node::OptimizerNodeCounters c = node.counters();
+    std::fprintf(stderr, "map_optimizer: %llu window and %llu whole-problem solves, CPU %.3f s (Ceres %.3f s)\n",
+                 static_cast<unsigned long long>(c.window_solves), static_cast<unsigned long long>(c.whole_solves),
+                 c.cpu_time_s, c.solve_time_s);
+    if (args.has("out")) write_outputs(args.get("out"), node.latest_map());
+    return 0;
+  });
+}

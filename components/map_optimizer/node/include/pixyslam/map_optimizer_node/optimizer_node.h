@@ -1,0 +1,126 @@
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <utility>
+#include <variant>
+
+#include "landmark_observation.h"
+#include "map_state.h"
+#include "odometry.h"
+#include "optimised_map.h"
+#include "pixyslam/dds/endpoints.h"
+#include "pixyslam/diagnostics/diagnostics_publisher.h"
+#include "pixyslam/map_optimizer/map_optimizer.h"
+#include "pixyslam/slam/sensor_queue.h"
+
+namespace pixyslam::map_optimizer_node {
+
+// Everything the map_optimizer process is configured with (config/map_optimizer.yaml).
+struct OptimizerNodeOptions {
+  map_optimizer::MapOptimizerOptions optimizer;  // motion and observation noise from the filter's config
+  slam::Pose2 initial_pose = slam::Pose2::Zero();  // the estimator's start pose (its config)
+  slam::SensorQueueOptions queue;                // the estimator's delays
+  bool use_detection_sigmas = true;              // as the estimator
+  std::size_t window_keyframes = 100;            // the newest keyframes a window solve frees
+  double window_period_s = 1.0;                  // data time between window solves
+  double whole_period_s = 10.0;                  // data time between whole-problem solves
+  int published_keyframes = 2000;                // OptimisedMap.keyframes at most (<= 8192)
+  double status_period_s = 10.0;                 // counters to the log every so often (0: never)
+  dds::DdsOptions dds;
+};
+
+// Reads the file: `filter_config` (the estimator's config, relative to this
+// file: its `filter:` noise and limits, `estimator.initial_pose`, delays and
+// detection sigmas, so both solve the same models), `optimizer:` and `dds:`.
+// Errors are config::ConfigError naming the file and key.
+OptimizerNodeOptions read_optimizer_node_options_file(const std::string& path);
+
+struct OptimizerNodeCounters {
+  std::uint64_t odometry_received = 0;
+  std::uint64_t observations_received = 0;
+  std::uint64_t map_states_received = 0;
+  std::uint64_t malformed = 0;          // samples that did not decode (dropped), all readers
+  std::uint64_t seq_jumps = 0;
+  std::uint64_t window_solves = 0;
+  std::uint64_t whole_solves = 0;
+  std::uint64_t maps_published = 0;
+  std::uint64_t guesses_from_filter = 0;  // keyframes started from the filter's pose
+  double cpu_time_s = 0.0;                // the optimiser thread's CPU time
+  double solve_time_s = 0.0;              // Ceres' time over all solves
+};
+
+// The map optimiser process: Odometry, LandmarkObservation and the estimator's
+// MapState in; OptimisedMap out. One thread feeds the core in stamp order
+// (SensorQueue, as the estimator) and solves: the newest window every
+// window_period_s of data, the whole problem every whole_period_s and at the
+// end (with the landmarks' marginal covariances), publishing after each.
+// MapStates give the keyframes' starting poses (the filter's pose at a frame's
+// stamp, when it has arrived) and new landmarks' starting positions.
+class OptimizerNode {
+ public:
+  explicit OptimizerNode(const OptimizerNodeOptions& options);
+  ~OptimizerNode();
+  OptimizerNode(const OptimizerNode&) = delete;
+  OptimizerNode& operator=(const OptimizerNode&) = delete;
+
+  void start();
+  // Drains what is queued, solves the whole problem, publishes and joins.
+  void stop();
+
+  OptimizerNodeCounters counters() const;
+  msg::OptimisedMap latest_map() const;
+
+ private:
+  using Inbox = std::variant<msg::Odometry, msg::LandmarkObservation>;
+  void enqueue(Inbox&& item);
+  void on_map_state(const msg::MapState& m);
+  void loop();
+  void step(const slam::SensorInput& input);
+  void solve(bool whole);
+  void publish(const map_optimizer::SolveSummary& s, bool whole);
+  void log_status() const;
+  diagnostics::Snapshot diagnostics_snapshot() const;
+
+  OptimizerNodeOptions options_;
+  std::unique_ptr<dds::Participant> participant_;
+  std::unique_ptr<dds::Writer<msg::OptimisedMap>> writer_;
+  std::unique_ptr<dds::Reader<msg::Odometry>> odometry_reader_;
+  std::unique_ptr<dds::Reader<msg::LandmarkObservation>> observation_reader_;
+  std::unique_ptr<dds::Reader<msg::MapState>> map_state_reader_;
+  std::unique_ptr<diagnostics::DiagnosticsPublisher> diagnostics_;
+
+  mutable std::mutex inbox_mutex_;
+  std::condition_variable inbox_cv_;
+  std::deque<Inbox> inbox_;
+  bool stopping_ = false;
+  std::thread thread_;
+
+  // The filter's recent poses by stamp and its newest map (DDS thread -> loop).
+  mutable std::mutex filter_mutex_;
+  std::deque<std::pair<std::uint64_t, slam::Pose2>> filter_poses_;
+  std::vector<std::pair<int, Eigen::Vector2d>> filter_landmarks_;
+
+  // Loop state (read by others under state_mutex_).
+  mutable std::mutex state_mutex_;
+  slam::SensorQueue queue_;
+  std::unique_ptr<map_optimizer::MapOptimizer> optimizer_;
+  bool has_epoch_ = false;
+  std::uint64_t epoch_ns_ = 0;
+  double last_t_s_ = 0.0;
+  double next_window_s_ = 0.0;
+  double next_whole_s_ = 0.0;
+  bool dirty_ = false;  // input since the last solve
+  std::uint64_t last_odometry_seq_ = 0;
+  std::uint64_t last_observation_seq_ = 0;
+  double cpu_start_s_ = 0.0;
+  msg::OptimisedMap map_;
+  OptimizerNodeCounters counters_;
+};
+
+}  // namespace pixyslam::map_optimizer_node

@@ -1,0 +1,314 @@
+#include "pixyslam/map_optimizer_node/optimizer_node.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+
+#include "pixyslam/slam_node/map_state_conversions.h"
+
+namespace pixyslam::map_optimizer_node {
+namespace {
+
+// The filter's poses kept for keyframe guesses: a few seconds of MapStates.
+constexpr std::size_t kFilterPosesKept = 2048;
+
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+double seconds_since(std::uint64_t stamp_ns, std::uint64_t epoch_ns) {
+  return static_cast<double>(static_cast<std::int64_t>(stamp_ns - epoch_ns)) * 1e-9;
+}
+
+msg::Pose2D to_msg(const slam::Pose2& p) {
+  msg::Pose2D out;
+  out.x_m(p.x());
+  out.y_m(p.y());
+  out.theta_rad(p.z());
+  return out;
+}
+
+}  // namespace
+
+OptimizerNode::OptimizerNode(const OptimizerNodeOptions& options) : options_(options), queue_(options.queue) {
+  map_optimizer::validate(options_.optimizer);
+  participant_ = std::make_unique<dds::Participant>(options_.dds, "map_optimizer");
+  writer_ = std::make_unique<dds::Writer<msg::OptimisedMap>>(*participant_);
+  odometry_reader_ = std::make_unique<dds::Reader<msg::Odometry>>(
+      *participant_, [this](const msg::Odometry& m) { enqueue(m); });
+  observation_reader_ = std::make_unique<dds::Reader<msg::LandmarkObservation>>(
+      *participant_, [this](const msg::LandmarkObservation& m) { enqueue(m); });
+  map_state_reader_ = std::make_unique<dds::Reader<msg::MapState>>(
+      *participant_, [this](const msg::MapState& m) { on_map_state(m); });
+  diagnostics_ = std::make_unique<diagnostics::DiagnosticsPublisher>(
+      *participant_, "map_optimizer", options_.dds.diagnostics_period_s, [this] { return diagnostics_snapshot(); });
+}
+
+OptimizerNode::~OptimizerNode() {
+  stop();
+  diagnostics_.reset();
+  odometry_reader_.reset();
+  observation_reader_.reset();
+  map_state_reader_.reset();
+  writer_.reset();
+  participant_.reset();
+}
+
+void OptimizerNode::start() {
+  std::lock_guard<std::mutex> lock(inbox_mutex_);
+  if (thread_.joinable() || stopping_) return;
+  thread_ = std::thread([this] { loop(); });
+}
+
+void OptimizerNode::stop() {
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    stopping_ = true;
+  }
+  inbox_cv_.notify_all();
+  if (!thread_.joinable()) return;
+  thread_.join();
+  diagnostics_->stop();
+}
+
+void OptimizerNode::enqueue(Inbox&& item) {
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    inbox_.push_back(std::move(item));
+  }
+  inbox_cv_.notify_one();
+}
+
+void OptimizerNode::on_map_state(const msg::MapState& m) {
+  const msg::Pose2D& p = m.mean_pose();
+  std::lock_guard<std::mutex> lock(filter_mutex_);
+  filter_poses_.emplace_back(m.header().stamp_ns(), slam::Pose2(p.x_m(), p.y_m(), p.theta_rad()));
+  while (filter_poses_.size() > kFilterPosesKept) filter_poses_.pop_front();
+  filter_landmarks_.clear();
+  for (const msg::LandmarkEstimate& l : m.landmarks()) {
+    filter_landmarks_.emplace_back(l.landmark_id(), Eigen::Vector2d(l.x_m(), l.y_m()));
+  }
+}
+
+OptimizerNodeCounters OptimizerNode::counters() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  OptimizerNodeCounters c = counters_;
+  c.odometry_received = odometry_reader_->received();
+  c.observations_received = observation_reader_->received();
+  c.map_states_received = map_state_reader_->received();
+  c.malformed = odometry_reader_->malformed() + observation_reader_->malformed() + map_state_reader_->malformed() +
+                odometry_reader_->callback_errors() + observation_reader_->callback_errors() +
+                map_state_reader_->callback_errors();
+  c.seq_jumps = odometry_reader_->seq_jumps() + observation_reader_->seq_jumps() + map_state_reader_->seq_jumps();
+  return c;
+}
+
+msg::OptimisedMap OptimizerNode::latest_map() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  return map_;
+}
+
+diagnostics::Snapshot OptimizerNode::diagnostics_snapshot() const {
+  const OptimizerNodeCounters c = counters();
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  const map_optimizer::OptimizerCounters o =
+      optimizer_ ? optimizer_->counters() : map_optimizer::OptimizerCounters{};
+  diagnostics::Snapshot s;
+  s.counters = {{"odometry_received", c.odometry_received, false},
+                {"observations_received", c.observations_received, false},
+                {"map_states_received", c.map_states_received, false},
+                {"malformed", c.malformed, true},
+                {"seq_jumps", c.seq_jumps, true},
+                {"samples_late", queue_.counters().late, true},
+                {"odometry_dropped", o.odometry_dropped, true},
+                {"frames_dropped", o.frames_dropped, true},
+                {"observations_invalid", o.observations_invalid, true},
+                {"keyframes", o.keyframes, false},
+                {"observations", o.observations, false},
+                {"window_solves", c.window_solves, false},
+                {"whole_solves", c.whole_solves, false},
+                {"maps_published", c.maps_published, false}};
+  return s;
+}
+
+void OptimizerNode::loop() {
+  using Clock = std::chrono::steady_clock;
+  cpu_start_s_ = thread_cpu_seconds();
+  auto next_status = Clock::now() + std::chrono::duration<double>(options_.status_period_s);
+  std::deque<Inbox> batch;
+  for (;;) {
+    bool stopping = false;
+    {
+      std::unique_lock<std::mutex> lock(inbox_mutex_);
+      double wait_s = 0.1;
+      {
+        std::lock_guard<std::mutex> state_lock(state_mutex_);
+        if (has_epoch_ && queue_.size() > 0) {
+          const double now_s = seconds_since(dds::now_ns(), epoch_ns_);
+          wait_s = std::clamp(queue_.next_release_s() - now_s, 0.0, 0.1);
+        }
+      }
+      inbox_cv_.wait_for(lock, std::chrono::duration<double>(wait_s), [this] { return !inbox_.empty() || stopping_; });
+      batch.swap(inbox_);
+      stopping = stopping_;
+    }
+    std::vector<slam::SensorInput> ready;
+    {
+      std::lock_guard<std::mutex> state_lock(state_mutex_);
+      for (const Inbox& item : batch) {
+        const std::uint64_t stamp = std::visit([](const auto& m) { return m.header().stamp_ns(); }, item);
+        if (!has_epoch_) {
+          epoch_ns_ = stamp;
+          has_epoch_ = true;
+        }
+        const double arrival_s = seconds_since(dds::now_ns(), epoch_ns_);
+        if (const auto* odometry = std::get_if<msg::Odometry>(&item)) {
+          queue_.push(slam_node::to_odometry_input(*odometry, epoch_ns_), arrival_s);
+        } else {
+          queue_.push(slam_node::to_observation_input(std::get<msg::LandmarkObservation>(item), epoch_ns_,
+                                                      options_.use_detection_sigmas),
+                      arrival_s);
+        }
+      }
+      batch.clear();
+      if (has_epoch_) ready = stopping ? queue_.pop_all() : queue_.pop_ready(seconds_since(dds::now_ns(), epoch_ns_));
+    }
+    for (const slam::SensorInput& input : ready) step(input);
+    if (stopping) {
+      std::lock_guard<std::mutex> state_lock(state_mutex_);
+      if (optimizer_ && dirty_) solve(true);
+    }
+    if (options_.status_period_s > 0.0 && Clock::now() >= next_status) {
+      log_status();
+      next_status = Clock::now() + std::chrono::duration<double>(options_.status_period_s);
+    }
+    if (stopping) break;
+  }
+  log_status();
+}
+
+void OptimizerNode::step(const slam::SensorInput& input) {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  const double t = slam::input_time(input);
+  if (!optimizer_) {
+    optimizer_ = std::make_unique<map_optimizer::MapOptimizer>(options_.optimizer, options_.initial_pose, t);
+    next_window_s_ = t + options_.window_period_s;
+    next_whole_s_ = t + options_.whole_period_s;
+  }
+  {
+    std::lock_guard<std::mutex> filter_lock(filter_mutex_);
+    for (const auto& [id, position] : filter_landmarks_) optimizer_->set_landmark_guess(id, position);
+  }
+  if (const auto* odometry = std::get_if<slam::OdometryInput>(&input)) {
+    optimizer_->add_odometry(odometry->sample);
+    last_odometry_seq_ = odometry->seq;
+  } else {
+    const auto& observation = std::get<slam::ObservationInput>(input);
+    std::optional<slam::Pose2> guess;
+    {
+      const std::uint64_t stamp = slam_node::to_stamp_ns(observation.frame.t_s, epoch_ns_);
+      std::lock_guard<std::mutex> filter_lock(filter_mutex_);
+      const auto it = std::find_if(filter_poses_.rbegin(), filter_poses_.rend(),
+                                   [stamp](const auto& p) { return p.first == stamp; });
+      if (it != filter_poses_.rend()) {
+        guess = it->second;
+        ++counters_.guesses_from_filter;
+      }
+    }
+    optimizer_->add_frame(observation.frame, guess);
+    last_observation_seq_ = observation.seq;
+  }
+  last_t_s_ = std::max(last_t_s_, t);
+  dirty_ = true;
+  if (t >= next_whole_s_) {
+    solve(true);
+    next_whole_s_ = t + options_.whole_period_s;
+    next_window_s_ = t + options_.window_period_s;
+  } else if (t >= next_window_s_) {
+    solve(false);
+    next_window_s_ = t + options_.window_period_s;
+  }
+}
+
+void OptimizerNode::solve(bool whole) {
+  const map_optimizer::SolveSummary s =
+      whole ? optimizer_->solve() : optimizer_->solve(options_.window_keyframes);
+  if (whole) {
+    optimizer_->compute_landmark_covariances();
+    ++counters_.whole_solves;
+  } else {
+    ++counters_.window_solves;
+  }
+  counters_.solve_time_s += s.solve_time_s;
+  counters_.cpu_time_s = thread_cpu_seconds() - cpu_start_s_;
+  dirty_ = false;
+  publish(s, whole);
+}
+
+void OptimizerNode::publish(const map_optimizer::SolveSummary& s, bool whole) {
+  msg::OptimisedMap& m = map_;
+  m.header().stamp_ns(slam_node::to_stamp_ns(last_t_s_, epoch_ns_));
+  m.header().frame_id("map");
+  m.current_pose(to_msg(optimizer_->current_pose()));
+  const std::vector<map_optimizer::Keyframe>& keyframes = optimizer_->keyframes();
+  m.keyframe_count(static_cast<std::uint32_t>(keyframes.size()));
+  // All keyframes, or an even stride ending at the newest.
+  const std::size_t n = keyframes.size();
+  const std::size_t limit = static_cast<std::size_t>(options_.published_keyframes);
+  const std::size_t stride = n <= limit ? 1 : (n + limit - 2) / (limit - 1);
+  std::vector<msg::OptimisedKeyframe>& out = m.keyframes();
+  out.clear();
+  for (std::size_t i = (n - 1) % stride; i < n; i += stride) {
+    msg::OptimisedKeyframe k;
+    k.stamp_ns(slam_node::to_stamp_ns(keyframes[i].t_s, epoch_ns_));
+    k.pose(to_msg(keyframes[i].pose));
+    out.push_back(k);
+  }
+  std::vector<msg::OptimisedLandmark>& landmarks = m.landmarks();
+  landmarks.clear();
+  for (const map_optimizer::LandmarkSolution& l : optimizer_->landmarks()) {
+    msg::OptimisedLandmark o;
+    o.landmark_id(l.id);
+    o.x_m(l.mean.x());
+    o.y_m(l.mean.y());
+    o.cov_xx_m2(l.cov(0, 0));
+    o.cov_xy_m2(l.cov(0, 1));
+    o.cov_yy_m2(l.cov(1, 1));
+    o.observations(static_cast<std::uint32_t>(l.observations));
+    landmarks.push_back(o);
+  }
+  m.whole_problem(whole);
+  m.converged(s.converged);
+  m.iterations(static_cast<std::uint32_t>(s.iterations));
+  m.initial_cost(s.initial_cost);
+  m.final_cost(s.final_cost);
+  m.solve_time_s(s.solve_time_s);
+  m.cpu_time_s(counters_.cpu_time_s);
+  m.keyframes_free(static_cast<std::uint32_t>(s.keyframes_free));
+  m.residuals(static_cast<std::uint32_t>(s.residuals));
+  m.odometry_sequence(last_odometry_seq_);
+  m.observation_sequence(last_observation_seq_);
+  if (writer_->publish(m)) ++counters_.maps_published;
+}
+
+void OptimizerNode::log_status() const {
+  const OptimizerNodeCounters c = counters();
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  const map_optimizer::OptimizerCounters o =
+      optimizer_ ? optimizer_->counters() : map_optimizer::OptimizerCounters{};
+  std::fprintf(stderr,
+               "map_optimizer: odometry %llu, observations %llu, map states %llu, malformed %llu; keyframes %zu, "
+               "factors from %zu observations (%zu invalid); solves %llu window / %llu whole, published %llu; "
+               "CPU %.2f s (Ceres %.2f s)\n",
+               static_cast<unsigned long long>(c.odometry_received),
+               static_cast<unsigned long long>(c.observations_received),
+               static_cast<unsigned long long>(c.map_states_received), static_cast<unsigned long long>(c.malformed),
+               o.keyframes, o.observations, o.observations_invalid, static_cast<unsigned long long>(c.window_solves),
+               static_cast<unsigned long long>(c.whole_solves), static_cast<unsigned long long>(c.maps_published),
+               c.cpu_time_s, c.solve_time_s);
+}
+
+}  // namespace pixyslam::map_optimizer_node
