@@ -105,11 +105,11 @@ fi
 if [[ $runner == podman ]]; then
   assignment="    robot:     {address: 10.200.$net.1, processes: [encoder_bridge, pixy_bridge, robot_sim]}
     estimator: {address: 10.200.$net.2, processes: [slam_estimator]}
-    logger:    {address: 10.200.$net.3, processes: [logger, evaluator, log_check]}
+    logger:    {address: 10.200.$net.3, processes: [logger, evaluator, map_optimizer, log_check]}
     viewer:    {address: 10.200.$net.4, processes: [map_view, final_map]}"
 else
   assignment="    robot:  {address: 10.200.$net.1, processes: [encoder_bridge, pixy_bridge, robot_sim]}
-    laptop: {address: 10.200.$net.2, processes: [logger, slam_estimator, evaluator, map_view, log_check, final_map]}
+    laptop: {address: 10.200.$net.2, processes: [logger, slam_estimator, map_optimizer, evaluator, map_view, log_check, final_map]}
     server: {address: 10.200.$net.3, processes: []}"
 fi
 cat > "$work/deploy.yaml" <<EOF

@@ -1,0 +1,140 @@
+// Map optimiser cost over a whole run, as the live process solves it: one
+// UTIAS MRCLAM robot (or the simulated world without --dataset) through the
+// filter, then the optimiser fed the same input in order with the live
+// schedule (the newest window every --window-period s of data, the whole
+// problem every --whole-period s, and once at the end).
+//   bench_map_optimizer --dataset DIR --robot N --config FILE
+//                       [--window-period S] [--window-keyframes K] [--whole-period S]
+//   bench_map_optimizer --config config/slam_sim.yaml        (the simulated world)
+// Prints the data time, the optimiser thread's CPU time in all and per minute
+// of data, the window and whole-problem solves (count, mean and max Ceres time),
+// and the filter's and the optimiser's ATE. Instruction counts:
+//   valgrind --tool=callgrind --toggle-collect='pixyslam::offline::optimise_run*' build/bin/bench_map_optimizer ...
+// Exit codes: 0 done, 77 dataset folder absent (SKIP), 2 bad arguments, 1 error.
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mrclam_dataset.h"
+#include "optimised_run.h"
+#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/sim/sim_world.h"
+#include "pixyslam/slam/slam_options_yaml.h"
+
+namespace {
+
+using namespace pixyslam;
+
+constexpr const char* kUsage =
+    "usage: bench_map_optimizer [--dataset DIR --robot N] --config FILE [--window-period S] [--window-keyframes K]\n"
+    "                           [--whole-period S]\n"
+    "  --dataset DIR --robot N   a MRCLAM robot (exit 77 when the folder is absent); without: the simulated\n"
+    "                            world of the config's world: section\n"
+    "  --config FILE             filter: (and mrclam: or world:) options\n"
+    "  --window-period S         data time between window solves, default 1 (as config/map_optimizer.yaml)\n"
+    "  --window-keyframes K      keyframes a window solve frees, default 100\n"
+    "  --whole-period S          data time between whole-problem solves, default 10\n";
+
+void print_solves(const char* label, const std::vector<map_optimizer::SolveSummary>& solves) {
+  double sum = 0.0, worst = 0.0;
+  for (const map_optimizer::SolveSummary& s : solves) {
+    sum += s.solve_time_s;
+    worst = std::max(worst, s.solve_time_s);
+  }
+  std::printf("%-14s %6zu solves, Ceres time %.3f s in all, mean %.4f s, max %.4f s\n", label, solves.size(), sum,
+              solves.empty() ? 0.0 : sum / static_cast<double>(solves.size()), worst);
+}
+
+int run(int argc, char** argv) {
+  std::map<std::string, std::string> args;
+  for (int i = 1; i < argc; ++i) {
+    const std::string key = argv[i];
+    if (key == "--help" || key == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+    static const char* known[] = {"--dataset", "--robot", "--config", "--window-period", "--window-keyframes",
+                                  "--whole-period"};
+    if (std::find(std::begin(known), std::end(known), key) == std::end(known)) {
+      throw std::invalid_argument("unknown argument '" + key + "'");
+    }
+    if (i + 1 >= argc) throw std::invalid_argument(key + " needs a value");
+    args[key.substr(2)] = argv[++i];
+  }
+  if (!args.count("config")) throw std::invalid_argument("missing --config");
+  if (args.count("dataset") != args.count("robot")) throw std::invalid_argument("--dataset and --robot go together");
+  const auto number = [&](const char* key, double fallback) {
+    if (!args.count(key)) return fallback;
+    std::size_t used = 0;
+    const double v = std::stod(args[key], &used);
+    if (used != args[key].size() || !(v >= 0.0)) throw std::invalid_argument(std::string("--") + key + ": not a number >= 0");
+    return v;
+  };
+  offline::OptimiseSchedule schedule;
+  schedule.window_period_s = number("window-period", 1.0);
+  schedule.window_keyframes = static_cast<std::size_t>(number("window-keyframes", 100.0));
+  schedule.whole_period_s = number("whole-period", 10.0);
+
+  config::YamlReader root = config::YamlReader::from_file(args["config"]);
+  config::YamlReader filter_yaml = root.child("filter");
+  const slam::FilterOptions options = slam::read_filter_options(filter_yaml);
+  offline::RunInput input;
+  if (args.count("dataset")) {
+    if (!std::filesystem::is_directory(args["dataset"])) {
+      std::printf("SKIP: dataset folder %s not found\n", args["dataset"].c_str());
+      return 77;
+    }
+    const offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
+    root.finish();
+    input = offline::mrclam_input(mrclam::load_robot(args["dataset"], std::stoi(args["robot"])), model);
+  } else {
+    config::YamlReader world_yaml = root.child("world");
+    const sim::WorldRun run = sim::simulate(sim::read_world_options(world_yaml));
+    root.finish();
+    input.initial_pose = run.initial_pose;
+    input.start_time_s = run.truth.front().t_s;
+    input.odometry = run.odometry;
+    input.frames = run.frames;
+    input.truth = run.truth;
+    for (const sim::Pole& p : run.poles) input.landmarks.push_back({p.id, p.x_m, p.y_m});
+  }
+  const offline::RunResult filter = offline::run_filter(options, input);
+  const offline::OptimisedRun opt = offline::optimise_run(options, input, filter, schedule);
+  const double data_s = filter.trajectory.empty() ? 0.0 : filter.trajectory.back().t_s - input.start_time_s;
+  std::printf("data %.1f s, %zu keyframes, %zu observation factors; schedule: window of %zu keyframes every %.1f s, "
+              "whole problem every %.1f s\n",
+              data_s, opt.counters.keyframes, opt.counters.observations, schedule.window_keyframes,
+              schedule.window_period_s, schedule.whole_period_s);
+  std::printf("optimiser CPU %.3f s in all, %.3f s per minute of data (%.2f %% of one core); filter CPU %.3f s\n",
+              opt.result.cpu_time_s, data_s > 0.0 ? 60.0 * opt.result.cpu_time_s / data_s : 0.0,
+              data_s > 0.0 ? 100.0 * opt.result.cpu_time_s / data_s : 0.0, filter.cpu_time_s);
+  print_solves("window", opt.window_solves);
+  print_solves("whole", opt.whole_solves);
+  print_solves("final whole", {opt.solve});
+  const offline::Report f = offline::evaluate(input, filter);
+  const offline::Report o = offline::evaluate(input, opt.result);
+  if (f.has_truth) {
+    std::printf("ATE: filter %.3f m, optimiser %.3f m; landmarks: filter %.3f m, optimiser %.3f m\n", f.filter.ate_rmse_m,
+                o.filter.ate_rmse_m, f.landmarks.rmse_m, o.landmarks.rmse_m);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "bench_map_optimizer: %s\n%s", e.what(), kUsage);
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_map_optimizer: %s\n", e.what());
+    return 1;
+  }
+}
