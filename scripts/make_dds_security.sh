@@ -23,7 +23,7 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 if [[ ${#names[@]} -eq 0 ]]; then
-  names=(encoder_bridge pixy_bridge slam_estimator logger robot_sim sim_evaluator map_view
+  names=(encoder_bridge pixy_bridge slam_estimator map_optimizer logger robot_sim sim_evaluator map_view
          pixyslam_play pixyslam_spy pixyslam_launch)
 fi
 [[ $domains =~ ^([0-9]+)-([0-9]+)$ ]] || { echo "--domains must be MIN-MAX, got '$domains'" >&2; exit 2; }

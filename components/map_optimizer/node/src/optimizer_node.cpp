@@ -12,6 +12,7 @@ namespace {
 
 // The filter's poses kept for keyframe guesses: a few seconds of MapStates.
 constexpr std::size_t kFilterPosesKept = 2048;
+constexpr std::uint64_t kStampToleranceNs = 1000;
 
 double thread_cpu_seconds() {
   timespec t{};
@@ -211,8 +212,10 @@ void OptimizerNode::step(const slam::SensorInput& input) {
     {
       const std::uint64_t stamp = slam_node::to_stamp_ns(observation.frame.t_s, epoch_ns_);
       std::lock_guard<std::mutex> filter_lock(filter_mutex_);
-      const auto it = std::find_if(filter_poses_.rbegin(), filter_poses_.rend(),
-                                   [stamp](const auto& p) { return p.first == stamp; });
+      // The same stamp, up to the rounding of the two processes' time bases.
+      const auto it = std::find_if(filter_poses_.rbegin(), filter_poses_.rend(), [stamp](const auto& p) {
+        return (p.first > stamp ? p.first - stamp : stamp - p.first) <= kStampToleranceNs;
+      });
       if (it != filter_poses_.rend()) {
         guess = it->second;
         ++counters_.guesses_from_filter;
@@ -301,12 +304,13 @@ void OptimizerNode::log_status() const {
       optimizer_ ? optimizer_->counters() : map_optimizer::OptimizerCounters{};
   std::fprintf(stderr,
                "map_optimizer: odometry %llu, observations %llu, map states %llu, malformed %llu; keyframes %zu, "
-               "factors from %zu observations (%zu invalid); solves %llu window / %llu whole, published %llu; "
-               "CPU %.2f s (Ceres %.2f s)\n",
+               "factors from %zu observations (%zu invalid), %llu keyframes started at the filter's pose; solves %llu "
+               "window / %llu whole, published %llu; CPU %.2f s (Ceres %.2f s)\n",
                static_cast<unsigned long long>(c.odometry_received),
                static_cast<unsigned long long>(c.observations_received),
                static_cast<unsigned long long>(c.map_states_received), static_cast<unsigned long long>(c.malformed),
-               o.keyframes, o.observations, o.observations_invalid, static_cast<unsigned long long>(c.window_solves),
+               o.keyframes, o.observations, o.observations_invalid,
+               static_cast<unsigned long long>(c.guesses_from_filter), static_cast<unsigned long long>(c.window_solves),
                static_cast<unsigned long long>(c.whole_solves), static_cast<unsigned long long>(c.maps_published),
                c.cpu_time_s, c.solve_time_s);
 }
