@@ -1,0 +1,227 @@
+// The map_optimizer process's node beside the estimator's, both fed over DDS
+// (loopback profile) with the simulated world by writers in this test: the
+// OptimisedMap arrives, its landmarks are at most as far from the truth as the
+// filter's, keyframes start from the filter's poses, and bytes that do not
+// decode are counted and dropped.
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/eval/trajectory_metrics.h"
+#include "pixyslam/map_optimizer_node/optimizer_node.h"
+#include "pixyslam/sim/sim_world.h"
+#include "pixyslam/slam_node/estimator_node.h"
+#include "pixyslam/slam_node/map_state_conversions.h"
+#include "raw_sample_writer.h"
+#include "sim_sensor_messages.h"
+
+namespace pixyslam::map_optimizer_node {
+namespace {
+
+const std::string kConfigDir = PIXYSLAM_CONFIG_DIR;
+
+OptimizerNodeOptions test_options() {
+  OptimizerNodeOptions o = read_optimizer_node_options_file(kConfigDir + "/map_optimizer.yaml");
+  o.status_period_s = 0.0;
+  o.dds.robot_id = "test_robot";
+  return o;
+}
+
+// Waits up to 20 s for the node's malformed-sample count to reach `target`.
+bool wait_for_malformed(const OptimizerNode& node, std::uint64_t target) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (node.counters().malformed < target && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return node.counters().malformed >= target;
+}
+
+TEST(OptimizerNode, OptimisesBesideTheEstimatorFromDdsInput) {
+  sim::WorldOptions world;
+  world.duration_s = 60.0;
+  world.camera_rate_hz = 10.0;
+  world.max_range_m = 4.0;
+  const sim::WorldRun run = sim::simulate(world);
+  const std::uint64_t base_ns = dds::now_ns();
+
+  slam_node::EstimatorOptions estimator_options =
+      slam_node::read_estimator_options_file(kConfigDir + "/slam_estimator.yaml");
+  estimator_options.status_period_s = 0.0;
+  estimator_options.initial_pose = run.initial_pose;
+  slam_node::EstimatorNode estimator(estimator_options);
+  estimator.start();
+  OptimizerNodeOptions options = test_options();
+  options.initial_pose = run.initial_pose;
+  OptimizerNode node(options);
+  node.start();
+
+  dds::Participant sensors(options.dds, "test_sensors");
+  dds::Writer<msg::Odometry> odometry_writer(sensors);
+  dds::Writer<msg::LandmarkObservation> observation_writer(sensors);
+  std::mutex mutex;
+  std::vector<msg::OptimisedMap> maps;
+  dds::Reader<msg::OptimisedMap> map_reader(sensors, [&](const msg::OptimisedMap& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    maps.push_back(m);
+  });
+  ASSERT_TRUE(odometry_writer.wait_for_readers(2, std::chrono::seconds(10)));
+  ASSERT_TRUE(observation_writer.wait_for_readers(2, std::chrono::seconds(10)));
+
+  // In stamp order, paced (the estimator answers every message with a MapState).
+  std::size_t o = 0, f = 0;
+  const double period = run.odometry[1].t_s - run.odometry[0].t_s;
+  while (o < run.odometry.size() || f < run.frames.size()) {
+    if (f == run.frames.size() || (o < run.odometry.size() && run.odometry[o].t_s + period <= run.frames[f].t_s)) {
+      const slam::OdometrySample& s = run.odometry[o++];
+      msg::Odometry m = test_support::odometry_msg(s, period, slam_node::to_stamp_ns(s.t_s, base_ns));
+      ASSERT_TRUE(odometry_writer.publish(m));
+    } else {
+      const slam::ObservationFrame& frame = run.frames[f++];
+      msg::LandmarkObservation m =
+          test_support::observation_msg(frame, slam_node::to_stamp_ns(frame.t_s, base_ns));
+      ASSERT_TRUE(observation_writer.publish(m));
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(1500));
+  }
+  ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(observation_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  estimator.stop();
+  node.stop();
+
+  const OptimizerNodeCounters c = node.counters();
+  EXPECT_EQ(c.odometry_received, run.odometry.size());
+  EXPECT_EQ(c.observations_received, run.frames.size());
+  EXPECT_GT(c.map_states_received, 0u);
+  EXPECT_GT(c.guesses_from_filter, 0u);  // keyframes started at the filter's pose
+  EXPECT_GE(c.whole_solves, 6u);         // every 10 s of data and at the end
+  EXPECT_GT(c.window_solves, 30u);
+  EXPECT_GT(c.cpu_time_s, 0.0);
+  EXPECT_EQ(c.malformed, 0u);
+
+  // The final solution: every landmark seen, at most as far from the truth as the filter's.
+  const msg::OptimisedMap last = node.latest_map();
+  EXPECT_TRUE(last.whole_problem());
+  EXPECT_EQ(last.odometry_sequence(), run.odometry.size());
+  EXPECT_EQ(last.observation_sequence(), run.frames.size());
+  EXPECT_GT(last.keyframe_count(), 60u);
+  EXPECT_EQ(last.keyframes().size(), last.keyframe_count());
+  std::set<int> seen;
+  for (const slam::ObservationFrame& frame : run.frames) {
+    for (const slam::RangeBearing& rb : frame.detections) seen.insert(rb.landmark_id);
+  }
+  ASSERT_EQ(last.landmarks().size(), seen.size());
+  std::vector<eval::LandmarkPoint> truth, optimised, filtered;
+  for (const sim::Pole& p : run.poles) truth.push_back({p.id, p.x_m, p.y_m});
+  for (const msg::OptimisedLandmark& l : last.landmarks()) {
+    optimised.push_back({l.landmark_id(), l.x_m(), l.y_m()});
+    EXPECT_TRUE(std::isfinite(l.cov_xx_m2()) && l.cov_xx_m2() > 0.0) << l.landmark_id();
+    EXPECT_GT(l.observations(), 0u);
+  }
+  for (const msg::LandmarkEstimate& l : estimator.latest_map_state().landmarks()) {
+    filtered.push_back({l.landmark_id(), l.x_m(), l.y_m()});
+  }
+  const eval::LandmarkErrors opt = eval::compare_landmarks(optimised, truth);
+  const eval::LandmarkErrors fil = eval::compare_landmarks(filtered, truth);
+  std::printf("landmark RMSE: filter %.3f m, map optimiser %.3f m (%zu matched)\n", fil.rmse_m, opt.rmse_m,
+              opt.matched);
+  EXPECT_EQ(opt.matched, seen.size());
+  EXPECT_LE(opt.rmse_m, fil.rmse_m);
+  std::vector<eval::TimedPose> keyframes;
+  for (const msg::OptimisedKeyframe& k : last.keyframes()) {
+    keyframes.push_back({static_cast<double>(k.stamp_ns() - base_ns) * 1e-9, k.pose().x_m(), k.pose().y_m(),
+                         k.pose().theta_rad()});
+  }
+  EXPECT_LT(eval::compare_trajectory(keyframes, run.truth).ate_rmse_m, 0.15);
+
+  // What went out on the topic: one map per solve, in order, none lost.
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  std::lock_guard<std::mutex> lock(mutex);
+  ASSERT_FALSE(maps.empty());
+  EXPECT_EQ(maps.back().header().seq(), c.maps_published);
+  EXPECT_EQ(c.maps_published, c.whole_solves + c.window_solves);
+  EXPECT_EQ(map_reader.lost(), 0u);
+}
+
+// Any participant can send any bytes: what does not decode is counted and dropped.
+TEST(OptimizerNode, MalformedSamplesAreCountedAndTheOptimiserGoesOn) {
+  OptimizerNodeOptions options = test_options();
+  options.initial_pose = slam::Pose2::Zero();
+  OptimizerNode node(options);
+  node.start();
+  dds::Participant hostile(options.dds, "test_hostile");
+  test_support::RawSampleWriter<msg::Odometry> bad_odometry(hostile);
+  test_support::RawSampleWriter<msg::MapState> bad_maps(hostile);
+  dds::Participant sensors(options.dds, "test_sensors");
+  dds::Writer<msg::Odometry> odometry_writer(sensors);
+  ASSERT_TRUE(bad_odometry.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(bad_maps.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
+
+  const std::uint64_t base_ns = dds::now_ns();
+  slam::OdometrySample good;
+  good.v_mps = 0.1;
+  const auto bad_o = test_support::malformed_payloads(
+      test_support::wire_bytes(test_support::odometry_msg(good, 0.1, base_ns)));
+  const auto bad_m = test_support::malformed_payloads(test_support::wire_bytes(msg::MapState()));
+  for (const auto& b : bad_o) ASSERT_TRUE(bad_odometry.write(b));
+  for (const auto& b : bad_m) ASSERT_TRUE(bad_maps.write(b));
+  for (int i = 0; i < 30; ++i) {
+    good.t_s = 0.1 * i;
+    msg::Odometry m = test_support::odometry_msg(good, 0.1, slam_node::to_stamp_ns(good.t_s, base_ns));
+    ASSERT_TRUE(odometry_writer.publish(m));
+  }
+  ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+  EXPECT_TRUE(wait_for_malformed(node, bad_o.size() + bad_m.size()));
+  node.stop();
+  const OptimizerNodeCounters c = node.counters();
+  EXPECT_EQ(c.odometry_received, 30u);
+  EXPECT_EQ(c.malformed, bad_o.size() + bad_m.size());
+  // Three seconds of odometry: window solves went on, and the final whole one.
+  EXPECT_GE(c.window_solves, 2u);
+  EXPECT_EQ(c.whole_solves, 1u);
+  const msg::OptimisedMap last = node.latest_map();
+  EXPECT_NEAR(last.current_pose().x_m(), 0.29, 0.02);  // 2.9 s at 0.1 m/s from the origin
+}
+
+TEST(OptimizerNodeOptions, ShippedConfigTakesTheEstimatorsModels) {
+  const OptimizerNodeOptions o = test_options();
+  const slam_node::EstimatorOptions e = slam_node::read_estimator_options_file(kConfigDir + "/slam_estimator.yaml");
+  EXPECT_EQ(o.optimizer.motion.w_sigma_rad_per_sqrt_s, e.filter.motion.w_sigma_rad_per_sqrt_s);
+  EXPECT_EQ(o.optimizer.bearing_sigma_rad, e.filter.bearing_sigma_rad);
+  EXPECT_EQ(o.initial_pose, e.initial_pose);
+  EXPECT_EQ(o.dds.domain_id, e.dds.domain_id);
+  EXPECT_EQ(o.window_keyframes, 100u);
+}
+
+TEST(OptimizerNodeOptions, ErrorsNameTheFileAndKey) {
+  const std::string dir = ::testing::TempDir();
+  const auto expect_error = [&](const std::string& text, const std::string& needle) {
+    const std::string path = dir + "/map_optimizer_test.yaml";
+    FILE* f = std::fopen(path.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs(text.c_str(), f);
+    std::fclose(f);
+    try {
+      read_optimizer_node_options_file(path);
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const config::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  const std::string estimator = "filter_config: " + kConfigDir + "/slam_estimator.yaml\n";
+  expect_error(estimator + "optimizer:\n  window_period_s: -1\n", "window_period_s");
+  expect_error(estimator + "optimizer:\n  windwo_keyframes: 5\n", "windwo_keyframes");
+  expect_error("filter_config: no_such_file.yaml\noptimizer: {}\n", "no_such_file.yaml");
+  expect_error(estimator, "optimizer");  // the section is required
+}
+
+}  // namespace
+}  // namespace pixyslam::map_optimizer_node
