@@ -23,4 +23,11 @@ BENCHMARK(BM_Frame)
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// BENCHMARK_MAIN, with an unknown flag a usage error (exit 2) as in every program here.
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

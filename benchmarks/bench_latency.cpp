@@ -16,6 +16,7 @@
 
 #include "pixyslam/sim/sim_world.h"
 #include "pixyslam/app/command_line.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/dds/endpoints.h"
 #include "process_group.h"
@@ -138,10 +139,6 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   pixyslam::app::StopSignal::install();
-  try {
-    return pixyslam::bench::run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_latency: %s\n", e.what());
-    return 1;
-  }
+  // A bad flag or config exits 2, any other error 1 (as every program here).
+  return pixyslam::app::run_main("bench_latency", [&] { return pixyslam::bench::run(argc, argv); });
 }

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "pixyslam/app/command_line.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/log_tool/sequence_check.h"
@@ -175,10 +176,6 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   pixyslam::app::StopSignal::install();
-  try {
-    return pixyslam::bench::run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_logger_throughput: %s\n", e.what());
-    return 1;
-  }
+  // A bad flag or config exits 2, any other error 1 (as every program here).
+  return pixyslam::app::run_main("bench_logger_throughput", [&] { return pixyslam::bench::run(argc, argv); });
 }

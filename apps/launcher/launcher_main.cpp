@@ -231,10 +231,13 @@ int main(int argc, char** argv) {
   signal(SIGPIPE, SIG_IGN);
   try {
     if (argc < 2 || argv[1][0] == '-') {
-      std::fprintf(stderr,
+      // --help: the usage on stdout, exit 0; no launch file or an unknown flag first: stderr, 2.
+      const bool help = argc >= 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h");
+      if (!help && argc >= 2) std::fprintf(stderr, "pixyslam_launch: unknown argument '%s'\n", argv[1]);
+      std::fprintf(help ? stdout : stderr,
                    "usage: pixyslam_launch LAUNCH.yaml [--run-dir DIR] [--duration S] [--input FILE]\n"
                    "                       [--deployment DEPLOY.yaml --host NAME]\n");
-      return argc < 2 ? 2 : 0;
+      return help ? 0 : 2;
     }
     // The launch file is positional; the rest are flags.
     std::vector<char*> flags{argv[0]};

@@ -14,18 +14,18 @@ CommandLine::CommandLine(int argc, char** argv, const std::set<std::string>& kno
       continue;
     }
     if (flag.rfind("--", 0) != 0 || known_flags.count(flag.substr(2)) == 0) {
-      throw std::invalid_argument("unknown argument '" + flag + "'");
+      throw UsageError("unknown argument '" + flag + "'");
     }
-    if (i + 1 >= argc) throw std::invalid_argument(flag + " needs a value");
+    if (i + 1 >= argc) throw UsageError(flag + " needs a value");
     if (!values_.emplace(flag.substr(2), argv[++i]).second) {
-      throw std::invalid_argument(flag + " given twice");
+      throw UsageError(flag + " given twice");
     }
   }
 }
 
 const std::string& CommandLine::get(const std::string& flag) const {
   auto it = values_.find(flag);
-  if (it == values_.end()) throw std::invalid_argument("missing --" + flag);
+  if (it == values_.end()) throw UsageError("missing --" + flag);
   return it->second;
 }
 
@@ -40,7 +40,7 @@ double CommandLine::number(const std::string& flag, double fallback) const {
   char* end = nullptr;
   const double v = std::strtod(it->second.c_str(), &end);
   if (it->second.empty() || *end != '\0') {
-    throw std::invalid_argument("--" + flag + ": not a number: '" + it->second + "'");
+    throw UsageError("--" + flag + ": not a number: '" + it->second + "'");
   }
   return v;
 }

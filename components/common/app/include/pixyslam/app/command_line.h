@@ -3,14 +3,22 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace pixyslam::app {
 
+// A command-line mistake (unknown or repeated flag, missing value, not a
+// number): run_main() exits with 2, as for a config error.
+class UsageError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
 // `--key value` flags of a process. Unknown flags, a flag without its value and
-// a repeated flag are errors (std::invalid_argument naming the flag); `--help`
-// and `-h` set help(). Thread-compatible.
+// a repeated flag are errors (UsageError naming the flag); `--help` and `-h`
+// set help(). Thread-compatible.
 class CommandLine {
  public:
   CommandLine(int argc, char** argv, const std::set<std::string>& known_flags);

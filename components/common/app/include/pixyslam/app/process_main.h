@@ -14,12 +14,16 @@ namespace pixyslam::app {
 
 // Runs a process's `body` (which returns the exit status) and turns an
 // exception escaping it into an exit status and one line on stderr:
+//   app::UsageError     -> 2, "<name>: <what> (see --help)"
 //   config::ConfigError -> 2, "<name>: config error: <what>"
 //   std::exception      -> 1, "<name>: <what>"
 template <class Body>
 int run_main(const char* name, const Body& body) {
   try {
     return body();
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "%s: %s (see --help)\n", name, e.what());
+    return 2;
   } catch (const config::ConfigError& e) {
     std::fprintf(stderr, "%s: config error: %s\n", name, e.what());
     return 2;
