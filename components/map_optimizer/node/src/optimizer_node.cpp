@@ -20,10 +20,6 @@ double thread_cpu_seconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-double seconds_since(std::uint64_t stamp_ns, std::uint64_t epoch_ns) {
-  return static_cast<double>(static_cast<std::int64_t>(stamp_ns - epoch_ns)) * 1e-9;
-}
-
 msg::Pose2D to_msg(const slam::Pose2& p) {
   msg::Pose2D out;
   out.x_m(p.x());
@@ -34,14 +30,15 @@ msg::Pose2D to_msg(const slam::Pose2& p) {
 
 }  // namespace
 
-OptimizerNode::OptimizerNode(const OptimizerNodeOptions& options) : options_(options), queue_(options.queue) {
+OptimizerNode::OptimizerNode(const OptimizerNodeOptions& options)
+    : options_(options), inbox_(options.queue, options.use_detection_sigmas) {
   map_optimizer::validate(options_.optimizer);
   participant_ = std::make_unique<dds::Participant>(options_.dds, "map_optimizer");
   writer_ = std::make_unique<dds::Writer<msg::OptimisedMap>>(*participant_);
   odometry_reader_ = std::make_unique<dds::Reader<msg::Odometry>>(
-      *participant_, [this](const msg::Odometry& m) { enqueue(m); });
+      *participant_, [this](const msg::Odometry& m) { inbox_.push(m); });
   observation_reader_ = std::make_unique<dds::Reader<msg::LandmarkObservation>>(
-      *participant_, [this](const msg::LandmarkObservation& m) { enqueue(m); });
+      *participant_, [this](const msg::LandmarkObservation& m) { inbox_.push(m); });
   map_state_reader_ = std::make_unique<dds::Reader<msg::MapState>>(
       *participant_, [this](const msg::MapState& m) { on_map_state(m); });
   diagnostics_ = std::make_unique<diagnostics::DiagnosticsPublisher>(
@@ -59,28 +56,20 @@ OptimizerNode::~OptimizerNode() {
 }
 
 void OptimizerNode::start() {
-  std::lock_guard<std::mutex> lock(inbox_mutex_);
+  std::lock_guard<std::mutex> lock(run_mutex_);
   if (thread_.joinable() || stopping_) return;
   thread_ = std::thread([this] { loop(); });
 }
 
 void OptimizerNode::stop() {
   {
-    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    std::lock_guard<std::mutex> lock(run_mutex_);
     stopping_ = true;
   }
-  inbox_cv_.notify_all();
+  inbox_.stop();
   if (!thread_.joinable()) return;
   thread_.join();
   diagnostics_->stop();
-}
-
-void OptimizerNode::enqueue(Inbox&& item) {
-  {
-    std::lock_guard<std::mutex> lock(inbox_mutex_);
-    inbox_.push_back(std::move(item));
-  }
-  inbox_cv_.notify_one();
 }
 
 void OptimizerNode::on_map_state(const msg::MapState& m) {
@@ -123,7 +112,7 @@ diagnostics::Snapshot OptimizerNode::diagnostics_snapshot() const {
                 {"map_states_received", c.map_states_received, false},
                 {"malformed", c.malformed, true},
                 {"seq_jumps", c.seq_jumps, true},
-                {"samples_late", queue_.counters().late, true},
+                {"samples_late", inbox_.queue_counters().late, true},
                 {"odometry_dropped", o.odometry_dropped, true},
                 {"frames_dropped", o.frames_dropped, true},
                 {"observations_invalid", o.observations_invalid, true},
@@ -139,45 +128,10 @@ void OptimizerNode::loop() {
   using Clock = std::chrono::steady_clock;
   cpu_start_s_ = thread_cpu_seconds();
   auto next_status = Clock::now() + std::chrono::duration<double>(options_.status_period_s);
-  std::deque<Inbox> batch;
   for (;;) {
-    bool stopping = false;
-    {
-      std::unique_lock<std::mutex> lock(inbox_mutex_);
-      double wait_s = 0.1;
-      {
-        std::lock_guard<std::mutex> state_lock(state_mutex_);
-        if (has_epoch_ && queue_.size() > 0) {
-          const double now_s = seconds_since(dds::now_ns(), epoch_ns_);
-          wait_s = std::clamp(queue_.next_release_s() - now_s, 0.0, 0.1);
-        }
-      }
-      inbox_cv_.wait_for(lock, std::chrono::duration<double>(wait_s), [this] { return !inbox_.empty() || stopping_; });
-      batch.swap(inbox_);
-      stopping = stopping_;
-    }
-    std::vector<slam::SensorInput> ready;
-    {
-      std::lock_guard<std::mutex> state_lock(state_mutex_);
-      for (const Inbox& item : batch) {
-        const std::uint64_t stamp = std::visit([](const auto& m) { return m.header().stamp_ns(); }, item);
-        if (!has_epoch_) {
-          epoch_ns_ = stamp;
-          has_epoch_ = true;
-        }
-        const double arrival_s = seconds_since(dds::now_ns(), epoch_ns_);
-        if (const auto* odometry = std::get_if<msg::Odometry>(&item)) {
-          queue_.push(slam_node::to_odometry_input(*odometry, epoch_ns_), arrival_s);
-        } else {
-          queue_.push(slam_node::to_observation_input(std::get<msg::LandmarkObservation>(item), epoch_ns_,
-                                                      options_.use_detection_sigmas),
-                      arrival_s);
-        }
-      }
-      batch.clear();
-      if (has_epoch_) ready = stopping ? queue_.pop_all() : queue_.pop_ready(seconds_since(dds::now_ns(), epoch_ns_));
-    }
-    for (const slam::SensorInput& input : ready) step(input);
+    const slam_node::SensorInbox::Ready ready = inbox_.wait_ready();
+    const bool stopping = ready.stopping;
+    for (const slam::SensorInput& input : ready.inputs) step(input);
     if (stopping) {
       std::lock_guard<std::mutex> state_lock(state_mutex_);
       if (optimizer_ && dirty_) solve(true);
@@ -195,6 +149,7 @@ void OptimizerNode::step(const slam::SensorInput& input) {
   std::lock_guard<std::mutex> lock(state_mutex_);
   const double t = slam::input_time(input);
   if (!optimizer_) {
+    epoch_ns_ = inbox_.epoch_ns();
     optimizer_ = std::make_unique<map_optimizer::MapOptimizer>(options_.optimizer, options_.initial_pose, t);
     next_window_s_ = t + options_.window_period_s;
     next_whole_s_ = t + options_.whole_period_s;

@@ -11,7 +11,7 @@
 namespace pixyslam::slam_node {
 
 EstimatorNode::EstimatorNode(const EstimatorOptions& options)
-    : options_(options), queue_(options.queue) {
+    : options_(options), inbox_(options.queue, options.use_detection_sigmas) {
   slam::validate(options_.filter);
   if (!options_.checkpoint.file.empty()) {
     // A directory (or device, FIFO) can be neither read nor replaced by rename():
@@ -27,9 +27,9 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options)
   participant_ = std::make_unique<dds::Participant>(options_.dds, "slam_estimator");
   map_writer_ = std::make_unique<dds::Writer<msg::MapState>>(*participant_);
   odometry_reader_ = std::make_unique<dds::Reader<msg::Odometry>>(
-      *participant_, [this](const msg::Odometry& m) { enqueue(m); });
+      *participant_, [this](const msg::Odometry& m) { inbox_.push(m); });
   observation_reader_ = std::make_unique<dds::Reader<msg::LandmarkObservation>>(
-      *participant_, [this](const msg::LandmarkObservation& m) { enqueue(m); });
+      *participant_, [this](const msg::LandmarkObservation& m) { inbox_.push(m); });
   diagnostics_ = std::make_unique<diagnostics::DiagnosticsPublisher>(
       *participant_, "slam_estimator", options_.dds.diagnostics_period_s, [this] { return diagnostics_snapshot(); });
   const CheckpointOptions& k = options_.checkpoint;
@@ -57,17 +57,17 @@ EstimatorNode::~EstimatorNode() {
 }
 
 void EstimatorNode::start() {
-  std::lock_guard<std::mutex> lock(inbox_mutex_);
+  std::lock_guard<std::mutex> lock(run_mutex_);
   if (thread_.joinable() || stopping_) return;
   thread_ = std::thread([this] { filter_loop(); });
 }
 
 void EstimatorNode::stop() {
   {
-    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    std::lock_guard<std::mutex> lock(run_mutex_);
     stopping_ = true;
   }
-  inbox_cv_.notify_all();
+  inbox_.stop();
   if (!thread_.joinable()) return;
   thread_.join();
   {
@@ -110,14 +110,6 @@ diagnostics::Snapshot EstimatorNode::diagnostics_snapshot() const {
   return s;
 }
 
-void EstimatorNode::enqueue(Inbox&& item) {
-  {
-    std::lock_guard<std::mutex> lock(inbox_mutex_);
-    inbox_.push_back(std::move(item));
-  }
-  inbox_cv_.notify_one();
-}
-
 EstimatorCounters EstimatorNode::counters() const {
   std::lock_guard<std::mutex> lock(state_mutex_);
   EstimatorCounters c = counters_;
@@ -128,8 +120,9 @@ EstimatorCounters EstimatorNode::counters() const {
   c.odometry_malformed = odometry_reader_->malformed() + odometry_reader_->callback_errors();
   c.observations_malformed = observation_reader_->malformed() + observation_reader_->callback_errors();
   c.seq_jumps = odometry_reader_->seq_jumps() + observation_reader_->seq_jumps();
-  c.samples_late = queue_.counters().late;
-  c.samples_reordered = queue_.counters().reordered;
+  const slam::SensorQueueCounters q = inbox_.queue_counters();
+  c.samples_late = q.late;
+  c.samples_reordered = q.reordered;
   return c;
 }
 
@@ -146,58 +139,10 @@ std::vector<std::pair<std::uint64_t, slam::Pose2>> EstimatorNode::trajectory() c
 void EstimatorNode::filter_loop() {
   using Clock = std::chrono::steady_clock;
   auto next_status = Clock::now() + std::chrono::duration<double>(options_.status_period_s);
-  std::deque<Inbox> batch;
   for (;;) {
-    bool stopping = false;
-    {
-      std::unique_lock<std::mutex> lock(inbox_mutex_);
-      // Wake for new input, for a held sample's release time, or periodically.
-      double wait_s = 0.1;
-      {
-        std::lock_guard<std::mutex> state_lock(state_mutex_);
-        if (has_epoch_ && queue_.size() > 0) {
-          const double now_s = static_cast<double>(static_cast<std::int64_t>(dds::now_ns() - epoch_ns_)) * 1e-9;
-          wait_s = std::clamp(queue_.next_release_s() - now_s, 0.0, 0.1);
-        }
-      }
-      inbox_cv_.wait_for(lock, std::chrono::duration<double>(wait_s),
-                         [this] { return !inbox_.empty() || stopping_; });
-      batch.swap(inbox_);
-      stopping = stopping_;
-    }
-
-    std::vector<slam::SensorInput> ready;
-    {
-      std::lock_guard<std::mutex> state_lock(state_mutex_);
-      for (const Inbox& item : batch) {
-        const std::uint64_t stamp = std::visit([](const auto& m) { return m.header().stamp_ns(); }, item);
-        if (!has_epoch_) {
-          // Times are seconds since the first stamp (small doubles); a replay
-          // with every stamp shifted by one constant computes exactly the same.
-          epoch_ns_ = stamp;
-          has_epoch_ = true;
-        }
-        const double arrival_s =
-            static_cast<double>(static_cast<std::int64_t>(dds::now_ns() - epoch_ns_)) * 1e-9;
-        if (const auto* odometry = std::get_if<msg::Odometry>(&item)) {
-          queue_.push(to_odometry_input(*odometry, epoch_ns_), arrival_s);
-        } else {
-          queue_.push(to_observation_input(std::get<msg::LandmarkObservation>(item), epoch_ns_,
-                                           options_.use_detection_sigmas),
-                      arrival_s);
-        }
-      }
-      batch.clear();
-      if (has_epoch_) {
-        if (stopping) {
-          ready = queue_.pop_all();
-        } else {
-          const double now_s = static_cast<double>(static_cast<std::int64_t>(dds::now_ns() - epoch_ns_)) * 1e-9;
-          ready = queue_.pop_ready(now_s);
-        }
-      }
-    }
-    for (const slam::SensorInput& input : ready) step(input);
+    const SensorInbox::Ready ready = inbox_.wait_ready();
+    const bool stopping = ready.stopping;
+    for (const slam::SensorInput& input : ready.inputs) step(input);
 
     if (options_.status_period_s > 0.0 && Clock::now() >= next_status) {
       log_status();
@@ -221,10 +166,10 @@ void EstimatorNode::step(const slam::SensorInput& input) {
     last_observation_seq_ = observation.seq;
   }
   StepInfo info;
-  info.epoch_ns = epoch_ns_;
+  info.epoch_ns = inbox_.epoch_ns();
   info.odometry_seq = last_odometry_seq_;
   info.observation_seq = last_observation_seq_;
-  info.samples_late = queue_.counters().late;
+  info.samples_late = inbox_.queue_counters().late;
   info.update_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   fill_map_state(*filter_, info, options_.published_particle_poses, options_.landmarks == "mixture",
                  map_state_);
@@ -246,7 +191,7 @@ void EstimatorNode::create_filter(double first_t_s) {
   if (checkpoint_) {
     const MapCheckpoint& c = *checkpoint_;
     const double gap_s =
-        static_cast<double>(static_cast<std::int64_t>(epoch_ns_ - c.stamp_ns)) * 1e-9 + first_t_s;
+        static_cast<double>(static_cast<std::int64_t>(inbox_.epoch_ns() - c.stamp_ns)) * 1e-9 + first_t_s;
     // A checkpoint from the future (another clock, a replayed log) is as unusable as an old one.
     if (gap_s >= -1.0 && gap_s <= k.max_age_s) {
       const slam::PoseGaussian pose = resume_pose(c, gap_s, k.max_speed_mps, k.max_turn_rate_radps);

@@ -1,6 +1,5 @@
 #pragma once
 
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -8,7 +7,6 @@
 #include <string>
 #include <thread>
 #include <utility>
-#include <variant>
 
 #include "landmark_observation.h"
 #include "map_state.h"
@@ -18,6 +16,7 @@
 #include "pixyslam/diagnostics/diagnostics_publisher.h"
 #include "pixyslam/map_optimizer/map_optimizer.h"
 #include "pixyslam/slam/sensor_queue.h"
+#include "pixyslam/slam_node/sensor_inbox.h"
 
 namespace pixyslam::map_optimizer_node {
 
@@ -77,8 +76,6 @@ class OptimizerNode {
   msg::OptimisedMap latest_map() const;
 
  private:
-  using Inbox = std::variant<msg::Odometry, msg::LandmarkObservation>;
-  void enqueue(Inbox&& item);
   void on_map_state(const msg::MapState& m);
   void loop();
   void step(const slam::SensorInput& input);
@@ -95,9 +92,8 @@ class OptimizerNode {
   std::unique_ptr<dds::Reader<msg::MapState>> map_state_reader_;
   std::unique_ptr<diagnostics::DiagnosticsPublisher> diagnostics_;
 
-  mutable std::mutex inbox_mutex_;
-  std::condition_variable inbox_cv_;
-  std::deque<Inbox> inbox_;
+  slam_node::SensorInbox inbox_;  // DDS callbacks -> the optimiser thread, in stamp order
+  std::mutex run_mutex_;
   bool stopping_ = false;
   std::thread thread_;
 
@@ -108,10 +104,8 @@ class OptimizerNode {
 
   // Loop state (read by others under state_mutex_).
   mutable std::mutex state_mutex_;
-  slam::SensorQueue queue_;
   std::unique_ptr<map_optimizer::MapOptimizer> optimizer_;
-  bool has_epoch_ = false;
-  std::uint64_t epoch_ns_ = 0;
+  std::uint64_t epoch_ns_ = 0;  // the inbox's, from the first input on
   double last_t_s_ = 0.0;
   double next_window_s_ = 0.0;
   double next_whole_s_ = 0.0;

@@ -1,9 +1,7 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -21,6 +19,7 @@
 #include "pixyslam/slam/sensor_queue.h"
 #include "pixyslam/slam_node/estimator_options.h"
 #include "pixyslam/slam_node/map_checkpoint.h"
+#include "pixyslam/slam_node/sensor_inbox.h"
 
 namespace pixyslam::slam_node {
 
@@ -64,9 +63,6 @@ class EstimatorNode {
   std::vector<std::pair<std::uint64_t, slam::Pose2>> trajectory() const;
 
  private:
-  using Inbox = std::variant<msg::Odometry, msg::LandmarkObservation>;
-
-  void enqueue(Inbox&& item);
   void filter_loop();
   void step(const slam::SensorInput& input);
   // The filter, from the checkpoint when there is a fresh one (state_mutex_ held).
@@ -82,18 +78,14 @@ class EstimatorNode {
   std::unique_ptr<dds::Reader<msg::LandmarkObservation>> observation_reader_;
   std::unique_ptr<diagnostics::DiagnosticsPublisher> diagnostics_;
 
-  mutable std::mutex inbox_mutex_;
-  std::condition_variable inbox_cv_;
-  std::deque<Inbox> inbox_;
+  SensorInbox inbox_;  // DDS callbacks -> the filter thread, in stamp order
+  std::mutex run_mutex_;
   bool stopping_ = false;
   std::thread thread_;
 
   // Filter-thread state (read by others under state_mutex_).
   mutable std::mutex state_mutex_;
-  slam::SensorQueue queue_;
   std::unique_ptr<slam::FastSlam2> filter_;
-  bool has_epoch_ = false;
-  std::uint64_t epoch_ns_ = 0;
   std::uint64_t last_odometry_seq_ = 0;
   std::uint64_t last_observation_seq_ = 0;
   msg::MapState map_state_;

@@ -1,0 +1,81 @@
+#include "pixyslam/slam_node/sensor_inbox.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "pixyslam/dds/endpoints.h"
+#include "pixyslam/slam_node/map_state_conversions.h"
+
+namespace pixyslam::slam_node {
+
+SensorInbox::SensorInbox(const slam::SensorQueueOptions& queue, bool use_detection_sigmas)
+    : use_detection_sigmas_(use_detection_sigmas), queue_(queue) {}
+
+void SensorInbox::push(const msg::Odometry& m) { enqueue(m); }
+void SensorInbox::push(const msg::LandmarkObservation& m) { enqueue(m); }
+
+void SensorInbox::enqueue(Message&& m) {
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    inbox_.push_back(std::move(m));
+  }
+  inbox_cv_.notify_one();
+}
+
+void SensorInbox::stop() {
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    stopping_ = true;
+  }
+  inbox_cv_.notify_all();
+}
+
+std::uint64_t SensorInbox::epoch_ns() const {
+  std::lock_guard<std::mutex> lock(queue_mutex_);
+  return epoch_ns_;
+}
+
+slam::SensorQueueCounters SensorInbox::queue_counters() const {
+  std::lock_guard<std::mutex> lock(queue_mutex_);
+  return queue_.counters();
+}
+
+double SensorInbox::now_s() const {
+  return static_cast<double>(static_cast<std::int64_t>(dds::now_ns() - epoch_ns_)) * 1e-9;
+}
+
+SensorInbox::Ready SensorInbox::wait_ready() {
+  std::deque<Message> batch;
+  Ready out;
+  {
+    std::unique_lock<std::mutex> lock(inbox_mutex_);
+    // Wake for new input, for a held sample's release time, or periodically.
+    double wait_s = 0.1;
+    {
+      std::lock_guard<std::mutex> queue_lock(queue_mutex_);
+      if (has_epoch_ && queue_.size() > 0) wait_s = std::clamp(queue_.next_release_s() - now_s(), 0.0, 0.1);
+    }
+    inbox_cv_.wait_for(lock, std::chrono::duration<double>(wait_s), [this] { return !inbox_.empty() || stopping_; });
+    batch.swap(inbox_);
+    out.stopping = stopping_;
+  }
+  std::lock_guard<std::mutex> queue_lock(queue_mutex_);
+  for (const Message& m : batch) {
+    const std::uint64_t stamp = std::visit([](const auto& x) { return x.header().stamp_ns(); }, m);
+    if (!has_epoch_) {
+      epoch_ns_ = stamp;
+      has_epoch_ = true;
+    }
+    const double arrival_s = now_s();
+    if (const auto* odometry = std::get_if<msg::Odometry>(&m)) {
+      queue_.push(to_odometry_input(*odometry, epoch_ns_), arrival_s);
+    } else {
+      queue_.push(to_observation_input(std::get<msg::LandmarkObservation>(m), epoch_ns_, use_detection_sigmas_),
+                  arrival_s);
+    }
+  }
+  if (has_epoch_) out.inputs = out.stopping ? queue_.pop_all() : queue_.pop_ready(now_s());
+  return out;
+}
+
+}  // namespace pixyslam::slam_node
