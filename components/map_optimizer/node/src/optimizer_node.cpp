@@ -20,14 +20,6 @@ double thread_cpu_seconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-msg::Pose2D to_msg(const slam::Pose2& p) {
-  msg::Pose2D out;
-  out.x_m(p.x());
-  out.y_m(p.y());
-  out.theta_rad(p.z());
-  return out;
-}
-
 }  // namespace
 
 OptimizerNode::OptimizerNode(const OptimizerNodeOptions& options)
@@ -210,7 +202,7 @@ void OptimizerNode::publish(const map_optimizer::SolveSummary& s, bool whole) {
   msg::OptimisedMap& m = map_;
   m.header().stamp_ns(slam_node::to_stamp_ns(last_t_s_, epoch_ns_));
   m.header().frame_id("map");
-  m.current_pose(to_msg(optimizer_->current_pose()));
+  m.current_pose(slam_node::to_pose_msg(optimizer_->current_pose()));
   const std::vector<map_optimizer::Keyframe>& keyframes = optimizer_->keyframes();
   m.keyframe_count(static_cast<std::uint32_t>(keyframes.size()));
   // All keyframes, or an even stride ending at the newest.
@@ -222,7 +214,7 @@ void OptimizerNode::publish(const map_optimizer::SolveSummary& s, bool whole) {
   for (std::size_t i = (n - 1) % stride; i < n; i += stride) {
     msg::OptimisedKeyframe k;
     k.stamp_ns(slam_node::to_stamp_ns(keyframes[i].t_s, epoch_ns_));
-    k.pose(to_msg(keyframes[i].pose));
+    k.pose(slam_node::to_pose_msg(keyframes[i].pose));
     out.push_back(k);
   }
   std::vector<msg::OptimisedLandmark>& landmarks = m.landmarks();

@@ -12,15 +12,15 @@ double to_seconds(std::uint64_t stamp_ns, std::uint64_t epoch_ns) {
   return static_cast<double>(static_cast<std::int64_t>(stamp_ns - epoch_ns)) * 1e-9;
 }
 
-msg::Pose2D to_pose(const slam::Pose2& p) {
+}  // namespace
+
+msg::Pose2D to_pose_msg(const slam::Pose2& p) {
   msg::Pose2D out;
   out.x_m(p.x());
   out.y_m(p.y());
   out.theta_rad(p.z());
   return out;
 }
-
-}  // namespace
 
 std::uint64_t to_stamp_ns(double t_s, std::uint64_t epoch_ns) {
   return epoch_ns + static_cast<std::uint64_t>(static_cast<std::int64_t>(std::llround(t_s * 1e9)));
@@ -62,11 +62,11 @@ void fill_map_state(const slam::FastSlam2& filter, const StepInfo& info, int max
   const slam::PoseEstimate estimate = filter.pose_estimate();
   out.header().stamp_ns(to_stamp_ns(estimate.t_s, info.epoch_ns));
   out.header().frame_id("map");
-  out.mean_pose(to_pose(estimate.mean));
+  out.mean_pose(to_pose_msg(estimate.mean));
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) out.pose_covariance()[static_cast<std::size_t>(3 * r + c)] = estimate.cov(r, c);
   }
-  out.best_pose(to_pose(estimate.best));
+  out.best_pose(to_pose_msg(estimate.best));
   out.effective_sample_size(estimate.effective_sample_size);
   out.particle_count(static_cast<std::uint32_t>(estimate.particles));
 
@@ -74,7 +74,7 @@ void fill_map_state(const slam::FastSlam2& filter, const StepInfo& info, int max
   out.particle_poses().clear();
   const std::size_t wanted = std::min<std::size_t>(count, static_cast<std::size_t>(std::max(0, max_particle_poses)));
   for (std::size_t k = 0; k < wanted; ++k) {
-    out.particle_poses().push_back(to_pose(filter.to_output(filter.particle_pose(k * count / wanted))));
+    out.particle_poses().push_back(to_pose_msg(filter.to_output(filter.particle_pose(k * count / wanted))));
   }
 
   out.landmarks().clear();

@@ -36,5 +36,6 @@ void fill_map_state(const slam::FastSlam2& filter, const StepInfo& info, int max
                     bool mixture_landmarks, msg::MapState& out);
 
 std::uint64_t to_stamp_ns(double t_s, std::uint64_t epoch_ns);
+msg::Pose2D to_pose_msg(const slam::Pose2& p);
 
 }  // namespace pixyslam::slam_node
