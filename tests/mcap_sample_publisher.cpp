@@ -87,6 +87,33 @@ msg::GroundTruth ground_truth(std::uint64_t i) {
   return m;
 }
 
+msg::OptimisedMap optimised_map(std::uint64_t i) {
+  msg::OptimisedMap m;
+  m.header().stamp_ns(dds::now_ns());
+  m.header().frame_id("map");
+  m.current_pose().x_m(0.01 * static_cast<double>(i));
+  m.keyframe_count(3);
+  for (int k = 0; k < 3; ++k) {
+    msg::OptimisedKeyframe keyframe;
+    keyframe.stamp_ns(m.header().stamp_ns() - static_cast<std::uint64_t>(3 - k) * 1000u);
+    keyframe.pose().x_m(0.01 * static_cast<double>(i) - 0.001 * (3 - k));
+    m.keyframes().push_back(keyframe);
+  }
+  msg::OptimisedLandmark l;
+  l.landmark_id(10);
+  l.x_m(1.0);
+  l.cov_xx_m2(0.004);
+  l.cov_yy_m2(0.004);
+  l.observations(static_cast<std::uint32_t>(i));
+  m.landmarks().push_back(l);
+  m.converged(true);
+  m.iterations(static_cast<std::uint32_t>(i % 20));
+  m.keyframes_free(3);
+  m.residuals(6);
+  m.odometry_sequence(i);
+  return m;
+}
+
 int run(int argc, char** argv) {
   constexpr const char* kUsage =
       "usage: mcap_sample_publisher --profiles FILE --domain D --count N [--rate HZ] [--topics all|odometry] "
@@ -122,16 +149,18 @@ int run(int argc, char** argv) {
   std::unique_ptr<dds::Writer<msg::LandmarkObservation>> observation_writer;
   std::unique_ptr<dds::Writer<msg::MapState>> map_writer;
   std::unique_ptr<dds::Writer<msg::GroundTruth>> truth_writer;
+  std::unique_ptr<dds::Writer<msg::OptimisedMap>> optimised_writer;
   if (all_topics) {
     observation_writer = std::make_unique<dds::Writer<msg::LandmarkObservation>>(participant);
     map_writer = std::make_unique<dds::Writer<msg::MapState>>(participant);
     truth_writer = std::make_unique<dds::Writer<msg::GroundTruth>>(participant);
+    optimised_writer = std::make_unique<dds::Writer<msg::OptimisedMap>>(participant);
   }
   const auto wait = std::chrono::milliseconds(static_cast<long>(wait_s * 1000.0));
   bool matched = odometry_writer.wait_for_readers(1, wait);
   if (all_topics) {
     matched = matched && observation_writer->wait_for_readers(1, wait) && map_writer->wait_for_readers(1, wait) &&
-              truth_writer->wait_for_readers(1, wait);
+              truth_writer->wait_for_readers(1, wait) && optimised_writer->wait_for_readers(1, wait);
   }
   if (!matched) {
     std::fprintf(stderr, "mcap_sample_publisher: no reader on domain %d after %.0f s\n", options.domain_id, wait_s);
@@ -152,9 +181,11 @@ int run(int argc, char** argv) {
       msg::LandmarkObservation l = observation(i);
       msg::MapState s = map_state(i);
       msg::GroundTruth g = ground_truth(i);
+      msg::OptimisedMap m = optimised_map(i);
       ok = observation_writer->publish(l) && ok;
       ok = map_writer->publish(s) && ok;
       ok = truth_writer->publish(g) && ok;
+      ok = optimised_writer->publish(m) && ok;
     }
     round = i;
     if (i % 10 == 0 || i == count) std::printf("progress %llu\n", static_cast<unsigned long long>(i));
@@ -166,6 +197,7 @@ int run(int argc, char** argv) {
     ok = observation_writer->wait_for_acknowledgments(ack) && ok;
     ok = map_writer->wait_for_acknowledgments(ack) && ok;
     ok = truth_writer->wait_for_acknowledgments(ack) && ok;
+    ok = optimised_writer->wait_for_acknowledgments(ack) && ok;
   }
   std::printf("published %s %llu\n", dds::kOdometryTopic.data(), static_cast<unsigned long long>(odometry_writer.published()));
   if (all_topics) {
@@ -174,6 +206,8 @@ int run(int argc, char** argv) {
     std::printf("published %s %llu\n", dds::kMapStateTopic.data(), static_cast<unsigned long long>(map_writer->published()));
     std::printf("published %s %llu\n", dds::kGroundTruthTopic.data(),
                 static_cast<unsigned long long>(truth_writer->published()));
+    std::printf("published %s %llu\n", dds::kOptimisedMapTopic.data(),
+                static_cast<unsigned long long>(optimised_writer->published()));
   }
   return ok && round == count ? 0 : 3;
 }

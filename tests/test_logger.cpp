@@ -151,7 +151,7 @@ TEST(CdrPayload, StrictDecodingRejectsCutPaddedAndMistypedPayloads) {
 
 TEST(CdrPayload, KnownTopicsAreTheSystemsTopicsWithTheirDdsTypeNames) {
   const auto& topics = known_topics();
-  ASSERT_EQ(topics.size(), 5u);
+  ASSERT_EQ(topics.size(), 6u);
   EXPECT_EQ(topics[0].topic, dds::kOdometryTopic);
   EXPECT_EQ(topics[0].type_name, "pixyslam::msg::Odometry");
   EXPECT_EQ(topics[0].idl_stem, "odometry");
@@ -161,6 +161,10 @@ TEST(CdrPayload, KnownTopicsAreTheSystemsTopicsWithTheirDdsTypeNames) {
   EXPECT_EQ(find_topic("odometry"), nullptr);
   EXPECT_EQ(topics[4].topic, dds::kDiagnosticsTopic);
   EXPECT_EQ(topics[4].type_name, "pixyslam::msg::Diagnostics");
+  EXPECT_EQ(topics[5].topic, dds::kOptimisedMapTopic);
+  EXPECT_EQ(topics[5].type_name, "pixyslam::msg::OptimisedMap");
+  EXPECT_EQ(topics[5].idl_stem, "optimised_map");
+  ASSERT_NE(find_topic("pixyslam/optimised_map"), nullptr);
 }
 
 // ---------------------------------------------------------------- topic patterns, file names
@@ -237,7 +241,9 @@ std::string config_error(const std::string& yaml) {
 TEST(LoggerOptions, ShippedConfigLoads) {
   const LoggerOptions o = read_logger_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/logger.yaml");
   EXPECT_EQ(o.output_file, "pixyslam_run.mcap");
-  EXPECT_EQ(o.topics.size(), 5u);
+  std::vector<std::string> every_topic;  // the shipped config records them all
+  for (const TopicInfo& t : known_topics()) every_topic.push_back(t.topic);
+  EXPECT_EQ(o.topics, every_topic);
   EXPECT_EQ(o.chunk_size_bytes, 1048576u);
   EXPECT_EQ(o.compression, default_compression());
   EXPECT_DOUBLE_EQ(o.flush_period_s, 1.0);
@@ -275,7 +281,7 @@ TEST(LoggerOptions, TopicPatternsAndRotation) {
   const LoggerOptions o = read_logger_options(root, "/cfg");
   EXPECT_EQ(o.topics,
             (std::vector<std::string>{"pixyslam/odometry", "pixyslam/landmark_observation", "pixyslam/map_state",
-                                      "pixyslam/diagnostics"}));
+                                      "pixyslam/diagnostics", "pixyslam/optimised_map"}));
   EXPECT_EQ(o.rotate_size_bytes, 1000000u);
   EXPECT_DOUBLE_EQ(o.rotate_period_s, 60.0);
   EXPECT_TRUE(rotation_enabled(o));
@@ -464,6 +470,44 @@ msg::GroundTruth ground_truth(int i) {
   return m;
 }
 
+msg::OptimisedMap optimised_map(int i) {
+  msg::OptimisedMap m;
+  m.header().stamp_ns(1'700'000'000'000'000'000ull + static_cast<std::uint64_t>(i) * 500'000'000ull + 11);
+  m.header().frame_id("map");
+  m.current_pose().x_m(0.5 * i);
+  m.keyframe_count(static_cast<std::uint32_t>(3 * i + 1));
+  for (int k = 0; k <= 3 * i; ++k) {
+    msg::OptimisedKeyframe f;
+    f.stamp_ns(1'700'000'000'000'000'000ull + static_cast<std::uint64_t>(k) * 100'000'000ull);
+    f.pose().x_m(0.1 * k);
+    f.pose().theta_rad(0.01 * k);
+    m.keyframes().push_back(f);
+  }
+  for (int k = 0; k < i % 4; ++k) {
+    msg::OptimisedLandmark l;
+    l.landmark_id(10 + k);
+    l.x_m(1.0 * k);
+    l.y_m(-2.0 * k);
+    l.cov_xx_m2(0.001 * k);
+    l.cov_xy_m2(0.0);
+    l.cov_yy_m2(0.002 * k);
+    l.observations(static_cast<std::uint32_t>(i + k));
+    m.landmarks().push_back(l);
+  }
+  m.whole_problem(i % 3 == 0);
+  m.converged(true);
+  m.iterations(static_cast<std::uint32_t>(5 + i));
+  m.initial_cost(100.0 / (i + 1));
+  m.final_cost(1.0 / (i + 1));
+  m.solve_time_s(0.01 * i);
+  m.cpu_time_s(0.1 * i);
+  m.keyframes_free(static_cast<std::uint32_t>(i));
+  m.residuals(static_cast<std::uint32_t>(20 * i));
+  m.odometry_sequence(static_cast<std::uint64_t>(50 * i));
+  m.observation_sequence(static_cast<std::uint64_t>(5 * i));
+  return m;
+}
+
 // Every message of `topic` in `reader`, decoded; checks the MCAP fields
 // against the header on the way.
 template <class Message>
@@ -502,7 +546,7 @@ void expect_recorded(const logger::McapReader& reader, const std::vector<Message
 
 // The recording that the log_tool_* ctests check with pixyslam_log (they set
 // PIXYSLAM_LOGGER_TEST_OUT to keep it): 500 Odometry, 50 LandmarkObservation,
-// 100 MapState, 20 GroundTruth.
+// 100 MapState, 20 GroundTruth, 10 OptimisedMap.
 TEST(LoggerNode, RecordsEveryTopicExactly) {
   const TempFile file("test_logger_recording", "PIXYSLAM_LOGGER_TEST_OUT");
   const std::uint64_t start_ns = dds::now_ns();
@@ -514,15 +558,18 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
   dds::Writer<msg::LandmarkObservation> observation_writer(robot);
   dds::Writer<msg::MapState> map_writer(robot);
   dds::Writer<msg::GroundTruth> truth_writer(robot);
+  dds::Writer<msg::OptimisedMap> optimised_writer(robot);
   ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
   ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
   ASSERT_TRUE(map_writer.wait_for_readers(1, std::chrono::seconds(10)));
   ASSERT_TRUE(truth_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(optimised_writer.wait_for_readers(1, std::chrono::seconds(10)));
 
   std::vector<msg::Odometry> odometry_sent;
   std::vector<msg::LandmarkObservation> observations_sent;
   std::vector<msg::MapState> maps_sent;
   std::vector<msg::GroundTruth> truths_sent;
+  std::vector<msg::OptimisedMap> optimised_sent;
   for (int i = 0; i < 500; ++i) {
     odometry_sent.push_back(odometry(i));
     ASSERT_TRUE(odometry_writer.publish(odometry_sent.back()));  // fills seq and robot_id
@@ -541,14 +588,23 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
       truths_sent.push_back(ground_truth(i / 25));
       ASSERT_TRUE(truth_writer.publish(truths_sent.back()));
     }
+    if (i % 50 == 0) {
+      // Keep-last 4 (the optimiser's pace: one solution per solve): spaced out
+      // like the MapStates above.
+      optimised_sent.push_back(optimised_map(i / 50));
+      ASSERT_TRUE(optimised_writer.publish(optimised_sent.back()));
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
   }
   ASSERT_EQ(observations_sent.size(), 50u);
   ASSERT_EQ(maps_sent.size(), 100u);
   ASSERT_EQ(truths_sent.size(), 20u);
+  ASSERT_EQ(optimised_sent.size(), 10u);
   EXPECT_TRUE(wait_until(
       [&] {
         return received(node, "pixyslam/odometry") == 500 && received(node, "pixyslam/map_state") == 100 &&
-               received(node, "pixyslam/landmark_observation") == 50 && received(node, "pixyslam/ground_truth") == 20;
+               received(node, "pixyslam/landmark_observation") == 50 && received(node, "pixyslam/ground_truth") == 20 &&
+               received(node, "pixyslam/optimised_map") == 10;
       },
       std::chrono::seconds(20)))
       << node.counters_text();
@@ -561,8 +617,9 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
                                                          {"pixyslam/landmark_observation", 50},
                                                          {"pixyslam/map_state", 100},
                                                          {"pixyslam/ground_truth", 20},
-                                                         {"pixyslam/diagnostics", 0}};
-  ASSERT_EQ(c.topics.size(), 5u);
+                                                         {"pixyslam/diagnostics", 0},
+                                                         {"pixyslam/optimised_map", 10}};
+  ASSERT_EQ(c.topics.size(), 6u);
   for (const auto& [topic, count] : expected) {
     const TopicCounters& t = topic_counters(c, topic);
     EXPECT_EQ(t.received, count) << topic;
@@ -570,7 +627,7 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
     EXPECT_EQ(t.dropped, 0u) << topic;
     EXPECT_EQ(t.reader.seq_gaps, 0u) << topic;
   }
-  EXPECT_EQ(c.file.messages, 670u);
+  EXPECT_EQ(c.file.messages, 680u);
   EXPECT_GT(c.file.chunks, 1u);
   EXPECT_GT(c.queue_peak_messages, 0u);
   EXPECT_NE(node.counters_text().find("pixyslam/odometry: received 500, written 500, dropped 0, seq gaps 0"),
@@ -580,15 +637,15 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
   const logger::McapReader reader(file.path());
   EXPECT_TRUE(reader.clean()) << reader.diagnostics_text();
   ASSERT_TRUE(reader.statistics().has_value());
-  EXPECT_EQ(reader.statistics()->message_count, 670u);
-  EXPECT_EQ(reader.messages().size(), 670u);
+  EXPECT_EQ(reader.statistics()->message_count, 680u);
+  EXPECT_EQ(reader.messages().size(), 680u);
   for (const logger::McapChunkInfo& chunk : reader.chunks()) {
     EXPECT_EQ(chunk.compression, logger::mcap_compression_name(default_compression()));
   }
 
   // Channels and schemas.
-  ASSERT_EQ(reader.channels().size(), 5u);
-  ASSERT_EQ(reader.schemas().size(), 5u);
+  ASSERT_EQ(reader.channels().size(), 6u);
+  ASSERT_EQ(reader.schemas().size(), 6u);
   for (const TopicInfo& info : known_topics()) {
     const logger::McapChannel* channel = reader.find_channel(info.topic);
     ASSERT_NE(channel, nullptr) << info.topic;
@@ -608,6 +665,7 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
   expect_recorded(reader, observations_sent);
   expect_recorded(reader, maps_sent);
   expect_recorded(reader, truths_sent);
+  expect_recorded(reader, optimised_sent);
   std::uint64_t previous_log_time = 0;
   for (const logger::McapMessage& m : reader.messages()) {
     EXPECT_GE(m.log_time_ns, start_ns);
@@ -757,7 +815,7 @@ TEST(LoggerNode, RotatesBySizeIntoCompleteFiles) {
   const LoggerCounters c = node.counters();
   EXPECT_TRUE(c.error.empty()) << c.error;
   EXPECT_GE(files.size(), 3u);
-  expect_complete_rotation(files, c, 4, kCount);  // all but the ground truth
+  expect_complete_rotation(files, c, known_topics().size() - 1, kCount);  // all but the ground truth
   for (std::size_t i = 0; i + 1 < files.size(); ++i) {
     const auto size = std::filesystem::file_size(files[i]);
     EXPECT_GE(size + 8192, options.rotate_size_bytes) << files[i];  // rotated near the limit,

@@ -59,6 +59,17 @@ bool near_colour(const cv::Vec3b& p, const cv::Scalar& c, int tol) {
 // "Reddish": the landmark colour blended with white by antialiasing.
 bool landmark_like(const cv::Vec3b& p) { return p[2] > 150 && p[1] < 170 && p[0] < 170 && p[2] - p[1] > 60; }
 
+// "Orange": the optimised colour blended with white (green above blue, unlike
+// the landmarks' red blends).
+bool optimised_like(const cv::Vec3b& p) { return p[2] > 200 && p[0] < 190 && p[1] - p[0] > 30 && p[2] - p[0] > 60; }
+
+int count_like(const cv::Mat& img, bool (*pred)(const cv::Vec3b&)) {
+  int n = 0;
+  for (int v = 0; v < img.rows; ++v)
+    for (int u = 0; u < img.cols; ++u) n += pred(img.at<cv::Vec3b>(v, u)) ? 1 : 0;
+  return n;
+}
+
 bool any_near(const cv::Mat& img, cv::Point2d at, int radius, bool (*pred)(const cv::Vec3b&)) {
   for (int dv = -radius; dv <= radius; ++dv) {
     for (int du = -radius; du <= radius; ++du) {
@@ -363,6 +374,91 @@ TEST(RenderMap, RejectsBadSizesAndSurvivesOddInput) {
   EXPECT_EQ(render_map(odd, o).size(), cv::Size(640, 480));
 }
 
+// Pixels within `tol` of colour `c` in `img` (whole image, footer included).
+int count_colour(const cv::Mat& img, const cv::Scalar& c, int tol) {
+  cv::Mat mask;
+  cv::inRange(img, c - cv::Scalar::all(tol), c + cv::Scalar::all(tol), mask);
+  return cv::countNonZero(mask);
+}
+
+TEST(RenderMap, OptimisedSolutionDrawnInItsOwnColourBesideTheFiltersMap) {
+  // Given the filter's map and trajectory, and the optimiser's keyframes along
+  // y = -1 and one landmark with sigma_x = 0.2 m, sigma_y = 0.1 m at (1, 1),
+  MapViewState s;
+  s.landmarks = {landmark_with(-1.0, 1.0, 0.1, 0.1, 0.0)};
+  s.mean_trajectory = {{-1.5, -1.5}, {1.5, -1.5}};
+  s.optimised_trajectory = {{-1.5, -1.0}, {0.0, -1.0}, {1.5, -1.0}};
+  s.optimised_landmarks = {landmark_with(1.0, 1.0, 0.2, 0.1, 0.0)};
+  RenderOptions o = plain_options(box(-2.0, -2.0, 2.0, 2.0));
+  const cv::Mat img = render_map(s, o);
+  const ViewTransform t = view_for(s, o);
+  const double ppm = t.pixels_per_metre();
+  auto optimised_near = [&](cv::Point2d at, int radius) { return any_near(img, at, radius, optimised_like); };
+  // then the optimised colour is on the keyframe line and on the diamond around its landmark,
+  EXPECT_TRUE(optimised_near(t.to_pixel(0.75, -1.0), 1));
+  EXPECT_TRUE(optimised_near(t.to_pixel(1.0, 1.0), 7));
+  EXPECT_FALSE(optimised_near(t.to_pixel(1.0, 1.0), 1));  // outlined: the centre stays free
+  // its ellipse reaches 2 sigma (0.4 m along x, 0.2 m along y), not 25 % further,
+  EXPECT_TRUE(optimised_near(t.to_pixel(1.4, 1.0), 1));
+  EXPECT_TRUE(optimised_near(t.to_pixel(1.0, 1.2), 1));
+  EXPECT_FALSE(optimised_near(t.to_pixel(1.5, 1.0), 2));
+  EXPECT_FALSE(optimised_near(t.to_pixel(1.0, 1.25), 2));
+  // and not on the filter's landmark, trajectory or empty space.
+  EXPECT_FALSE(optimised_near(t.to_pixel(-1.0, 1.0), 8));
+  EXPECT_FALSE(optimised_near(t.to_pixel(0.0, -1.5), 3));
+  EXPECT_FALSE(optimised_near(t.to_pixel(0.0, 0.5), 10));
+  EXPECT_TRUE(any_near(img, t.to_pixel(-1.0, 1.0), 1, landmark_like));  // the filter's map is still drawn
+  EXPECT_GT(0.4 * ppm, 20.0);  // the ellipse is well outside the diamond
+
+  // Without the optimised solution: not one pixel of its colour, and the same
+  // image as a state that never had one.
+  MapViewState without = s;
+  without.optimised_trajectory.clear();
+  without.optimised_landmarks.clear();
+  const cv::Mat plain = render_map(without, o);
+  EXPECT_EQ(count_like(plain, optimised_like), 0);
+  EXPECT_GT(count_colour(img, o.colours.optimised, 40), 50);
+  MapViewState never;
+  never.landmarks = s.landmarks;
+  never.mean_trajectory = s.mean_trajectory;
+  EXPECT_EQ(cv::norm(plain, render_map(never, o), cv::NORM_INF), 0.0);
+}
+
+TEST(RenderMap, OptimisedLandmarkWithoutCovarianceHasNoEllipse) {
+  MapViewState s;
+  LandmarkView l = landmark_with(0.0, 0.0, 0.3, 0.3, 0.0);
+  s.optimised_landmarks = {l};
+  RenderOptions o = plain_options(box(-1.0, -1.0, 1.0, 1.0));
+  const ViewTransform t = view_for(s, o);
+  const auto orange_at = [&](const cv::Mat& img, cv::Point2d at) { return any_near(img, at, 2, optimised_like); };
+  // A finite covariance: the 2-sigma circle (0.6 m) is drawn.
+  EXPECT_TRUE(orange_at(render_map(s, o), t.to_pixel(0.6, 0.0)));
+  // NaN (before the first whole-problem solve): only the marker.
+  s.optimised_landmarks[0].cov_xx_m2 = std::nan("");
+  s.optimised_landmarks[0].cov_xy_m2 = std::nan("");
+  s.optimised_landmarks[0].cov_yy_m2 = std::nan("");
+  const cv::Mat img = render_map(s, o);
+  EXPECT_FALSE(orange_at(img, t.to_pixel(0.6, 0.0)));
+  EXPECT_FALSE(orange_at(img, t.to_pixel(0.0, -0.6)));
+  EXPECT_TRUE(orange_at(img, t.to_pixel(0.0, 0.0) + cv::Point2d(6.0, 0.0)));
+}
+
+TEST(RenderMap, LegendNamesTheOptimisedSolutionOnlyWhenPresent) {
+  MapViewState s = full_state();
+  const RenderOptions o;  // footer with the legend
+  const cv::Rect footer(0, o.height_px - o.footer_px, o.width_px, o.footer_px);
+  const cv::Mat without = render_map(s, o);
+  EXPECT_EQ(count_like(without, optimised_like), 0);
+  s.optimised_trajectory = s.mean_trajectory;
+  s.optimised_landmarks = s.landmarks;
+  const cv::Mat with = render_map(s, o);
+  EXPECT_GT(count_colour(with(footer), o.colours.optimised, 40), 10);
+  // The view fits the optimised solution too: a landmark far out moves the view.
+  MapViewState far = s;
+  far.optimised_landmarks.push_back(landmark_with(30.0, 0.0, 0.1, 0.1, 0.0));
+  EXPECT_NEAR(content_bounds(far, 2.0, true).max_x_m, 30.2, 1e-9);
+}
+
 // ---- conversion ----------------------------------------------------------
 
 msg::MapState map_state(std::uint64_t stamp_ns, double x, int landmarks) {
@@ -441,6 +537,61 @@ TEST(MsgConversion, MapStateBecomesTheViewState) {
   EXPECT_EQ(builder.state().mean_trajectory.size(), 2u);
 }
 
+msg::OptimisedMap optimised_map(std::uint64_t stamp_ns, int keyframes, double shift) {
+  msg::OptimisedMap m;
+  m.header().stamp_ns(stamp_ns);
+  m.header().frame_id("map");
+  m.keyframe_count(static_cast<std::uint32_t>(keyframes));
+  for (int i = 0; i < keyframes; ++i) {
+    msg::OptimisedKeyframe k;
+    k.stamp_ns(stamp_ns - static_cast<std::uint64_t>(keyframes - i) * 1000u);
+    k.pose().x_m(0.1 * i + shift);
+    k.pose().y_m(-0.2 * i);
+    m.keyframes().push_back(k);
+  }
+  msg::OptimisedLandmark l;
+  l.landmark_id(20);
+  l.x_m(1.0 + shift);
+  l.y_m(2.0);
+  l.cov_xx_m2(0.004);
+  l.cov_xy_m2(0.001);
+  l.cov_yy_m2(0.009);
+  l.observations(11);
+  m.landmarks().push_back(l);
+  return m;
+}
+
+TEST(MsgConversion, OptimisedMapReplacesTheOptimisedSolution) {
+  MapViewBuilder builder(0.0);
+  const std::uint64_t t0 = 1'700'000'000'000'000'000ULL;
+  ASSERT_TRUE(builder.add(map_state(t0 + 100'000'000ULL, 0.1, 2)));
+  const MapViewState before = builder.state();
+  // The first solution: its keyframes and landmarks, the filter's state untouched.
+  ASSERT_TRUE(builder.add(optimised_map(t0 + 200'000'000ULL, 4, 0.0)));
+  const MapViewState& s = builder.state();
+  ASSERT_EQ(s.optimised_trajectory.size(), 4u);
+  EXPECT_DOUBLE_EQ(s.optimised_trajectory[3].x_m, 0.3);
+  EXPECT_DOUBLE_EQ(s.optimised_trajectory[3].y_m, -0.6);
+  ASSERT_EQ(s.optimised_landmarks.size(), 1u);
+  EXPECT_EQ(s.optimised_landmarks[0].id, 20);
+  EXPECT_DOUBLE_EQ(s.optimised_landmarks[0].cov_xy_m2, 0.001);
+  EXPECT_DOUBLE_EQ(s.optimised_landmarks[0].cov_yy_m2, 0.009);
+  EXPECT_EQ(s.optimised_landmarks[0].times_observed, 11u);
+  EXPECT_EQ(s.landmarks.size(), before.landmarks.size());
+  EXPECT_EQ(s.mean_trajectory.size(), before.mean_trajectory.size());
+  EXPECT_EQ(s.caption, before.caption);
+  EXPECT_EQ(builder.optimised_maps(), 1u);
+  // A later solution replaces it (not appended: each holds the whole trajectory).
+  ASSERT_TRUE(builder.add(optimised_map(t0 + 300'000'000ULL, 6, 5.0)));
+  ASSERT_EQ(builder.state().optimised_trajectory.size(), 6u);
+  EXPECT_DOUBLE_EQ(builder.state().optimised_trajectory[0].x_m, 5.0);
+  EXPECT_DOUBLE_EQ(builder.state().optimised_landmarks[0].x_m, 6.0);
+  // A stale one is ignored.
+  EXPECT_FALSE(builder.add(optimised_map(t0 + 250'000'000ULL, 2, 9.0)));
+  EXPECT_EQ(builder.state().optimised_trajectory.size(), 6u);
+  EXPECT_EQ(builder.optimised_maps(), 2u);
+}
+
 TEST(MsgConversion, TrajectoryDecimation) {
   std::vector<Point2> path;
   append_point(path, {0.0, 0.0}, 0.1);
@@ -454,9 +605,16 @@ TEST(MsgConversion, TrajectoryDecimation) {
 // ---- MCAP logs -----------------------------------------------------------
 
 // Writes a log like the logger's: map_state and ground_truth channels (CDR,
-// omgidl schemas) plus odometry, interleaved by time.
-void write_log(const std::string& path, int steps, bool with_map_channel) {
+// omgidl schemas), interleaved by time; with `optimised_every` > 0 an
+// optimised_map channel too, one solution every that many steps.
+void write_log(const std::string& path, int steps, bool with_map_channel, int optimised_every = 0) {
   logger::McapWriter writer(path, {});
+  std::uint16_t optimised_channel = 0;
+  if (optimised_every > 0) {
+    const std::uint16_t schema =
+        writer.add_schema("pixyslam::msg::OptimisedMap", "omgidl", msg::idl_text("optimised_map"));
+    optimised_channel = writer.add_channel("pixyslam/optimised_map", "cdr", schema);
+  }
   std::uint16_t map_channel = 0;
   if (with_map_channel) {
     const std::uint16_t schema = writer.add_schema("pixyslam::msg::MapState", "omgidl", msg::idl_text("map_state"));
@@ -474,6 +632,10 @@ void write_log(const std::string& path, int steps, bool with_map_channel) {
     if (with_map_channel) {
       writer.write_message(map_channel, static_cast<std::uint32_t>(i + 1), t + 1000, t + 1000,
                            logger_node::to_cdr(map_state(t, x, 1 + i / 10)));
+    }
+    if (optimised_every > 0 && (i + 1) % optimised_every == 0) {
+      writer.write_message(optimised_channel, static_cast<std::uint32_t>((i + 1) / optimised_every), t + 2000,
+                           t + 2000, logger_node::to_cdr(optimised_map(t, i + 1, 0.01 * i)));
     }
   }
   writer.close();
@@ -521,6 +683,44 @@ TEST(MapViewLog, RendersLogWrittenWithMcapWriter) {
   EXPECT_EQ(back.cols, 640);
   EXPECT_EQ(back.rows, 480);
   EXPECT_EQ(cv::norm(back, render_map(final, o), cv::NORM_INF), 0.0);
+}
+
+TEST(MapViewLog, ReplaysTheOptimisedMapsOfALog) {
+  const fs::path dir = temp_dir("optimised");
+  const std::string path = (dir / "optimised.mcap").string();
+  write_log(path, 40, true, 10);
+  const MapLog log = MapLog::read(path);
+  EXPECT_EQ(log.map_states().size(), 40u);
+  ASSERT_EQ(log.optimised_maps().size(), 4u);
+  EXPECT_EQ(log.undecodable(), 0u);
+
+  // Halfway: the second solution (20 keyframes); at the end the fourth (40).
+  LogPlayer player(log, 0.0);
+  player.advance_to(log.start_ns() + 19u * 100'000'000ULL + 2000u);
+  EXPECT_EQ(player.state().optimised_trajectory.size(), 20u);
+  EXPECT_EQ(player.builder().optimised_maps(), 2u);
+  const MapViewState final = final_state(log, 0.0);
+  ASSERT_EQ(final.optimised_trajectory.size(), 40u);
+  EXPECT_NEAR(final.optimised_trajectory.back().x_m, 0.1 * 39 + 0.01 * 39, 1e-12);
+  ASSERT_EQ(final.optimised_landmarks.size(), 1u);
+  EXPECT_NEAR(final.optimised_landmarks[0].x_m, 1.0 + 0.01 * 39, 1e-12);
+  // The video's fixed view covers every solution (the keyframes reach y = -7.8).
+  EXPECT_LE(run_bounds(log, 2.0, false).min_y_m, -0.2 * 39 + 1e-9);
+
+  // Drawn in the optimised colour; the same log without the channel is not.
+  RenderOptions o;
+  cv::Mat mask;
+  cv::inRange(render_map(final, o), o.colours.optimised - cv::Scalar::all(40),
+              o.colours.optimised + cv::Scalar::all(40), mask);
+  EXPECT_GT(cv::countNonZero(mask), 100);
+  const std::string plain_path = (dir / "plain.mcap").string();
+  write_log(plain_path, 40, true);
+  const MapLog plain = MapLog::read(plain_path);
+  EXPECT_TRUE(plain.optimised_maps().empty());
+  cv::inRange(render_map(final_state(plain, 0.0), o), o.colours.optimised - cv::Scalar::all(40),
+              o.colours.optimised + cv::Scalar::all(40), mask);
+  EXPECT_EQ(cv::countNonZero(mask), 0);
+  EXPECT_EQ(count_like(render_map(final_state(plain, 0.0), o), optimised_like), 0);
 }
 
 TEST(MapViewLog, BadLogsAreInputErrorsNamingTheFile) {

@@ -1,6 +1,6 @@
-// map_view live against a real DDS writer on a private domain: the process
-// starts without a display, draws what it receives into map_latest.png, and
-// ends with status 0 on SIGINT after a last snapshot.
+// map_view live against real DDS writers on a private domain: the process
+// starts without a display, draws what it receives (MapState, OptimisedMap)
+// into map_latest.png, and ends with status 0 on SIGINT after a last snapshot.
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -45,7 +45,9 @@ TEST(MapViewLive, DrawsReceivedMapStatesAndStopsOnSigint) {
   {
     dds::Participant participant(options, "test_map_view_live");
     dds::Writer<msg::MapState> writer(participant);
+    dds::Writer<msg::OptimisedMap> optimised_writer(participant);
     ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(20)));
+    ASSERT_TRUE(optimised_writer.wait_for_readers(1, std::chrono::seconds(20)));
     for (int i = 1; i <= 20; ++i) {
       msg::MapState m;
       m.header().stamp_ns(1'000'000'000ULL * static_cast<std::uint64_t>(i));
@@ -63,7 +65,27 @@ TEST(MapViewLive, DrawsReceivedMapStatesAndStopsOnSigint) {
       // MapState is keep-last 1: a reader sees the latest, not every state of a burst.
       std::this_thread::sleep_for(std::chrono::milliseconds(40));
     }
+    // The optimiser's solution: keyframes along y = -0.5, a landmark at (1.5, 1).
+    msg::OptimisedMap optimised;
+    optimised.header().stamp_ns(20'000'000'000ULL);
+    for (int i = 0; i <= 20; ++i) {
+      msg::OptimisedKeyframe k;
+      k.stamp_ns(1'000'000'000ULL * static_cast<std::uint64_t>(i));
+      k.pose().x_m(0.1 * i);
+      k.pose().y_m(-0.5);
+      optimised.keyframes().push_back(k);
+    }
+    optimised.keyframe_count(21);
+    msg::OptimisedLandmark l;
+    l.landmark_id(5);
+    l.x_m(1.5);
+    l.y_m(1.0);
+    l.cov_xx_m2(0.01);
+    l.cov_yy_m2(0.01);
+    optimised.landmarks().push_back(l);
+    ASSERT_TRUE(optimised_writer.publish(optimised));
     EXPECT_TRUE(writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+    EXPECT_TRUE(optimised_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
     std::this_thread::sleep_for(std::chrono::milliseconds(800));  // > two snapshot periods
   }
   kill(child, SIGINT);
@@ -82,6 +104,10 @@ TEST(MapViewLive, DrawsReceivedMapStatesAndStopsOnSigint) {
   cv::inRange(image, cv::Scalar(180, 70, 0), cv::Scalar(220, 110, 40), blue);
   EXPECT_GT(cv::countNonZero(red), 20);
   EXPECT_GT(cv::countNonZero(blue), 100);
+  // So is the optimised solution (orange, the default colour (240, 140, 0)).
+  cv::Mat orange;
+  cv::inRange(image, cv::Scalar(0, 110, 210), cv::Scalar(40, 170, 255), orange);
+  EXPECT_GT(cv::countNonZero(orange), 100);
   fs::remove_all(out);
 }
 

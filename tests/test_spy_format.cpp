@@ -49,6 +49,54 @@ msg::LandmarkObservation observation() {
   return m;
 }
 
+// The map optimiser's solution: two keyframes, a landmark with its marginal
+// covariance and one without (NaN before the first whole-problem solve).
+msg::OptimisedMap optimised_map() {
+  msg::OptimisedMap m;
+  m.header().stamp_ns(2000);
+  m.header().seq(4);
+  m.header().robot_id("robot1");
+  m.header().frame_id("map");
+  m.current_pose().x_m(1.5);
+  m.current_pose().theta_rad(0.25);
+  m.keyframe_count(9);
+  for (int i = 0; i < 2; ++i) {
+    msg::OptimisedKeyframe k;
+    k.stamp_ns(1000u + 500u * static_cast<unsigned>(i));
+    k.pose().x_m(0.5 * i);
+    k.pose().y_m(0.125 - 0.25 * i);
+    k.pose().theta_rad(0.0625 * i);
+    m.keyframes().push_back(k);
+  }
+  msg::OptimisedLandmark l;
+  l.landmark_id(12);
+  l.x_m(2.5);
+  l.y_m(-1.25);
+  l.cov_xx_m2(0.01);
+  l.cov_xy_m2(-0.002);
+  l.cov_yy_m2(0.04);
+  l.observations(17);
+  m.landmarks().push_back(l);
+  l.landmark_id(13);
+  l.cov_xx_m2(std::numeric_limits<double>::quiet_NaN());
+  l.cov_xy_m2(std::numeric_limits<double>::quiet_NaN());
+  l.cov_yy_m2(std::numeric_limits<double>::quiet_NaN());
+  l.observations(1);
+  m.landmarks().push_back(l);
+  m.whole_problem(true);
+  m.converged(false);
+  m.iterations(23);
+  m.initial_cost(812.5);
+  m.final_cost(3.75);
+  m.solve_time_s(0.125);
+  m.cpu_time_s(7.5);
+  m.keyframes_free(6);
+  m.residuals(140);
+  m.odometry_sequence(88);
+  m.observation_sequence(41);
+  return m;
+}
+
 TEST(SpyFormat, OdometryAsJsonLineHasEveryFieldInIdlOrder) {
   EXPECT_EQ(to_json_line(to_value(odometry())),
             "{\"header\":{\"stamp_ns\":1700000000123456789,\"seq\":7,\"robot_id\":\"robot1\","
@@ -137,6 +185,94 @@ TEST(SpyFormat, GroundTruthFieldsCanBeFoundByPath) {
   ASSERT_NE(v.find("landmarks"), nullptr);
   EXPECT_EQ(v.find("landmarks")->items().size(), 2u);
   EXPECT_EQ(v.find("pose.nothing"), nullptr);
+}
+
+TEST(SpyFormat, OptimisedMapAsYamlDocumentHasEveryFieldInIdlOrder) {
+  EXPECT_EQ(to_yaml_document(to_value(optimised_map())),
+            "---\n"
+            "header:\n"
+            "  stamp_ns: 2000\n"
+            "  seq: 4\n"
+            "  robot_id: \"robot1\"\n"
+            "  frame_id: \"map\"\n"
+            "current_pose:\n"
+            "  x_m: 1.5\n"
+            "  y_m: 0\n"
+            "  theta_rad: 0.25\n"
+            "keyframe_count: 9\n"
+            "keyframes:\n"
+            "  - stamp_ns: 1000\n"
+            "    pose:\n"
+            "      x_m: 0\n"
+            "      y_m: 0.125\n"
+            "      theta_rad: 0\n"
+            "  - stamp_ns: 1500\n"
+            "    pose:\n"
+            "      x_m: 0.5\n"
+            "      y_m: -0.125\n"
+            "      theta_rad: 0.0625\n"
+            "landmarks:\n"
+            "  - landmark_id: 12\n"
+            "    x_m: 2.5\n"
+            "    y_m: -1.25\n"
+            "    cov_xx_m2: 0.01\n"
+            "    cov_xy_m2: -0.002\n"
+            "    cov_yy_m2: 0.04\n"
+            "    observations: 17\n"
+            "  - landmark_id: 13\n"
+            "    x_m: 2.5\n"
+            "    y_m: -1.25\n"
+            "    cov_xx_m2: .nan\n"
+            "    cov_xy_m2: .nan\n"
+            "    cov_yy_m2: .nan\n"
+            "    observations: 1\n"
+            "whole_problem: true\n"
+            "converged: false\n"
+            "iterations: 23\n"
+            "initial_cost: 812.5\n"
+            "final_cost: 3.75\n"
+            "solve_time_s: 0.125\n"
+            "cpu_time_s: 7.5\n"
+            "keyframes_free: 6\n"
+            "residuals: 140\n"
+            "odometry_sequence: 88\n"
+            "observation_sequence: 41\n");
+}
+
+TEST(SpyFormat, OptimisedMapAsJsonLine) {
+  const std::string json = to_json_line(to_value(optimised_map()));
+  EXPECT_EQ(json.rfind("{\"header\":{\"stamp_ns\":2000,\"seq\":4,\"robot_id\":\"robot1\",\"frame_id\":\"map\"},"
+                      "\"current_pose\":{\"x_m\":1.5,\"y_m\":0,\"theta_rad\":0.25},\"keyframe_count\":9,"
+                      "\"keyframes\":[{\"stamp_ns\":1000,",
+                      0),
+            0u)
+      << json;
+  // Booleans as JSON booleans, a NaN covariance as null, the statistics last.
+  EXPECT_NE(json.find("{\"landmark_id\":13,\"x_m\":2.5,\"y_m\":-1.25,\"cov_xx_m2\":null,\"cov_xy_m2\":null,"
+                      "\"cov_yy_m2\":null,\"observations\":1}],\"whole_problem\":true,\"converged\":false,"
+                      "\"iterations\":23,"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find(",\"residuals\":140,\"odometry_sequence\":88,\"observation_sequence\":41}"), std::string::npos)
+      << json;
+  const Value v = to_value(optimised_map());
+  ASSERT_NE(v.find("keyframes"), nullptr);
+  EXPECT_EQ(v.find("keyframes")->items().size(), 2u);
+  ASSERT_NE(v.find("converged"), nullptr);
+  EXPECT_EQ(v.find("converged")->kind(), Value::Kind::kBool);
+  EXPECT_FALSE(v.find("converged")->bool_value());
+  EXPECT_TRUE(v.find("whole_problem")->bool_value());
+}
+
+TEST(CompareValues, OptimisedMapBooleansAndLandmarksDiffer) {
+  msg::OptimisedMap changed = optimised_map();
+  EXPECT_TRUE(compare_values(to_value(optimised_map()), to_value(changed), {}, 0.0, 10).empty());
+  changed.converged(true);
+  changed.landmarks()[1].cov_yy_m2(0.5);
+  const auto lines = compare_values(to_value(optimised_map()), to_value(changed), {}, 0.0, 10);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0], "landmarks[1].cov_yy_m2: .nan != 0.5");
+  EXPECT_EQ(lines[1], "converged: false != true");
 }
 
 TEST(SpyFormat, StringsAreEscapedAndNonFiniteNumbersStayValid) {

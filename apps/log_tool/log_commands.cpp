@@ -302,6 +302,7 @@ bool decode_value(const std::string& topic, const std::vector<std::uint8_t>& byt
   if (topic == dds::kMapStateTopic) return decode_as<msg::MapState>(bytes, value, error);
   if (topic == dds::kGroundTruthTopic) return decode_as<msg::GroundTruth>(bytes, value, error);
   if (topic == dds::kDiagnosticsTopic) return decode_as<msg::Diagnostics>(bytes, value, error);
+  if (topic == dds::kOptimisedMapTopic) return decode_as<msg::OptimisedMap>(bytes, value, error);
   error = "not a topic of this project";
   return false;
 }

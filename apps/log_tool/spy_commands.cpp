@@ -238,10 +238,11 @@ int with_topic_type(const std::string& topic, Function f) {
   if (topic == dds::kMapStateTopic) return f(msg::MapState{});
   if (topic == dds::kGroundTruthTopic) return f(msg::GroundTruth{});
   if (topic == dds::kDiagnosticsTopic) return f(msg::Diagnostics{});
-  std::fprintf(stderr, "pixyslam_spy: unknown topic '%s'; known: %s, %s, %s, %s, %s\n", topic.c_str(),
+  if (topic == dds::kOptimisedMapTopic) return f(msg::OptimisedMap{});
+  std::fprintf(stderr, "pixyslam_spy: unknown topic '%s'; known: %s, %s, %s, %s, %s, %s\n", topic.c_str(),
                std::string(dds::kOdometryTopic).c_str(), std::string(dds::kLandmarkObservationTopic).c_str(),
                std::string(dds::kMapStateTopic).c_str(), std::string(dds::kGroundTruthTopic).c_str(),
-               std::string(dds::kDiagnosticsTopic).c_str());
+               std::string(dds::kDiagnosticsTopic).c_str(), std::string(dds::kOptimisedMapTopic).c_str());
   return 2;
 }
 

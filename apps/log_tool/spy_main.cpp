@@ -52,7 +52,7 @@ constexpr const char* kUsage =
     ", domain 0)\n"
     "             --domain N (overrides the file's domain_id)\n"
     "TOPIC: pixyslam/odometry, pixyslam/landmark_observation, pixyslam/map_state, pixyslam/ground_truth,\n"
-    "       pixyslam/diagnostics\n";
+    "       pixyslam/diagnostics, pixyslam/optimised_map\n";
 
 // TOPIC=N, N a non-negative integer.
 void add_expectation(const std::string& text, pixyslam::log_tool::CheckRequest& request) {

@@ -115,6 +115,10 @@ int run_live(const MapViewOptions& options, const LiveRequest& request) {
     shared.builder.add(g);
     shared.changed = true;
   });
+  dds::Reader<msg::OptimisedMap> optimised(participant, [&](const msg::OptimisedMap& m) {
+    std::lock_guard<std::mutex> lock(shared.mutex);
+    shared.changed = shared.builder.add(m) || shared.changed;
+  });
   std::fprintf(stderr, "map_view: listening on DDS domain %d; %s%s%s\n", options.dds.domain_id,
                window ? "window" : "no window", snapshots ? ", snapshots to " : "", snapshots ? latest.c_str() : "");
 
@@ -137,7 +141,8 @@ int run_live(const MapViewOptions& options, const LiveRequest& request) {
       if (!shared.changed && !image.empty()) return false;
       shared.changed = false;
       state = shared.builder.state();
-      have_state = shared.builder.map_states() > 0 || shared.builder.ground_truths() > 0;
+      have_state = shared.builder.map_states() > 0 || shared.builder.ground_truths() > 0 ||
+                   shared.builder.optimised_maps() > 0;
     }
     view.extend(content_bounds(state, render.sigma_scale, render.ground_truth));
     render.view = view;
@@ -177,9 +182,11 @@ int run_live(const MapViewOptions& options, const LiveRequest& request) {
     snapshot();
   }
   if (window) cv::destroyAllWindows();
-  std::fprintf(stderr, "map_view: stopped; %llu map states, %llu ground-truth messages received%s%s\n",
+  std::fprintf(stderr,
+               "map_view: stopped; %llu map states, %llu ground-truth messages, %llu optimised maps received%s%s\n",
                static_cast<unsigned long long>(maps.received()), static_cast<unsigned long long>(truth.received()),
-               snapshots ? "; last snapshot " : "", snapshots ? latest.c_str() : "");
+               static_cast<unsigned long long>(optimised.received()), snapshots ? "; last snapshot " : "",
+               snapshots ? latest.c_str() : "");
   return 0;
 }
 

@@ -1,5 +1,6 @@
 // map_view: the estimator's map as an image (seed paper Fig. 6b): particles,
-// mean trajectory, landmarks with n-sigma ellipses and ids, ground truth.
+// mean trajectory, landmarks with n-sigma ellipses and ids, ground truth, the
+// map optimiser's solution.
 //   map_view live   [--config FILE] [--out DIR] [--period S] [--no-window] [--domain N]
 //   map_view render LOG.mcap --out FILE.png [--config FILE] [--width N] [--height N] [--no-truth]
 //   map_view video  LOG.mcap --out FILE.avi|DIR [--config FILE] [--fps N] [--speed X]

@@ -32,9 +32,11 @@ int run_render(const MapViewOptions& options, const RenderRequest& request) {
   } catch (const std::runtime_error& e) {
     throw InputError(std::string("--out: ") + e.what());
   }
-  std::printf("map_view: %s: %zu map states, %zu ground-truth messages, %zu landmarks -> %s (%dx%d)\n",
-              request.log.c_str(), log.map_states().size(), log.ground_truths().size(), state.landmarks.size(),
-              request.out.c_str(), image.cols, image.rows);
+  const std::string optimised =
+      log.optimised_maps().empty() ? "" : ", " + std::to_string(log.optimised_maps().size()) + " optimised maps";
+  std::printf("map_view: %s: %zu map states, %zu ground-truth messages%s, %zu landmarks -> %s (%dx%d)\n",
+              request.log.c_str(), log.map_states().size(), log.ground_truths().size(), optimised.c_str(),
+              state.landmarks.size(), request.out.c_str(), image.cols, image.rows);
   return 0;
 }
 

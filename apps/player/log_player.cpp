@@ -72,6 +72,7 @@ std::unique_ptr<LogPlayer::Channel> make_channel(const std::string& topic, dds::
   if (topic == dds::kMapStateTopic) return std::make_unique<TypedChannel<msg::MapState>>(participant);
   if (topic == dds::kGroundTruthTopic) return std::make_unique<TypedChannel<msg::GroundTruth>>(participant);
   if (topic == dds::kDiagnosticsTopic) return std::make_unique<TypedChannel<msg::Diagnostics>>(participant);
+  if (topic == dds::kOptimisedMapTopic) return std::make_unique<TypedChannel<msg::OptimisedMap>>(participant);
   throw std::logic_error("no channel type for " + topic);
 }
 

@@ -1,6 +1,6 @@
 // libFuzzer target: arbitrary bytes as a received DDS sample of each topic.
 // The first byte picks the topic (PIXYSLAM_FUZZ_TOPIC pins one: 0 odometry, 1
-// landmark_observation, 2 map_state, 3 ground_truth, 4 diagnostics); the rest is the
+// landmark_observation, 2 map_state, 3 ground_truth, 4 diagnostics, 5 optimised_map); the rest is the
 // payload (encapsulation header and CDR). It goes through the readers' own
 // GuardedPubSubType::deserialize exactly as Fast DDS hands it over (no
 // pre-check of the encapsulation), which must never throw; then through the
@@ -84,6 +84,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     case 1: reader_decode<pixyslam::msg::LandmarkObservation>(payload); break;
     case 2: reader_decode<pixyslam::msg::MapState>(payload); break;
     case 4: reader_decode<pixyslam::msg::Diagnostics>(payload); break;
+    case 5: reader_decode<pixyslam::msg::OptimisedMap>(payload); break;
     default: reader_decode<pixyslam::msg::GroundTruth>(payload); break;
   }
   switch (topic) {
@@ -113,6 +114,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     case 4: {
       pixyslam::msg::Diagnostics m;
+      (void)from_cdr(payload, m, error);
+      break;
+    }
+    case 5: {
+      pixyslam::msg::OptimisedMap m;
       (void)from_cdr(payload, m, error);
       break;
     }

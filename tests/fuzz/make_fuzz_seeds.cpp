@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
   }
 
   // CDR payloads (first byte & 7: topic, 0 Odometry, 1 LandmarkObservation, 2 MapState, 3 GroundTruth,
-  // 4 Diagnostics).
+  // 4 Diagnostics, 5 OptimisedMap).
   const fs::path cdr = root / "fuzz_cdr_topics";
   const auto cdr_seed = [&](const std::string& name, std::uint8_t topic, const Bytes& payload) {
     Bytes b{topic};
@@ -140,6 +140,20 @@ int main(int argc, char** argv) {
   diagnostics.counters()[0].name("lines_rejected");
   diagnostics.counters()[0].value(3);
   cdr_seed("diagnostics", 4, logger_node::to_cdr(diagnostics));
+  msg::OptimisedMap optimised;
+  optimised.header(header(1, 1'000'000'000ull, "map"));
+  optimised.keyframe_count(2);
+  optimised.keyframes().resize(2);
+  optimised.keyframes()[1].stamp_ns(1'100'000'000ull);
+  optimised.keyframes()[1].pose().x_m(0.02);
+  optimised.landmarks().resize(1);
+  optimised.landmarks()[0].landmark_id(3);
+  optimised.landmarks()[0].x_m(2.0);
+  optimised.landmarks()[0].cov_xx_m2(0.01);
+  optimised.landmarks()[0].cov_yy_m2(0.01);
+  optimised.landmarks()[0].observations(4);
+  optimised.converged(true);
+  cdr_seed("optimised_map", 5, logger_node::to_cdr(optimised));
 
   // MCAP files: chunked and unchunked, with the project's schemas.
   const fs::path mcap = root / "fuzz_mcap_reader";

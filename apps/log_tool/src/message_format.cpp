@@ -24,6 +24,11 @@ Value Value::unsigned_integer(std::uint64_t v) {
   r.uint_ = v;
   return r;
 }
+Value Value::boolean(bool v) {
+  Value r(Kind::kBool);
+  r.uint_ = v ? 1 : 0;
+  return r;
+}
 Value Value::string(std::string v) {
   Value r(Kind::kString);
   r.text_ = std::move(v);
@@ -118,6 +123,24 @@ Value true_landmark_value(const msg::TrueLandmark& l) {
   return v;
 }
 
+Value keyframe_value(const msg::OptimisedKeyframe& k) {
+  Value v = Value::structure();
+  v.add("stamp_ns", Value::unsigned_integer(k.stamp_ns())).add("pose", pose_value(k.pose()));
+  return v;
+}
+
+Value optimised_landmark_value(const msg::OptimisedLandmark& l) {
+  Value v = Value::structure();
+  v.add("landmark_id", Value::integer(l.landmark_id()))
+      .add("x_m", Value::number(l.x_m()))
+      .add("y_m", Value::number(l.y_m()))
+      .add("cov_xx_m2", Value::number(l.cov_xx_m2()))
+      .add("cov_xy_m2", Value::number(l.cov_xy_m2()))
+      .add("cov_yy_m2", Value::number(l.cov_yy_m2()))
+      .add("observations", Value::unsigned_integer(l.observations()));
+  return v;
+}
+
 bool is_scalar(const Value& v) { return v.kind() != Value::Kind::kStruct && v.kind() != Value::Kind::kList; }
 
 // JSON string literal (also a valid YAML double-quoted scalar).
@@ -153,6 +176,7 @@ std::string scalar_text(const Value& v, bool json) {
     }
     case Value::Kind::kInt: return std::to_string(v.int_value());
     case Value::Kind::kUInt: return std::to_string(v.uint_value());
+    case Value::Kind::kBool: return v.bool_value() ? "true" : "false";
     case Value::Kind::kString: return quoted(v.string_value());
     default: return "";
   }
@@ -310,6 +334,27 @@ Value to_value(const msg::Diagnostics& m) {
   return v;
 }
 
+Value to_value(const msg::OptimisedMap& m) {
+  Value v = Value::structure();
+  v.add("header", header_value(m.header()))
+      .add("current_pose", pose_value(m.current_pose()))
+      .add("keyframe_count", Value::unsigned_integer(m.keyframe_count()))
+      .add("keyframes", list_of(m.keyframes(), keyframe_value))
+      .add("landmarks", list_of(m.landmarks(), optimised_landmark_value))
+      .add("whole_problem", Value::boolean(m.whole_problem()))
+      .add("converged", Value::boolean(m.converged()))
+      .add("iterations", Value::unsigned_integer(m.iterations()))
+      .add("initial_cost", Value::number(m.initial_cost()))
+      .add("final_cost", Value::number(m.final_cost()))
+      .add("solve_time_s", Value::number(m.solve_time_s()))
+      .add("cpu_time_s", Value::number(m.cpu_time_s()))
+      .add("keyframes_free", Value::unsigned_integer(m.keyframes_free()))
+      .add("residuals", Value::unsigned_integer(m.residuals()))
+      .add("odometry_sequence", Value::unsigned_integer(m.odometry_sequence()))
+      .add("observation_sequence", Value::unsigned_integer(m.observation_sequence()));
+  return v;
+}
+
 std::string diagnostics_table(std::vector<msg::Diagnostics> reports) {
   std::sort(reports.begin(), reports.end(), [](const msg::Diagnostics& a, const msg::Diagnostics& b) {
     return std::make_tuple(a.header().robot_id(), a.process(), a.pid()) <
@@ -387,6 +432,7 @@ bool same_scalar(const Value& a, const Value& b, double tolerance) {
     case Value::Kind::kInt:
       return a.int_value() == b.int_value();
     case Value::Kind::kUInt:
+    case Value::Kind::kBool:
       return a.uint_value() == b.uint_value();
     default:
       return a.string_value() == b.string_value();

@@ -12,7 +12,7 @@ namespace pixyslam::map_view {
 namespace {
 
 template <class Message>
-void decode_channel(const logger::McapReader& reader, const logger::McapChannel& channel, bool is_map_state,
+void decode_channel(const logger::McapReader& reader, const logger::McapChannel& channel, MapLog::Kind kind,
                     std::vector<Message>& out, std::vector<MapLog::Entry>& entries, std::size_t& undecodable) {
   typename dds::MessageTraits<Message>::PubSubType type;
   std::string error;
@@ -23,7 +23,7 @@ void decode_channel(const logger::McapReader& reader, const logger::McapChannel&
       ++undecodable;
       continue;
     }
-    entries.push_back({m.log_time_ns, is_map_state, out.size()});
+    entries.push_back({m.log_time_ns, kind, out.size()});
     out.push_back(std::move(sample));
   }
 }
@@ -48,6 +48,7 @@ MapLog MapLog::read(const std::string& path) {
   log.path_ = path;
   const std::string map_topic(dds::kMapStateTopic);
   const std::string truth_topic(dds::kGroundTruthTopic);
+  const std::string optimised_topic(dds::kOptimisedMapTopic);
   const logger::McapChannel* map_channel = reader->find_channel(map_topic);
   if (map_channel == nullptr) {
     std::string topics;
@@ -56,7 +57,7 @@ MapLog MapLog::read(const std::string& path) {
                      "); record it with the logger");
   }
   check_encoding(path, *map_channel);
-  decode_channel(*reader, *map_channel, true, log.map_states_, log.entries_, log.undecodable_);
+  decode_channel(*reader, *map_channel, Kind::kMapState, log.map_states_, log.entries_, log.undecodable_);
   if (log.map_states_.empty()) {
     throw InputError(path + ": no MapState message" +
                      (log.undecodable_ > 0 ? " that decodes (" + std::to_string(log.undecodable_) + " bad payloads)"
@@ -64,7 +65,12 @@ MapLog MapLog::read(const std::string& path) {
   }
   if (const logger::McapChannel* truth_channel = reader->find_channel(truth_topic)) {
     check_encoding(path, *truth_channel);
-    decode_channel(*reader, *truth_channel, false, log.ground_truths_, log.entries_, log.undecodable_);
+    decode_channel(*reader, *truth_channel, Kind::kGroundTruth, log.ground_truths_, log.entries_, log.undecodable_);
+  }
+  if (const logger::McapChannel* optimised_channel = reader->find_channel(optimised_topic)) {
+    check_encoding(path, *optimised_channel);
+    decode_channel(*reader, *optimised_channel, Kind::kOptimisedMap, log.optimised_maps_, log.entries_,
+                   log.undecodable_);
   }
   std::stable_sort(log.entries_.begin(), log.entries_.end(),
                    [](const Entry& a, const Entry& b) { return a.time_ns < b.time_ns; });
@@ -83,10 +89,10 @@ void LogPlayer::advance_to(std::uint64_t time_ns) {
   const std::vector<MapLog::Entry>& entries = log_.entries();
   while (next_ < entries.size() && entries[next_].time_ns <= time_ns) {
     const MapLog::Entry& e = entries[next_++];
-    if (e.is_map_state) {
-      builder_.add(log_.map_states()[e.index]);
-    } else {
-      builder_.add(log_.ground_truths()[e.index]);
+    switch (e.kind) {
+      case MapLog::Kind::kMapState: builder_.add(log_.map_states()[e.index]); break;
+      case MapLog::Kind::kGroundTruth: builder_.add(log_.ground_truths()[e.index]); break;
+      case MapLog::Kind::kOptimisedMap: builder_.add(log_.optimised_maps()[e.index]); break;
     }
   }
 }
@@ -106,6 +112,12 @@ WorldBox run_bounds(const MapLog& log, double sigma_scale, bool include_truth) {
     for (const msg::Pose2D& p : m.particle_poses()) one.particles.push_back(to_pose(p));
     one.current_pose = to_pose(m.mean_pose());
     one.landmarks = to_landmarks(m);
+    box.extend(content_bounds(one, sigma_scale, false));
+  }
+  for (const msg::OptimisedMap& m : log.optimised_maps()) {
+    MapViewState one;
+    one.optimised_trajectory = to_trajectory(m);
+    one.optimised_landmarks = to_landmarks(m);
     box.extend(content_bounds(one, sigma_scale, false));
   }
   if (include_truth) {

@@ -30,6 +30,32 @@ std::vector<TrueLandmarkView> to_true_landmarks(const msg::GroundTruth& truth) {
   return out;
 }
 
+LandmarkView to_landmark(const msg::OptimisedLandmark& l) {
+  LandmarkView v;
+  v.id = l.landmark_id();
+  v.x_m = l.x_m();
+  v.y_m = l.y_m();
+  v.cov_xx_m2 = l.cov_xx_m2();
+  v.cov_xy_m2 = l.cov_xy_m2();
+  v.cov_yy_m2 = l.cov_yy_m2();
+  v.times_observed = l.observations();
+  return v;
+}
+
+std::vector<LandmarkView> to_landmarks(const msg::OptimisedMap& map) {
+  std::vector<LandmarkView> out;
+  out.reserve(map.landmarks().size());
+  for (const msg::OptimisedLandmark& l : map.landmarks()) out.push_back(to_landmark(l));
+  return out;
+}
+
+std::vector<Point2> to_trajectory(const msg::OptimisedMap& map) {
+  std::vector<Point2> out;
+  out.reserve(map.keyframes().size());
+  for (const msg::OptimisedKeyframe& k : map.keyframes()) out.push_back({k.pose().x_m(), k.pose().y_m()});
+  return out;
+}
+
 void MapViewBuilder::note_stamp(std::uint64_t stamp_ns) {
   if (!have_start_ || stamp_ns < start_ns_) {
     start_ns_ = stamp_ns;
@@ -66,6 +92,19 @@ void MapViewBuilder::add(const msg::GroundTruth& g) {
   state_.true_pose = to_pose(g.pose());
   append_point(state_.true_trajectory, {g.pose().x_m(), g.pose().y_m()}, min_step_m_);
   if (!g.landmarks().empty() || state_.true_landmarks.empty()) state_.true_landmarks = to_true_landmarks(g);
+}
+
+bool MapViewBuilder::add(const msg::OptimisedMap& m) {
+  const std::uint64_t stamp = m.header().stamp_ns();
+  if (optimised_maps_ > 0 && stamp < last_optimised_ns_) return false;
+  note_stamp(stamp);
+  last_optimised_ns_ = stamp;
+  ++optimised_maps_;
+  // Each solution holds the whole trajectory: it replaces the one before.
+  state_.optimised_trajectory.clear();
+  for (const Point2& p : to_trajectory(m)) append_point(state_.optimised_trajectory, p, min_step_m_);
+  state_.optimised_landmarks = to_landmarks(m);
+  return true;
 }
 
 }  // namespace pixyslam::map_view

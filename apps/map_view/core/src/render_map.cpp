@@ -70,6 +70,17 @@ void cross(cv::Mat& img, const cv::Point2d& at, double half_px, const cv::Scalar
   line(img, at + cv::Point2d(-half_px, half_px), at + cv::Point2d(half_px, -half_px), colour, 2);
 }
 
+// An outlined diamond (a square on its corner): the optimised landmarks' marker.
+void diamond(cv::Mat& img, const cv::Point2d& at, double half_px, const cv::Scalar& colour) {
+  const std::vector<cv::Point> corners = {sub(at + cv::Point2d(0.0, -half_px)), sub(at + cv::Point2d(half_px, 0.0)),
+                                          sub(at + cv::Point2d(0.0, half_px)), sub(at + cv::Point2d(-half_px, 0.0))};
+  cv::polylines(img, corners, true, colour, 2, cv::LINE_AA, kShift);
+}
+
+bool finite_covariance(const LandmarkView& l) {
+  return std::isfinite(l.cov_xx_m2) && std::isfinite(l.cov_xy_m2) && std::isfinite(l.cov_yy_m2);
+}
+
 void landmark_ellipse(cv::Mat& img, const cv::Point2d& centre, const EllipseAxes& axes, double ppm,
                       const cv::Scalar& colour) {
   const cv::Size size(sub_length(axes.semi_major_m * ppm), sub_length(axes.semi_minor_m * ppm));
@@ -151,6 +162,17 @@ void draw_content(cv::Mat& map, const MapViewState& s, const ViewTransform& view
       text(map, std::to_string(l.id), {static_cast<int>(at.x) + 6, static_cast<int>(at.y) - 6}, 0.42, c.landmark);
     }
   }
+  // The map optimiser's solution over the filter's map (no ids: they are the filter's).
+  path(map, s.optimised_trajectory, view, c.optimised, 2);
+  for (const LandmarkView& l : s.optimised_landmarks) {
+    if (!finite(l.x_m, l.y_m)) continue;
+    const cv::Point2d at = view.to_pixel(l.x_m, l.y_m);
+    if (finite_covariance(l)) {
+      landmark_ellipse(map, at, covariance_ellipse(l.cov_xx_m2, l.cov_xy_m2, l.cov_yy_m2, o.sigma_scale), ppm,
+                       c.optimised);
+    }
+    diamond(map, at, 6.0, c.optimised);
+  }
   if (o.ground_truth && s.true_pose && finite(s.true_pose->x_m, s.true_pose->y_m) &&
       std::isfinite(s.true_pose->theta_rad)) {
     pose_arrow(map, view.to_pixel(s.true_pose->x_m, s.true_pose->y_m), s.true_pose->theta_rad, c.truth, false);
@@ -199,6 +221,12 @@ int draw_legend(cv::Mat& img, const MapViewState& s, const RenderOptions& o, int
     entry("ground truth", [&](double x0) {
       line(img, {x0, mid}, {x0 + sample_w, mid}, c.truth, 1);
       cross(img, {x0 + sample_w / 2.0, mid}, 4.0, c.truth);
+    });
+  }
+  if (!s.optimised_trajectory.empty() || !s.optimised_landmarks.empty()) {
+    entry("optimised", [&](double x0) {
+      line(img, {x0, mid}, {x0 + sample_w, mid}, c.optimised, 2);
+      diamond(img, {x0 + sample_w / 2.0, mid}, 5.0, c.optimised);
     });
   }
   return x;

@@ -97,6 +97,10 @@ WorldBox content_bounds(const MapViewState& state, double sigma_scale, bool incl
   for (const LandmarkView& l : state.landmarks) {
     if (std::isfinite(l.x_m) && std::isfinite(l.y_m)) box.extend(ellipse_bounds(l, sigma_scale));
   }
+  for (const Point2& p : state.optimised_trajectory) box.extend(p.x_m, p.y_m);
+  for (const LandmarkView& l : state.optimised_landmarks) {
+    if (std::isfinite(l.x_m) && std::isfinite(l.y_m)) box.extend(ellipse_bounds(l, sigma_scale));
+  }
   if (include_truth) {
     for (const Point2& p : state.true_trajectory) box.extend(p.x_m, p.y_m);
     if (state.true_pose) box.extend(state.true_pose->x_m, state.true_pose->y_m);

@@ -98,6 +98,8 @@ LoggerNode::LoggerNode(const LoggerOptions& options) : options_(options) {
       subscribe<msg::GroundTruth>(i);
     } else if (name == dds::kDiagnosticsTopic) {
       subscribe<msg::Diagnostics>(i);
+    } else if (name == dds::kOptimisedMapTopic) {
+      subscribe<msg::OptimisedMap>(i);
     } else {
       throw std::logic_error("logger: no reader for topic '" + name + "'");
     }

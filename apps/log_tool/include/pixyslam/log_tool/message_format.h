@@ -10,6 +10,7 @@
 #include "landmark_observation.h"
 #include "map_state.h"
 #include "odometry.h"
+#include "optimised_map.h"
 
 namespace pixyslam::log_tool {
 
@@ -18,11 +19,12 @@ namespace pixyslam::log_tool {
 // e.g. `v_mps`). Plain value type, no DDS; thread-compatible.
 class Value {
  public:
-  enum class Kind { kFloat, kInt, kUInt, kString, kStruct, kList };
+  enum class Kind { kFloat, kInt, kUInt, kBool, kString, kStruct, kList };
 
   static Value number(double v);
   static Value integer(std::int64_t v);
   static Value unsigned_integer(std::uint64_t v);
+  static Value boolean(bool v);
   static Value string(std::string v);
   static Value structure() { return Value(Kind::kStruct); }
   static Value list() { return Value(Kind::kList); }
@@ -35,6 +37,7 @@ class Value {
   double float_value() const { return float_; }
   std::int64_t int_value() const { return int_; }
   std::uint64_t uint_value() const { return uint_; }
+  bool bool_value() const { return uint_ != 0; }
   const std::string& string_value() const { return text_; }
   const std::vector<std::pair<std::string, Value>>& fields() const { return fields_; }
   const std::vector<Value>& items() const { return items_; }
@@ -46,7 +49,7 @@ class Value {
   Kind kind_;
   double float_ = 0.0;
   std::int64_t int_ = 0;
-  std::uint64_t uint_ = 0;
+  std::uint64_t uint_ = 0;  // also a boolean's value (0 or 1)
   std::string text_;
   std::vector<std::pair<std::string, Value>> fields_;
   std::vector<Value> items_;
@@ -58,6 +61,7 @@ Value to_value(const msg::LandmarkObservation& m);
 Value to_value(const msg::MapState& m);
 Value to_value(const msg::GroundTruth& m);
 Value to_value(const msg::Diagnostics& m);
+Value to_value(const msg::OptimisedMap& m);
 
 // One report per process (sorted by robot, process, pid): a line "robot process
 // (pid P): LEVEL, up S s[: status]", then its counters, wrapped at 100 columns.

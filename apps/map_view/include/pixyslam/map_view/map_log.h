@@ -8,6 +8,7 @@
 
 #include "ground_truth.h"
 #include "map_state.h"
+#include "optimised_map.h"
 #include "pixyslam/map_view/msg_conversion.h"
 #include "pixyslam/map_view/view_transform.h"
 
@@ -19,17 +20,18 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// The MapState and GroundTruth messages of an MCAP log (the logger's run.mcap),
-// decoded, in log-time order (MCAP log_time, ties in file order). Other
+// The MapState, GroundTruth and OptimisedMap messages of an MCAP log (the
+// logger's run.mcap), decoded, in log-time order (MCAP log_time, ties in file order). Other
 // topics are ignored; payloads that do not decode are skipped and counted. A
 // file cut short (killed logger) is read as far as it is complete. Immutable
 // after read(); thread-safe for const use.
 class MapLog {
  public:
+  enum class Kind { kMapState, kGroundTruth, kOptimisedMap };
   struct Entry {
     std::uint64_t time_ns = 0;
-    bool is_map_state = false;
-    std::size_t index = 0;  // into map_states() or ground_truths()
+    Kind kind = Kind::kMapState;
+    std::size_t index = 0;  // into map_states(), ground_truths() or optimised_maps()
   };
 
   // Throws InputError naming the file: unreadable or not MCAP, no
@@ -40,6 +42,7 @@ class MapLog {
   const std::vector<Entry>& entries() const { return entries_; }
   const std::vector<msg::MapState>& map_states() const { return map_states_; }
   const std::vector<msg::GroundTruth>& ground_truths() const { return ground_truths_; }
+  const std::vector<msg::OptimisedMap>& optimised_maps() const { return optimised_maps_; }
   std::size_t undecodable() const { return undecodable_; }
   // "" for a complete file, else what the reader had to skip (one line).
   const std::string& recovery_note() const { return recovery_note_; }
@@ -51,6 +54,7 @@ class MapLog {
   std::vector<Entry> entries_;
   std::vector<msg::MapState> map_states_;
   std::vector<msg::GroundTruth> ground_truths_;
+  std::vector<msg::OptimisedMap> optimised_maps_;
   std::size_t undecodable_ = 0;
   std::string recovery_note_;
 };
@@ -76,7 +80,8 @@ class LogPlayer {
 MapViewState final_state(const MapLog& log, double trajectory_min_step_m);
 
 // Bounds of everything drawn at any time of the run (every particle subsample,
-// pose, landmark ellipse, and with include_truth the ground truth): a fixed
+// pose, landmark ellipse, optimised solution, and with include_truth the
+// ground truth): a fixed
 // view under which a video's frame does not jump.
 WorldBox run_bounds(const MapLog& log, double sigma_scale, bool include_truth);
 

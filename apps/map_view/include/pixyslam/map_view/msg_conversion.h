@@ -6,6 +6,7 @@
 
 #include "map_state.h"
 #include "ground_truth.h"
+#include "optimised_map.h"
 #include "pixyslam/map_view/map_view_state.h"
 
 namespace pixyslam::map_view {
@@ -15,12 +16,17 @@ Pose2 to_pose(const msg::Pose2D& pose);
 LandmarkView to_landmark(const msg::LandmarkEstimate& landmark);
 std::vector<LandmarkView> to_landmarks(const msg::MapState& state);
 std::vector<TrueLandmarkView> to_true_landmarks(const msg::GroundTruth& truth);
+LandmarkView to_landmark(const msg::OptimisedLandmark& landmark);  // times_observed = observations
+std::vector<LandmarkView> to_landmarks(const msg::OptimisedMap& map);
+std::vector<Point2> to_trajectory(const msg::OptimisedMap& map);    // the keyframes' positions
 
-// Builds the MapViewState from a stream of MapState and GroundTruth messages:
-// the latest map, particles and poses, and the mean and true trajectories
-// accumulated so far (decimated by `trajectory_min_step_m`). A MapState
-// stamped before the last one taken (a late joiner's stale state) is ignored.
-// Caption times are relative to the first stamp of either kind.
+// Builds the MapViewState from a stream of MapState, OptimisedMap and
+// GroundTruth messages: the latest map, particles and poses, and the mean and
+// true trajectories accumulated so far (decimated by `trajectory_min_step_m`);
+// the latest optimised solution (its keyframes, decimated alike, and
+// landmarks) replaces the one before. A MapState or OptimisedMap stamped
+// before the last one of its kind taken (a late joiner's stale state) is
+// ignored. Caption times are relative to the first stamp of any kind.
 // Thread-compatible (the live view guards it with a mutex).
 class MapViewBuilder {
  public:
@@ -29,10 +35,13 @@ class MapViewBuilder {
   // False if the message was ignored (older than the last MapState).
   bool add(const msg::MapState& state);
   void add(const msg::GroundTruth& truth);
+  // False if the message was ignored (older than the last OptimisedMap).
+  bool add(const msg::OptimisedMap& map);
 
   const MapViewState& state() const { return state_; }
   std::size_t map_states() const { return map_states_; }
   std::size_t ground_truths() const { return ground_truths_; }
+  std::size_t optimised_maps() const { return optimised_maps_; }
 
  private:
   void note_stamp(std::uint64_t stamp_ns);
@@ -41,9 +50,11 @@ class MapViewBuilder {
   MapViewState state_;
   std::size_t map_states_ = 0;
   std::size_t ground_truths_ = 0;
+  std::size_t optimised_maps_ = 0;
   bool have_start_ = false;
   std::uint64_t start_ns_ = 0;
   std::uint64_t last_map_ns_ = 0;
+  std::uint64_t last_optimised_ns_ = 0;
 };
 
 }  // namespace pixyslam::map_view

@@ -39,9 +39,9 @@ struct TrueLandmarkView {
 };
 
 // Everything the map view draws, as plain values: what the estimator's
-// MapState and the simulator's GroundTruth say, plus the trajectories
-// accumulated so far. Empty vectors / unset optionals are simply not drawn;
-// non-finite values are skipped.
+// MapState, the map optimiser's OptimisedMap and the simulator's GroundTruth
+// say, plus the trajectories accumulated so far. Empty vectors / unset
+// optionals are simply not drawn; non-finite values are skipped.
 struct MapViewState {
   std::vector<Pose2> particles;           // the (subsampled) particle poses
   std::vector<Point2> mean_trajectory;    // the weighted mean position after every update so far
@@ -50,6 +50,8 @@ struct MapViewState {
   std::vector<Point2> true_trajectory;    // ground truth path (optional)
   std::optional<Pose2> true_pose;         // ground truth pose now (optional)
   std::vector<TrueLandmarkView> true_landmarks;
+  std::vector<Point2> optimised_trajectory;       // the map optimiser's keyframes (optional)
+  std::vector<LandmarkView> optimised_landmarks;  // its landmarks; non-finite covariance: no ellipse
   std::string caption;                    // one line under the map, e.g. "t = 12.3 s  ..."
 };
 

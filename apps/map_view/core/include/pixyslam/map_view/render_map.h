@@ -10,7 +10,8 @@
 namespace pixyslam::map_view {
 
 // Colours (BGR). The defaults follow Fig. 6b of the seed paper: mean trajectory
-// blue, landmark covariance red; ground truth green.
+// blue, landmark covariance red; ground truth green; the map optimiser's
+// solution orange.
 struct MapColours {
   cv::Scalar background{255, 255, 255};
   cv::Scalar grid{228, 228, 228};
@@ -21,6 +22,7 @@ struct MapColours {
   cv::Scalar pose{120, 30, 0};
   cv::Scalar landmark{20, 20, 210};
   cv::Scalar truth{40, 150, 40};
+  cv::Scalar optimised{0, 140, 240};
 };
 
 // How render_map draws. Sizes are pixels of the whole image; the map area is
@@ -61,10 +63,11 @@ double nice_grid_step_m(double pixels_per_metre, double min_px);
 // Draws the map (CV_8UC3, options.width_px x options.height_px): metric grid
 // with labels, ground truth (path, true landmarks as crosses, true pose as an
 // outlined arrow), particles as dots, the mean trajectory as a line, landmarks
-// as filled dots with their n-sigma ellipses and ids, the current pose as a
-// filled arrow, then the footer: a legend row (items present only, those that
-// fit), then the caption with the scale bar on its right (a footer under 40 px
-// has no legend row). Pure and single-threaded: same input, same pixels. Throws
+// as filled dots with their n-sigma ellipses and ids, the optimised trajectory
+// as a line and its landmarks as outlined diamonds with n-sigma ellipses (only
+// finite covariances), the current pose as a filled arrow, then the footer: a
+// legend row (items present only, those that fit), then the caption with the
+// scale bar on its right (a footer under 40 px has no legend row). Pure and single-threaded: same input, same pixels. Throws
 // std::invalid_argument for options that fail validate().
 cv::Mat render_map(const MapViewState& state, const RenderOptions& options);
 

@@ -65,9 +65,9 @@ EllipseAxes covariance_ellipse(double cov_xx_m2, double cov_xy_m2, double cov_yy
 // Bounding box of the n-sigma ellipse (exact: +/- n*sqrt(cov_xx), n*sqrt(cov_yy)).
 WorldBox ellipse_bounds(const LandmarkView& landmark, double sigma_scale);
 
-// Bounding box of everything drawn: particles, both trajectories and poses,
-// landmark means with their n-sigma ellipses, true landmarks. With
-// `include_truth` false the ground truth is left out.
+// Bounding box of everything drawn: particles, every trajectory and pose,
+// landmark means with their n-sigma ellipses (the optimised ones too), true
+// landmarks. With `include_truth` false the ground truth is left out.
 WorldBox content_bounds(const MapViewState& state, double sigma_scale, bool include_truth = true);
 
 }  // namespace pixyslam::map_view
