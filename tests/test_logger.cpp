@@ -589,7 +589,7 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
       ASSERT_TRUE(truth_writer.publish(truths_sent.back()));
     }
     if (i % 50 == 0) {
-      // Keep-last 4 (the optimiser's pace: one solution per solve): spaced out
+      // Keep-last 64 (the optimiser's pace: one solution per solve): spaced out
       // like the MapStates above.
       optimised_sent.push_back(optimised_map(i / 50));
       ASSERT_TRUE(optimised_writer.publish(optimised_sent.back()));
