@@ -5,10 +5,6 @@
 
 namespace pixyslam::offline {
 
-// The map optimiser over a whole run after the filter (slam_offline --optimise,
-// mrclam_eval --optimise): the same input in the filter's order, keyframes
-// started from the filter's poses at the camera frames and landmarks from its
-// map, one solve of the whole problem at the end.
 // The live process's solves as the data come (map_optimizer): the newest
 // window_keyframes every window_period_s of data, the whole problem every
 // whole_period_s; 0 turns either off. The whole problem is solved at the end
@@ -30,6 +26,11 @@ struct OptimisedRun {
   map_optimizer::OptimizerCounters counters;
   bool landmark_covariances = false;
 };
+
+// The map optimiser over a whole run after the filter (slam_offline --optimise,
+// mrclam_eval --optimise): the same input in the filter's order, keyframes
+// started from the filter's poses at the camera frames and landmarks from its
+// map, one solve of the whole problem at the end (and on the way as `schedule` says).
 OptimisedRun optimise_run(const slam::FilterOptions& options, const RunInput& input, const RunResult& filter,
                           const OptimiseSchedule& schedule = {});
 
