@@ -75,10 +75,11 @@ int run(int argc, char** argv) {
     if (used != args[key].size() || !(v >= 0.0)) throw std::invalid_argument(std::string("--") + key + ": not a number >= 0");
     return v;
   };
-  offline::OptimiseSchedule schedule;
-  schedule.window_period_s = number("window-period", 1.0);
-  schedule.window_keyframes = static_cast<std::size_t>(number("window-keyframes", 100.0));
-  schedule.whole_period_s = number("whole-period", 10.0);
+  map_optimizer::SolveScheduleOptions schedule;  // the live process's defaults
+  schedule.window_period_s = number("window-period", schedule.window_period_s);
+  schedule.window_keyframes =
+      static_cast<std::size_t>(number("window-keyframes", static_cast<double>(schedule.window_keyframes)));
+  schedule.whole_period_s = number("whole-period", schedule.whole_period_s);
 
   config::YamlReader root = config::YamlReader::from_file(args["config"]);
   config::YamlReader filter_yaml = root.child("filter");

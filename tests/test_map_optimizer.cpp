@@ -3,6 +3,7 @@
 // solution, a window solve holds what is outside it, bad input is counted and
 // dropped, and on the simulated robot the optimised map and trajectory are at
 // least as good as the filter's, also after a blind stretch with a heading bias.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -169,6 +170,26 @@ TEST(MapOptimizer, OptionsAreValidatedByName) {
   o.keyframe_interval_s = kNan;
   EXPECT_THROW(validate(o), std::invalid_argument);
   EXPECT_THROW(MapOptimizer(MapOptimizerOptions(), slam::Pose2(kNan, 0.0, 0.0), 0.0), std::invalid_argument);
+}
+
+TEST(SolveSchedule, WholeEveryPeriodElseWindowAndZeroTurnsASolveOff) {
+  SolveSchedule live({100, 1.0, 10.0}, 100.0);
+  std::vector<SolveKind> kinds;
+  for (int i = 0; i <= 80; ++i) kinds.push_back(live.due(100.0 + 0.25 * i));  // to 120 s
+  const auto count = [&](SolveKind k) { return std::count(kinds.begin(), kinds.end(), k); };
+  EXPECT_EQ(count(SolveKind::kWhole), 2);   // at 110 and 120 s
+  EXPECT_EQ(count(SolveKind::kWindow), 18);  // every second but those
+  EXPECT_EQ(kinds[0], SolveKind::kNone);     // nothing at the start
+  EXPECT_EQ(live.due(120.5), SolveKind::kNone);  // the whole solve at 120 restarted the window period
+  EXPECT_EQ(live.due(121.0), SolveKind::kWindow);
+
+  SolveSchedule off(SolveScheduleOptions::at_end_only(), 0.0);
+  for (double t = 0.0; t < 100.0; t += 0.5) ASSERT_EQ(off.due(t), SolveKind::kNone);
+  SolveSchedule windows_only({50, 2.0, 0.0}, 0.0);
+  EXPECT_EQ(windows_only.due(1.0), SolveKind::kNone);
+  EXPECT_EQ(windows_only.due(2.0), SolveKind::kWindow);
+  EXPECT_EQ(windows_only.due(1000.0), SolveKind::kWindow);  // a gap in the data: one solve, not a backlog
+  EXPECT_EQ(windows_only.due(1001.0), SolveKind::kNone);
 }
 
 TEST(MapOptimizer, LandmarkCovariancesShrinkWithMoreObservations) {

@@ -198,7 +198,7 @@ TEST(OptimizerNodeOptions, ShippedConfigTakesTheEstimatorsModels) {
   EXPECT_EQ(o.optimizer.bearing_sigma_rad, e.filter.bearing_sigma_rad);
   EXPECT_EQ(o.initial_pose, e.initial_pose);
   EXPECT_EQ(o.dds.domain_id, e.dds.domain_id);
-  EXPECT_EQ(o.window_keyframes, 100u);
+  EXPECT_EQ(o.schedule.window_keyframes, 100u);
 }
 
 TEST(OptimizerNodeOptions, ErrorsNameTheFileAndKey) {

@@ -6,7 +6,7 @@
 namespace pixyslam::offline {
 
 OptimisedRun optimise_run(const slam::FilterOptions& options, const RunInput& input, const RunResult& filter,
-                          const OptimiseSchedule& schedule) {
+                          const map_optimizer::SolveScheduleOptions& schedule) {
   OptimisedRun out;
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_seconds();
@@ -18,18 +18,16 @@ OptimisedRun optimise_run(const slam::FilterOptions& options, const RunInput& in
   std::vector<double> times;
   anchors.reserve(filter.trajectory.size());
   times.reserve(filter.trajectory.size());
-  double next_window = input.start_time_s + schedule.window_period_s;
-  double next_whole = input.start_time_s + schedule.whole_period_s;
+  map_optimizer::SolveSchedule due(schedule, input.start_time_s);
   auto record = [&](double t) {
     anchors.push_back(optimizer.anchor_now());
     times.push_back(t);
-    if (schedule.whole_period_s > 0.0 && t >= next_whole) {
-      out.whole_solves.push_back(optimizer.solve());
-      next_whole = t + schedule.whole_period_s;
-      next_window = t + schedule.window_period_s;
-    } else if (schedule.window_period_s > 0.0 && t >= next_window) {
-      out.window_solves.push_back(optimizer.solve(schedule.window_keyframes));
-      next_window = t + schedule.window_period_s;
+    switch (due.due(t)) {
+      case map_optimizer::SolveKind::kWhole: out.whole_solves.push_back(optimizer.solve()); break;
+      case map_optimizer::SolveKind::kWindow:
+        out.window_solves.push_back(optimizer.solve(schedule.window_keyframes));
+        break;
+      case map_optimizer::SolveKind::kNone: break;
     }
   };
   for_each_step(

@@ -54,8 +54,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "map_optimizer: keyframe every %.2f s at most, window of %zu keyframes every %.1f s, whole problem "
                  "every %.1f s; DDS domain %d, profiles '%s'\n",
-                 options.optimizer.keyframe_interval_s, options.window_keyframes, options.window_period_s,
-                 options.whole_period_s, options.dds.domain_id, options.dds.profiles_file.c_str());
+                 options.optimizer.keyframe_interval_s, options.schedule.window_keyframes, options.schedule.window_period_s,
+                 options.schedule.whole_period_s, options.dds.domain_id, options.dds.profiles_file.c_str());
     map_optimizer_node::OptimizerNode node(options);
     node.start();
     while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {

@@ -329,4 +329,22 @@ slam::Pose2 MapOptimizer::pose_of(const PoseAnchor& anchor) const {
                      slam::wrap_angle(b[2] + anchor.relative.z()));
 }
 
+SolveSchedule::SolveSchedule(const SolveScheduleOptions& options, double start_s)
+    : options_(options),
+      next_window_s_(start_s + options.window_period_s),
+      next_whole_s_(start_s + options.whole_period_s) {}
+
+SolveKind SolveSchedule::due(double t_s) {
+  if (options_.whole_period_s > 0.0 && t_s >= next_whole_s_) {
+    next_whole_s_ = t_s + options_.whole_period_s;
+    next_window_s_ = t_s + options_.window_period_s;
+    return SolveKind::kWhole;
+  }
+  if (options_.window_period_s > 0.0 && t_s >= next_window_s_) {
+    next_window_s_ = t_s + options_.window_period_s;
+    return SolveKind::kWindow;
+  }
+  return SolveKind::kNone;
+}
+
 }  // namespace pixyslam::map_optimizer

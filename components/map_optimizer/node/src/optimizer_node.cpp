@@ -143,8 +143,7 @@ void OptimizerNode::step(const slam::SensorInput& input) {
   if (!optimizer_) {
     epoch_ns_ = inbox_.epoch_ns();
     optimizer_ = std::make_unique<map_optimizer::MapOptimizer>(options_.optimizer, options_.initial_pose, t);
-    next_window_s_ = t + options_.window_period_s;
-    next_whole_s_ = t + options_.whole_period_s;
+    schedule_.emplace(options_.schedule, t);
   }
   {
     std::lock_guard<std::mutex> filter_lock(filter_mutex_);
@@ -173,19 +172,13 @@ void OptimizerNode::step(const slam::SensorInput& input) {
   }
   last_t_s_ = std::max(last_t_s_, t);
   dirty_ = true;
-  if (t >= next_whole_s_) {
-    solve(true);
-    next_whole_s_ = t + options_.whole_period_s;
-    next_window_s_ = t + options_.window_period_s;
-  } else if (t >= next_window_s_) {
-    solve(false);
-    next_window_s_ = t + options_.window_period_s;
-  }
+  const map_optimizer::SolveKind due = schedule_->due(t);
+  if (due != map_optimizer::SolveKind::kNone) solve(due == map_optimizer::SolveKind::kWhole);
 }
 
 void OptimizerNode::solve(bool whole) {
   const map_optimizer::SolveSummary s =
-      whole ? optimizer_->solve() : optimizer_->solve(options_.window_keyframes);
+      whole ? optimizer_->solve() : optimizer_->solve(options_.schedule.window_keyframes);
   if (whole) {
     optimizer_->compute_landmark_covariances();
     ++counters_.whole_solves;

@@ -24,9 +24,10 @@ OptimizerNodeOptions read_optimizer_node_options_file(const std::string& path) {
   m.keyframe_interval_s = y.number("keyframe_interval_s", 0.01, 3600.0, m.keyframe_interval_s);
   m.huber_threshold = y.number("huber_threshold", 1e-3, 1e6, m.huber_threshold);
   m.max_iterations = static_cast<int>(y.integer("max_iterations", 1, 10000, m.max_iterations));
-  o.window_keyframes = static_cast<std::size_t>(y.integer("window_keyframes", 1, 1000000, 100));
-  o.window_period_s = y.number("window_period_s", 0.01, 3600.0, o.window_period_s);
-  o.whole_period_s = y.number("whole_period_s", 0.01, 86400.0, o.whole_period_s);
+  o.schedule.window_keyframes = static_cast<std::size_t>(
+      y.integer("window_keyframes", 1, 1000000, static_cast<std::int64_t>(o.schedule.window_keyframes)));
+  o.schedule.window_period_s = y.number("window_period_s", 0.01, 3600.0, o.schedule.window_period_s);
+  o.schedule.whole_period_s = y.number("whole_period_s", 0.01, 86400.0, o.schedule.whole_period_s);
   o.published_keyframes = static_cast<int>(y.integer("published_keyframes", 2, 8192, o.published_keyframes));
   o.status_period_s = y.number("status_period_s", 0.0, 3600.0, o.status_period_s);
   y.finish();

@@ -170,4 +170,32 @@ class MapOptimizer {
   OptimizerCounters counters_;
 };
 
+// When to solve while the data come (the map_optimizer process and
+// bench_map_optimizer share it): the whole problem every whole_period_s of data
+// time, else the newest window_keyframes every window_period_s. A period of 0
+// turns that solve off; the caller solves the whole problem at the end.
+struct SolveScheduleOptions {
+  std::size_t window_keyframes = 100;  // the newest keyframes a window solve frees
+  double window_period_s = 1.0;        // data time between window solves
+  double whole_period_s = 10.0;        // data time between whole-problem solves
+  // No solve on the way: only the caller's solve at the end.
+  static SolveScheduleOptions at_end_only() { return {100, 0.0, 0.0}; }
+};
+
+enum class SolveKind { kNone, kWindow, kWhole };
+
+class SolveSchedule {
+ public:
+  SolveSchedule(const SolveScheduleOptions& options, double start_s);
+  // The solve due once the data reach t_s; a whole solve also restarts the
+  // window period (it solved the window too).
+  SolveKind due(double t_s);
+  const SolveScheduleOptions& options() const { return options_; }
+
+ private:
+  SolveScheduleOptions options_;
+  double next_window_s_;
+  double next_whole_s_;
+};
+
 }  // namespace pixyslam::map_optimizer

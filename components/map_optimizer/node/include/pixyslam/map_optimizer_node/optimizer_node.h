@@ -4,6 +4,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
@@ -26,9 +27,7 @@ struct OptimizerNodeOptions {
   slam::Pose2 initial_pose = slam::Pose2::Zero();  // the estimator's start pose (its config)
   slam::SensorQueueOptions queue;                // the estimator's delays
   bool use_detection_sigmas = true;              // as the estimator
-  std::size_t window_keyframes = 100;            // the newest keyframes a window solve frees
-  double window_period_s = 1.0;                  // data time between window solves
-  double whole_period_s = 10.0;                  // data time between whole-problem solves
+  map_optimizer::SolveScheduleOptions schedule;  // window and whole-problem solves as the data come
   int published_keyframes = 2000;                // OptimisedMap.keyframes at most (<= 8192)
   double status_period_s = 10.0;                 // counters to the log every so often (0: never)
   dds::DdsOptions dds;
@@ -107,8 +106,7 @@ class OptimizerNode {
   std::unique_ptr<map_optimizer::MapOptimizer> optimizer_;
   std::uint64_t epoch_ns_ = 0;  // the inbox's, from the first input on
   double last_t_s_ = 0.0;
-  double next_window_s_ = 0.0;
-  double next_whole_s_ = 0.0;
+  std::optional<map_optimizer::SolveSchedule> schedule_;  // from the first input's time
   bool dirty_ = false;  // input since the last solve
   std::uint64_t last_odometry_seq_ = 0;
   std::uint64_t last_observation_seq_ = 0;
