@@ -13,8 +13,8 @@
 // (comments kept), checked by the bridge's own option reader.
 //   pixyslam_calibrate noise --mrclam DIR --robot N --config BASE.yaml --out FILE.yaml [--ground-truth]
 //                            [--fit-range-scale] [--keys LIST]
-// noise: the odometry noise densities, range and bearing sigmas, range scale and
-// command lag of a robot from the filter's own innovations over a recording
+// noise: the odometry noise densities, range and bearing sigmas, range scale,
+// the range's cos-bearing exponent and command lag of a robot from the filter's own innovations over a recording
 // (repeated filter passes, never the ground truth); BASE with those keys
 // replaced. --ground-truth also fits them against the ground truth and prints
 // both with their relative difference.
@@ -53,10 +53,11 @@ constexpr const char* kUsage =
     "                                   --config ENCODER_BRIDGE.yaml [--out FILE]\n"
     "       pixyslam_calibrate noise --mrclam DIR --robot N --config BASE.yaml --out FILE.yaml [--ground-truth]\n"
     "                                [--fit-range-scale] [--keys v_sigma,w_sigma,range_sigma,bearing_sigma,...]\n"
-    "           (odometry noise densities, range/bearing sigmas, command lag (and with --fit-range-scale\n"
-    "            the range scale) from the filter's innovations, without ground truth; --ground-truth\n"
-    "            also fits them with it and prints both with the relative difference; --keys: write only\n"
-    "            these of v_sigma, w_sigma, range_sigma, bearing_sigma, range_scale, odometry_delay)\n";
+    "           (odometry noise densities, range/bearing sigmas, the range's cos-bearing exponent, command\n"
+    "            lag (and with --fit-range-scale the range scale) from the filter's innovations, without\n"
+    "            ground truth; --ground-truth also fits them with it and prints both with the relative\n"
+    "            difference; --keys: write only these of v_sigma, w_sigma, range_sigma, bearing_sigma,\n"
+    "            range_scale, range_exponent, odometry_delay)\n";
 
 std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -211,9 +212,9 @@ std::string rounded(double value) {
 
 void print_parameters(const char* title, const calibration::NoiseParameters& p) {
   std::printf("%s: v_sigma %.5f m/sqrt(s), w_sigma %.5f rad/sqrt(s), range_sigma %.4f m, bearing_sigma %.4f rad, "
-              "range_scale %.4f, odometry_delay %.3f s\n",
+              "range_scale %.4f, range_cos_bearing_exponent %.3f, odometry_delay %.3f s\n",
               title, p.v_sigma_m_per_sqrt_s, p.w_sigma_rad_per_sqrt_s, p.range_sigma_m, p.bearing_sigma_rad,
-              p.range_scale, p.odometry_delay_s);
+              p.range_scale, p.range_cos_bearing_exponent, p.odometry_delay_s);
 }
 
 int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_scale) {
@@ -229,9 +230,11 @@ int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_s
   start.range_sigma_m = base.range_sigma_m;
   start.bearing_sigma_rad = base.bearing_sigma_rad;
   start.range_scale = model.range_scale;
+  start.range_cos_bearing_exponent = model.range_cos_bearing_exponent;
   start.odometry_delay_s = model.odometry_delay_s;
-  // The calibration applies its own range scale and delay to the raw input.
+  // The calibration applies its own range model and delay to the raw input.
   model.range_scale = 1.0;
+  model.range_cos_bearing_exponent = 0.0;
   model.odometry_delay_s = 0.0;
 
   const double robot = args.number("robot", 0.0);
@@ -251,13 +254,17 @@ int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_s
   noise_options.fit_range_scale = fit_range_scale;
   const calibration::NoiseCalibration result = calibration::calibrate_noise(
       blind, base, start, noise_options, [&](const calibration::NoiseIteration& it) {
-        char title[96];
-        std::snprintf(title, sizeof title, "pass %d (%zu innovations, %zu outliers, mean NIS %.2f)", ++pass,
-                      it.statistics.innovations, it.statistics.outliers, it.statistics.mean_nis);
+        char title[128];
+        std::snprintf(title, sizeof title, "pass %d (%zu innovations, %zu outliers, mean NIS %.2f, log-lik %.3f)",
+                      ++pass, it.statistics.innovations, it.statistics.outliers, it.statistics.mean_nis,
+                      it.statistics.mean_log_likelihood);
         print_parameters(title, it.parameters);
       });
   const calibration::NoiseParameters& p = result.parameters;
-  print_parameters(result.converged ? "calibrated (settled)" : "calibrated (not settled)", p);
+  char title[128];
+  std::snprintf(title, sizeof title, "calibrated (pass %zu of %zu: the highest mean log-likelihood; %s)",
+                result.best_iteration + 1, result.iterations.size(), result.converged ? "settled" : "not settled");
+  print_parameters(title, p);
   if (!result.iterations.empty()) {
     std::printf("mean range innovation %.4f m (a range bias; not written)\n",
                 result.iterations.back().statistics.range_bias_m);
@@ -278,19 +285,21 @@ int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_s
     row("range_sigma_m", p.range_sigma_m, g.range_sigma_m);
     row("bearing_sigma_rad", p.bearing_sigma_rad, g.bearing_sigma_rad);
     row("range_scale", p.range_scale, g.range_scale);
+    row("range_cos_bearing_exponent", p.range_cos_bearing_exponent, g.range_cos_bearing_exponent);
     row("odometry_delay_s", p.odometry_delay_s, g.odometry_delay_s);
   }
 
   // --keys: which of the values to write (default all that were fitted).
-  std::set<std::string> keys{"v_sigma", "w_sigma", "range_sigma", "bearing_sigma", "odometry_delay"};
+  std::set<std::string> keys{"v_sigma", "w_sigma", "range_sigma", "bearing_sigma", "range_exponent", "odometry_delay"};
   if (fit_range_scale) keys.insert("range_scale");
   if (args.has("keys")) {
     keys.clear();
     for (const std::string& key : config::split_comma_list(args.get("keys"))) {
       if (key != "v_sigma" && key != "w_sigma" && key != "range_sigma" && key != "bearing_sigma" &&
-          key != "range_scale" && key != "odometry_delay") {
-        throw std::invalid_argument("--keys: unknown value '" + key +
-                                    "' (v_sigma, w_sigma, range_sigma, bearing_sigma, range_scale, odometry_delay)");
+          key != "range_scale" && key != "range_exponent" && key != "odometry_delay") {
+        throw std::invalid_argument(
+            "--keys: unknown value '" + key +
+            "' (v_sigma, w_sigma, range_sigma, bearing_sigma, range_scale, range_exponent, odometry_delay)");
       }
       keys.insert(key);
     }
@@ -304,6 +313,8 @@ int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_s
   replace("range_sigma", "filter", "range_sigma_m", rounded(p.range_sigma_m));
   replace("bearing_sigma", "filter", "bearing_sigma_rad", rounded(p.bearing_sigma_rad));
   replace("range_scale", "mrclam", "range_scale", rounded(p.range_scale));
+  replace("range_exponent", "mrclam", "range_cos_bearing_exponent",
+          config::yaml_number(std::round(p.range_cos_bearing_exponent * 1000.0) / 1000.0));
   replace("odometry_delay", "mrclam", "odometry_delay_s",
           config::yaml_number(std::round(p.odometry_delay_s * 1000.0) / 1000.0));
   // Read back with the programs' own readers before writing.

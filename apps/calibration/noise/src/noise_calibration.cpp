@@ -17,7 +17,9 @@ offline::RunInput apply_parameters(const offline::RunInput& raw, const NoisePara
   offline::RunInput in = raw;
   for (slam::OdometrySample& s : in.odometry) s.t_s += p.odometry_delay_s;
   for (slam::ObservationFrame& f : in.frames) {
-    for (slam::RangeBearing& d : f.detections) d.range_m /= p.range_scale;
+    for (slam::RangeBearing& d : f.detections) {
+      d.range_m /= p.range_scale * std::pow(std::cos(d.bearing_rad), p.range_cos_bearing_exponent);
+    }
   }
   return in;
 }
@@ -107,6 +109,9 @@ struct Row {
   double range_m = 0.0;     // measured range (scale applied)
   // d e_range / d c for a relative range scale change c (scale * (1 + c)).
   double de_range_dscale = 0.0;
+  // d e_range / d k for a change k of the cos-bearing exponent: -range ln cos(bearing).
+  double de_range_dexponent = 0.0;
+  int landmark_id = 0;
 };
 
 constexpr double kDelayStep = 0.02;
@@ -183,7 +188,9 @@ std::vector<Row> collect_rows(const offline::RunInput& in, const References& ref
         r.dh_delay = Eigen::Vector2d(q.z.x() - p.z.x(), slam::wrap_angle(q.z.y() - p.z.y())) / kDelayStep;
         r.range_m = d.range_m;
         r.de_range_dscale = -d.range_m;
-        if (std::isfinite(r.e.x()) && std::isfinite(r.e.y())) rows.push_back(r);
+        r.de_range_dexponent = -d.range_m * std::log(std::cos(d.bearing_rad));
+        r.landmark_id = d.landmark_id;
+        if (std::isfinite(r.e.x()) && std::isfinite(r.e.y()) && std::isfinite(r.de_range_dexponent)) rows.push_back(r);
       }
     }
   }
@@ -264,13 +271,23 @@ NoiseParameters fit_noise(const offline::RunInput& raw, const References& refere
 
   // Range scale and delay: a Gauss-Newton step on the innovations, weights 1 / S.
   // A relative range scale change c moves the measured range by -c * range; a
-  // delay change moves the prediction by dh_delay.
+  // delay change moves the prediction by dh_delay. Rows are -d e / d(c, d).
   Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
   Eigen::Vector2d rhs = Eigen::Vector2d::Zero();
-  double nis = 0.0, bias = 0.0, bias_weight = 0.0;
+  // The exponent from the range innovations' change with the bearing within each
+  // landmark (a fixed-effects fit): the map, built with the current exponent,
+  // absorbs a landmark's mean range error, which a plain fit would then miss.
+  struct ExponentSums {
+    double w = 0.0, x = 0.0, e = 0.0, xx = 0.0, xe = 0.0;
+  };
+  std::unordered_map<int, ExponentSums> exponent_sums;
+  double nis = 0.0, bias = 0.0, bias_weight = 0.0, log_likelihood = 0.0;
+  const bool scale_here = options.fit_range_scale && !options.range_scale_from_pairs;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
     const Eigen::Vector2d s = variances(r);
+    log_likelihood -= 0.5 * (std::min(r.e.x() * r.e.x() / s.x(), gate2) + std::min(r.e.y() * r.e.y() / s.y(), gate2) +
+                             std::log(4.0 * M_PI * M_PI * s.x() * s.y()));
     if (r.e.x() * r.e.x() > gate2 * s.x() || r.e.y() * r.e.y() > gate2 * s.y()) {
       ++stats.outliers;
       continue;
@@ -279,13 +296,18 @@ NoiseParameters fit_noise(const offline::RunInput& raw, const References& refere
     nis += r.e.x() * r.e.x() / s.x() + r.e.y() * r.e.y() / s.y();
     bias += r.e.x() / s.x();
     bias_weight += 1.0 / s.x();
-    // e ~ J (c, d): range row (-de/dc, dh_r), bearing row (0, dh_b).
-    const bool scale_here = options.fit_range_scale && !options.range_scale_from_pairs;
     const Eigen::Vector2d range_row(scale_here ? -r.de_range_dscale : 0.0,
                                     options.fit_odometry_delay ? r.dh_delay.x() : 0.0);
     const Eigen::Vector2d bearing_row(0.0, options.fit_odometry_delay ? r.dh_delay.y() : 0.0);
     normal += range_row * range_row.transpose() / s.x() + bearing_row * bearing_row.transpose() / s.y();
     rhs += range_row * r.e.x() / s.x() + bearing_row * r.e.y() / s.y();
+    ExponentSums& k = exponent_sums[r.landmark_id];
+    const double w = 1.0 / s.x(), x = -r.de_range_dexponent;
+    k.w += w;
+    k.x += w * x;
+    k.e += w * r.e.x();
+    k.xx += w * x * x;
+    k.xe += w * x * r.e.x();
   }
   if (options.fit_range_scale && options.range_scale_from_pairs) {
     // Both observations carry range noise.
@@ -306,8 +328,23 @@ NoiseParameters fit_noise(const offline::RunInput& raw, const References& refere
     out.range_scale = current.range_scale * (1.0 + c);
     out.odometry_delay_s = current.odometry_delay_s + std::clamp(step.y(), -0.2, 0.2);
   }
+  if (options.fit_range_cos_bearing_exponent) {
+    // Sum over landmarks of the weighted (co)variances about each one's means.
+    double sxx = 0.0, sxe = 0.0;
+    for (const auto& [id, k] : exponent_sums) {
+      if (k.w <= 0.0) continue;
+      sxx += k.xx - k.x * k.x / k.w;
+      sxe += k.xe - k.x * k.e / k.w;
+    }
+    if (sxx > 0.0 && std::isfinite(sxe / sxx)) {
+      // mrclam.range_cos_bearing_exponent is read in [0, 3].
+      out.range_cos_bearing_exponent =
+          std::clamp(current.range_cos_bearing_exponent + std::clamp(sxe / sxx, -1.0, 1.0), 0.0, 3.0);
+    }
+  }
   stats.mean_nis = stats.innovations > 0 ? nis / static_cast<double>(stats.innovations) : 0.0;
   stats.range_bias_m = bias_weight > 0.0 ? bias / bias_weight : 0.0;
+  stats.mean_log_likelihood = log_likelihood / static_cast<double>(rows.size());
   if (statistics) *statistics = stats;
   return out;
 }
@@ -378,7 +415,8 @@ bool settled(const NoiseParameters& a, const NoiseParameters& b, const NoiseCali
   const auto close = [&](double x, double y) { return std::abs(x - y) <= o.relative_tolerance * std::abs(y); };
   return close(a.v_sigma_m_per_sqrt_s, b.v_sigma_m_per_sqrt_s) && close(a.w_sigma_rad_per_sqrt_s, b.w_sigma_rad_per_sqrt_s) &&
          close(a.range_sigma_m, b.range_sigma_m) && close(a.bearing_sigma_rad, b.bearing_sigma_rad) &&
-         close(a.range_scale, b.range_scale) && std::abs(a.odometry_delay_s - b.odometry_delay_s) <= o.delay_tolerance_s;
+         close(a.range_scale, b.range_scale) && std::abs(a.odometry_delay_s - b.odometry_delay_s) <= o.delay_tolerance_s &&
+         std::abs(a.range_cos_bearing_exponent - b.range_cos_bearing_exponent) <= o.exponent_tolerance;
 }
 
 template <typename Refs>
@@ -398,7 +436,13 @@ NoiseCalibration iterate(const offline::RunInput& raw, const NoiseParameters& st
       break;
     }
   }
-  result.parameters = p;
+  for (std::size_t i = 0; i < result.iterations.size(); ++i) {
+    if (result.iterations[i].statistics.mean_log_likelihood >=
+        result.iterations[result.best_iteration].statistics.mean_log_likelihood) {
+      result.best_iteration = i;
+    }
+  }
+  result.parameters = result.iterations.empty() ? p : result.iterations[result.best_iteration].parameters;
   return result;
 }
 

@@ -22,6 +22,7 @@ struct NoiseParameters {
   double range_sigma_m = 0.1;
   double bearing_sigma_rad = 0.05;
   double range_scale = 1.0;
+  double range_cos_bearing_exponent = 0.0;
   double odometry_delay_s = 0.0;
 };
 
@@ -29,6 +30,7 @@ struct NoiseCalibrationOptions {
   int max_iterations = 8;           // filter passes (expectation-maximisation)
   double relative_tolerance = 0.02; // stop when no value moves more than this (sigmas, scale)
   double delay_tolerance_s = 0.01;
+  double exponent_tolerance = 0.05;
   // Innovations are predicted from a reference pose at an earlier frame through
   // the odometry, from min_lag_s to max_lag_s before the observation: the
   // growth of their variance with the lag is the odometry noise, the rest the
@@ -43,6 +45,10 @@ struct NoiseCalibrationOptions {
   double min_odometry_sigma = 0.0005;
   bool fit_range_scale = true;
   bool fit_odometry_delay = true;
+  // The exponent from how the range innovations against the map vary with the
+  // bearing: the map absorbs a landmark's mean range error, not its change
+  // between the bearings it is seen at.
+  bool fit_range_cos_bearing_exponent = true;
   // The range scale from pairs of observations of one landmark at two frames
   // (its position from the first, moved by the odometry, against the second):
   // independent of the map, which a filter pass builds with the ranges it is
@@ -76,6 +82,11 @@ struct FitStatistics {
   std::size_t start_frames = 0;
   double mean_nis = 0.0;             // mean normalised innovation squared (2 dof: ideal 2)
   double range_bias_m = 0.0;         // mean range innovation at the fitted values (reported only)
+  // Mean log-likelihood of every innovation (outliers too, their NIS capped at
+  // the gate) under the fitted values: how well the values and the pass's
+  // references explain the data. A filter pass that diverged gives references
+  // that explain little, whatever values are fitted to them.
+  double mean_log_likelihood = 0.0;
 };
 
 struct NoiseIteration {
@@ -84,13 +95,15 @@ struct NoiseIteration {
 };
 
 struct NoiseCalibration {
-  NoiseParameters parameters;
+  NoiseParameters parameters;        // of the pass with the highest mean_log_likelihood
+  std::size_t best_iteration = 0;    // its index in `iterations`
   std::vector<NoiseIteration> iterations;
-  bool converged = false;
+  bool converged = false;            // the values settled (the last pass moved none beyond the tolerances)
 };
 
-// The raw input (range scale 1, no delay) with the parameters' range scale and
-// delay applied: ranges divided by range_scale, odometry stamps moved by +delay.
+// The raw input (range scale 1, exponent 0, no delay) with the parameters'
+// range model and delay applied: ranges divided by range_scale *
+// cos(bearing)^exponent, odometry stamps moved by +delay.
 offline::RunInput apply_parameters(const offline::RunInput& raw, const NoiseParameters& p);
 
 // The filter options with the parameters' sigmas.
@@ -104,8 +117,8 @@ slam::FilterOptions with_parameters(slam::FilterOptions options, const NoisePara
 // alpha (H P H^T + G M G^T) (A from propagating the pose through the odometry
 // over the lag; P, M the references' pose and landmark covariances, alpha in
 // [0, 1] fitted: they hold the map frame's uncertainty, which cancels); range
-// scale (from the map, or from landmark pairs) and delay from a Gauss-Newton
-// step on the innovations. Throws std::invalid_argument when there are too few
+// scale (from the map, or from landmark pairs), the range's cos-bearing
+// exponent and the delay from a Gauss-Newton step on the innovations. Throws std::invalid_argument when there are too few
 // innovations.
 NoiseParameters fit_noise(const offline::RunInput& raw, const References& references, const NoiseParameters& current,
                           const NoiseCalibrationOptions& options, FitStatistics* statistics = nullptr);
@@ -122,7 +135,10 @@ References filter_references(const offline::RunInput& raw, const slam::FilterOpt
                              const NoiseParameters& p);
 
 // Blind calibration (never reads raw.truth or raw.landmarks): repeated filter
-// passes, each followed by fit_noise on its references, until the values settle.
+// passes, each followed by fit_noise on its references, until the values settle
+// or max_iterations; the result is the pass whose values explain the data best
+// (FitStatistics::mean_log_likelihood), so a pass whose filter diverged (too
+// small sigmas, the next pass trusting them) does not end the calibration.
 NoiseCalibration calibrate_noise(const offline::RunInput& raw, const slam::FilterOptions& base,
                                  const NoiseParameters& start, const NoiseCalibrationOptions& options,
                                  const std::function<void(const NoiseIteration&)>& on_iteration = {});
