@@ -113,6 +113,42 @@ TEST(MapOptimizer, KeyframesEverySecondThroughABlindStretch) {
   EXPECT_NEAR((opt.current_pose() - run.truth.back()).head<2>().norm(), 0.0, 1e-9);
 }
 
+TEST(MapOptimizer, AParkedRobotAddsNoKeyframesUnlessItsOdometryIsLost) {
+  const ExactRun run = exact_circle(100);  // 10 s of driving, then parked where it ended
+  MapOptimizer opt(exact_options(), run.truth.front(), 50.0);
+  for (std::size_t i = 0; i < run.odometry.size(); ++i) {
+    opt.add_odometry(run.odometry[i]);
+    opt.add_frame(run.frames[i]);
+  }
+  const slam::Pose2 parked = run.truth.back();
+  ASSERT_FALSE(run.frames.back().detections.empty());
+  const std::size_t driven = opt.keyframes().size();
+  double t = run.odometry.back().t_s;
+  // 10 minutes parked: the odometry reports zero at 10 Hz, the camera sees the
+  // same landmarks at every sample.
+  opt.add_odometry({t, 0.0, 0.0});
+  for (int i = 0; i < 6000; ++i) {
+    t += 0.1;
+    opt.add_odometry({t, 0.0, 0.0});
+    slam::ObservationFrame f = run.frames.back();
+    f.t_s = t;
+    opt.add_frame(f);
+  }
+  EXPECT_EQ(opt.keyframes().size(), driven);
+  EXPECT_GT(opt.counters().observations, 6000u);
+  EXPECT_LT(opt.solve().final_cost, 1e-12);  // still exact: standing still is what the data say
+  EXPECT_NEAR((opt.current_pose() - parked).norm(), 0.0, 1e-6);
+  // The odometry goes silent (control_timeout_s): the robot may be moving, so
+  // the frames get keyframes again.
+  for (int i = 0; i < 100; ++i) {
+    t += 0.1;
+    slam::ObservationFrame f = run.frames.back();
+    f.t_s = t;
+    opt.add_frame(f);
+  }
+  EXPECT_GT(opt.keyframes().size(), driven + 40);
+}
+
 TEST(MapOptimizer, AWindowSolveHoldsTheOlderKeyframes) {
   const ExactRun run = exact_circle(100);
   MapOptimizer opt(exact_options(), run.truth.front(), 50.0);

@@ -113,6 +113,7 @@ MapOptimizer::MapOptimizer(const MapOptimizerOptions& options, const slam::Pose2
   keyframes_.push_back({start_time_s, start_pose});
   last_time_s_ = start_time_s;
   last_measured_s_ = start_time_s;
+  keyframe_due_s_ = start_time_s + options_.keyframe_interval_s;
   counters_.keyframes = 1;
 }
 
@@ -120,21 +121,29 @@ MapOptimizer::~MapOptimizer() = default;
 
 void MapOptimizer::integrate_to(double t_s) {
   while (last_time_s_ < t_s) {
-    double next = t_s;
-    const double keyframe_due = keyframes_.back().t_s + options_.keyframe_interval_s;
-    next = std::min(next, keyframe_due);
+    double next = std::min(t_s, keyframe_due_s_);
     const double timeout_at = last_measured_s_ + options_.control_timeout_s;
     double v = held_v_;
     double w = held_w_;
+    bool measured = true;
     if (last_time_s_ >= timeout_at) {
       v = 0.0;
       w = 0.0;
+      measured = false;
     } else {
       next = std::min(next, timeout_at);
     }
-    open_motion_.add(v, w, next - last_time_s_, options_.motion);
+    // A measured standstill (the odometry reports zero) moves nothing and adds
+    // no noise: a parked robot adds neither keyframes nor uncertainty.
+    if (!(measured && v == 0.0 && w == 0.0)) open_motion_.add(v, w, next - last_time_s_, options_.motion);
     last_time_s_ = next;
-    if (next >= keyframe_due) close_keyframe(next, std::nullopt);
+    if (next >= keyframe_due_s_) {
+      if (open_motion_.empty()) {
+        keyframe_due_s_ = next + options_.keyframe_interval_s;
+      } else {
+        close_keyframe(next, std::nullopt);
+      }
+    }
   }
 }
 
@@ -160,6 +169,7 @@ void MapOptimizer::close_keyframe(double t_s, const std::optional<slam::Pose2>& 
   problem_->AddResidualBlock(new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(new OdometryResidual(residual)),
                              nullptr, before, after);
   keyframes_.push_back({t_s, initial});
+  keyframe_due_s_ = t_s + options_.keyframe_interval_s;
   open_motion_.clear();
   ++counters_.keyframes;
 }
@@ -198,8 +208,9 @@ void MapOptimizer::add_frame(const slam::ObservationFrame& frame, const std::opt
     }
   }
   if (valid.empty()) return;
-  // A keyframe at the frame time, unless the newest one is already there.
-  if (!open_motion_.empty() || frame.t_s > keyframes_.back().t_s) close_keyframe(frame.t_s, guess);
+  // A keyframe at the frame time, unless the robot has not moved since the
+  // newest one (it is there, or the robot stood still since).
+  if (!open_motion_.empty()) close_keyframe(frame.t_s, guess);
   const std::size_t k = keyframes_.size() - 1;
   double* const pose = pose_blocks_.back().data();
   const slam::Pose2 at(pose[0], pose[1], pose[2]);

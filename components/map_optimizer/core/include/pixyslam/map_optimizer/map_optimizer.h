@@ -41,7 +41,10 @@ namespace pixyslam::map_optimizer {
 //   defines the frame, as it does for the filter.
 // Keyframes: one at every camera frame with a valid detection, and one at least
 // every keyframe_interval_s in between, so a long blind stretch bends through
-// several factors instead of one badly linearised one.
+// several factors instead of one badly linearised one; none while the odometry
+// reports a standstill (a parked robot's observations join the newest keyframe,
+// and the standstill adds no motion noise), so a robot parked for hours among
+// its landmarks does not grow the problem.
 // Initial values: the pose guess given with a frame (the filter's estimate) or
 // dead reckoning from the previous keyframe; a landmark's guess, else its first
 // observation. Pure: no DDS, time passed in; one thread.
@@ -165,6 +168,7 @@ class MapOptimizer {
   slam::ComposedMotion open_motion_;  // odometry since the newest keyframe
   double last_time_s_ = 0.0;
   double last_measured_s_ = 0.0;
+  double keyframe_due_s_ = 0.0;  // a keyframe at the latest then, unless standing still
   double held_v_ = 0.0;
   double held_w_ = 0.0;
   OptimizerCounters counters_;
