@@ -75,7 +75,8 @@ TEST(SlamOptionsYaml, FullConfigRoundTripsEveryValue) {
       "    exit_position_sigma_m: 0.07\n"
       "    max_landmarks: 24\n"
       "  frame_uncertainty:\n"
-      "    enabled: true\n");
+      "    enabled: true\n"
+      "    landmarks: true\n");
   // then each value arrives in its field.
   const FilterOptions d;
   EXPECT_EQ(o.particles, 321);
@@ -109,6 +110,8 @@ TEST(SlamOptionsYaml, FullConfigRoundTripsEveryValue) {
   EXPECT_EQ(o.delayed_sampling.max_landmarks, 24);
   EXPECT_TRUE(o.frame_uncertainty);
   EXPECT_NE(o.frame_uncertainty, d.frame_uncertainty);
+  EXPECT_TRUE(o.landmark_uncertainty);
+  EXPECT_NE(o.landmark_uncertainty, d.landmark_uncertainty);
   EXPECT_NO_THROW(validate(o));
 }
 

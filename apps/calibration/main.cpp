@@ -18,6 +18,7 @@
 // (repeated filter passes, never the ground truth); BASE with those keys
 // replaced. --ground-truth also fits them against the ground truth and prints
 // both with their relative difference.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -262,7 +263,8 @@ int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_s
       });
   const calibration::NoiseParameters& p = result.parameters;
   char title[128];
-  std::snprintf(title, sizeof title, "calibrated (pass %zu of %zu: the highest mean log-likelihood; %s)",
+  std::snprintf(title, sizeof title, "calibrated (mean of passes %zu-%zu, pass %zu of %zu the most likely; %s)",
+                std::min<std::size_t>(3, result.best_iteration + 1), result.best_iteration + 1,
                 result.best_iteration + 1, result.iterations.size(), result.converged ? "settled" : "not settled");
   print_parameters(title, p);
   if (!result.iterations.empty()) {

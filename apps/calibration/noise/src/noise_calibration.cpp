@@ -371,6 +371,7 @@ References filter_references(const offline::RunInput& raw, const slam::FilterOpt
   const offline::RunInput in = apply_parameters(raw, p);
   slam::FilterOptions options = with_parameters(base, p);
   options.frame_uncertainty = false;  // the pose covariance relative to the map
+  options.landmark_uncertainty = false;
   slam::FastSlam2 filter(options, in.initial_pose);
   References refs;
   refs.frame_pose.resize(in.frames.size(), slam::Pose2::Zero());
@@ -419,6 +420,37 @@ bool settled(const NoiseParameters& a, const NoiseParameters& b, const NoiseCali
          std::abs(a.range_cos_bearing_exponent - b.range_cos_bearing_exponent) <= o.exponent_tolerance;
 }
 
+// Each pass draws its own particles, so its values scatter about the fixed point
+// (w_sigma by +-15 % from pass to pass): the mean of the passes from the third
+// (the first two move away from the start values) up to the best one (after it
+// the passes explained the data less well, or diverged). Just the best pass
+// when it is one of the first two.
+NoiseParameters average_of_passes(const std::vector<NoiseIteration>& passes, std::size_t best) {
+  const std::size_t first = best >= 2 ? 2 : best;
+  NoiseParameters sum;
+  sum.v_sigma_m_per_sqrt_s = sum.w_sigma_rad_per_sqrt_s = sum.range_sigma_m = sum.bearing_sigma_rad = 0.0;
+  sum.range_scale = sum.range_cos_bearing_exponent = sum.odometry_delay_s = 0.0;
+  for (std::size_t i = first; i <= best; ++i) {
+    const NoiseParameters& p = passes[i].parameters;
+    sum.v_sigma_m_per_sqrt_s += p.v_sigma_m_per_sqrt_s;
+    sum.w_sigma_rad_per_sqrt_s += p.w_sigma_rad_per_sqrt_s;
+    sum.range_sigma_m += p.range_sigma_m;
+    sum.bearing_sigma_rad += p.bearing_sigma_rad;
+    sum.range_scale += p.range_scale;
+    sum.range_cos_bearing_exponent += p.range_cos_bearing_exponent;
+    sum.odometry_delay_s += p.odometry_delay_s;
+  }
+  const double n = static_cast<double>(best - first + 1);
+  sum.v_sigma_m_per_sqrt_s /= n;
+  sum.w_sigma_rad_per_sqrt_s /= n;
+  sum.range_sigma_m /= n;
+  sum.bearing_sigma_rad /= n;
+  sum.range_scale /= n;
+  sum.range_cos_bearing_exponent /= n;
+  sum.odometry_delay_s /= n;
+  return sum;
+}
+
 template <typename Refs>
 NoiseCalibration iterate(const offline::RunInput& raw, const NoiseParameters& start, const NoiseCalibrationOptions& o,
                          const Refs& references, const std::function<void(const NoiseIteration&)>& on_iteration) {
@@ -442,7 +474,7 @@ NoiseCalibration iterate(const offline::RunInput& raw, const NoiseParameters& st
       result.best_iteration = i;
     }
   }
-  result.parameters = result.iterations.empty() ? p : result.iterations[result.best_iteration].parameters;
+  result.parameters = result.iterations.empty() ? p : average_of_passes(result.iterations, result.best_iteration);
   return result;
 }
 

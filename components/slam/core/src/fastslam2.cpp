@@ -8,6 +8,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 
 #include "pixyslam/slam/observation_model.h"
 #include "pixyslam/slam/resampling.h"
@@ -279,9 +280,60 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
       ++counters_.observations_used;
     }
   }
+  const bool landmark_floor = options_.landmark_uncertainty && options_.association == Association::kKnownId;
+  if (landmark_floor) capture_mapped_spread(valid);
   resample_if_needed();
   refresh_caches();
   update_output_frame();
+  if (landmark_floor) update_landmark_floor(valid);
+}
+
+void FastSlam2::capture_mapped_spread(const std::vector<RangeBearing>& valid) {
+  // Before resampling: the spread of each newly mapped landmark over all particles.
+  std::vector<double> log_w(particles_.size());
+  for (std::size_t i = 0; i < particles_.size(); ++i) log_w[i] = particles_[i].log_weight;
+  const std::vector<double> w = normalised_weights(log_w);
+  mapped_spread_.resize(id_of_slot_.size(), Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  for (std::size_t k = 0; k < valid.size(); ++k) {
+    const std::uint32_t slot = slots_[k];
+    if (!std::isnan(mapped_spread_[slot](0, 0))) continue;
+    double total = 0.0;
+    Eigen::Vector2d m = Eigen::Vector2d::Zero();
+    Eigen::Matrix2d second = Eigen::Matrix2d::Zero();
+    for (std::size_t i = 0; i < particles_.size(); ++i) {
+      const Landmark* lm = particles_[i].map.find(slot);
+      if (lm == nullptr) continue;
+      total += w[i];
+      m += w[i] * lm->mean;
+      second += w[i] * lm->mean * lm->mean.transpose();  // the means' spread: the pose's part, not the sensor's
+    }
+    // Mapped once most particles hold it (the rest still carry it in their joint state).
+    if (total < 0.5) continue;
+    m /= total;
+    mapped_spread_[slot] = second / total - m * m.transpose();
+  }
+}
+
+void FastSlam2::update_landmark_floor(const std::vector<RangeBearing>& valid) {
+  // The pose as the landmarks seen now pin it, by their spread at mapping alone.
+  const Pose2 pose = particle_frame_estimate().mean;
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  int landmarks = 0;
+  for (std::size_t k = 0; k < valid.size(); ++k) {
+    const Eigen::Matrix2d& spread = mapped_spread_[slots_[k]];
+    if (std::isnan(spread(0, 0))) continue;
+    const Landmark* lm = particles_[best_index()].map.find(slots_[k]);
+    if (lm == nullptr) continue;
+    const PredictedObservation p = predict_observation(pose, lm->mean);
+    const Eigen::Matrix2d a = p.h_landmark * spread * p.h_landmark.transpose() + 1e-12 * Eigen::Matrix2d::Identity();
+    information += p.h_pose.transpose() * a.inverse() * p.h_pose;
+    ++landmarks;
+  }
+  if (landmarks < 2) return;
+  const Eigen::FullPivLU<Eigen::Matrix3d> lu(information);
+  if (!lu.isInvertible()) return;
+  landmark_floor_ = lu.inverse();
+  landmark_floor_ = 0.5 * (landmark_floor_ + landmark_floor_.transpose());
 }
 
 void FastSlam2::associate(const Particle& p) {
@@ -631,6 +683,7 @@ PoseEstimate FastSlam2::pose_estimate() const {
     j(1, 2) = e.mean.x() - frame_.pivot.x();
     e.cov = psd_max(e.cov, j * frame_.cov * j.transpose());
   }
+  if (options_.landmark_uncertainty && landmark_floor_.allFinite()) e.cov = psd_max(e.cov, landmark_floor_);
   e.best = to_output(e.best);
   e.mean = to_output(e.mean);
   Eigen::Matrix3d r = Eigen::Matrix3d::Identity();

@@ -77,6 +77,7 @@ FilterOptions read_filter_options(config::YamlReader& f) {
   if (f.has("frame_uncertainty")) {
     config::YamlReader u = f.child("frame_uncertainty");
     o.frame_uncertainty = u.boolean("enabled", o.frame_uncertainty);
+    o.landmark_uncertainty = u.boolean("landmarks", o.landmark_uncertainty);
     u.finish();
   }
   f.finish();

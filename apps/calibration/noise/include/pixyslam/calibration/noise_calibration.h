@@ -95,7 +95,9 @@ struct NoiseIteration {
 };
 
 struct NoiseCalibration {
-  NoiseParameters parameters;        // of the pass with the highest mean_log_likelihood
+  // The mean over the passes from the third up to the one with the highest
+  // mean_log_likelihood (that pass alone when it is the first or second).
+  NoiseParameters parameters;
   std::size_t best_iteration = 0;    // its index in `iterations`
   std::vector<NoiseIteration> iterations;
   bool converged = false;            // the values settled (the last pass moved none beyond the tolerances)
@@ -136,9 +138,10 @@ References filter_references(const offline::RunInput& raw, const slam::FilterOpt
 
 // Blind calibration (never reads raw.truth or raw.landmarks): repeated filter
 // passes, each followed by fit_noise on its references, until the values settle
-// or max_iterations; the result is the pass whose values explain the data best
-// (FitStatistics::mean_log_likelihood), so a pass whose filter diverged (too
-// small sigmas, the next pass trusting them) does not end the calibration.
+// or max_iterations; the result is the mean of the passes up to the one whose
+// values explain the data best (FitStatistics::mean_log_likelihood), so a pass
+// whose filter diverged (too small sigmas, the next pass trusting them) does
+// not end the calibration, and the pass-to-pass scatter averages out.
 NoiseCalibration calibrate_noise(const offline::RunInput& raw, const slam::FilterOptions& base,
                                  const NoiseParameters& start, const NoiseCalibrationOptions& options,
                                  const std::function<void(const NoiseIteration&)>& on_iteration = {});

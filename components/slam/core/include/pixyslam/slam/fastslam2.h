@@ -200,6 +200,12 @@ class FastSlam2 {
     Eigen::Vector2d pivot = Eigen::Vector2d::Zero();
   };
   FrameUncertainty frame_;
+  // FilterOptions::landmark_uncertainty: per slot the landmark's spread over the
+  // particles when first mapped (NaN until then), and the pose floor it implies.
+  std::vector<Eigen::Matrix2d> mapped_spread_;
+  Eigen::Matrix3d landmark_floor_ = Eigen::Matrix3d::Zero();
+  void capture_mapped_spread(const std::vector<RangeBearing>& valid);
+  void update_landmark_floor(const std::vector<RangeBearing>& valid);
   double output_rotation_rad_ = 0.0;
   Eigen::Vector2d output_translation_m_ = Eigen::Vector2d::Zero();
 

@@ -105,6 +105,13 @@ struct FilterOptions {
   // landmark until the frame is pinned (anchor_frame's thresholds), moved to the
   // current position. The estimates themselves are unchanged.
   bool frame_uncertainty = false;
+  // The same for every landmark (with frame_uncertainty): a landmark's world
+  // position is only as good as its spread over the particles when it was first
+  // mapped (the pose uncertainty then, which resampling later loses). The output
+  // pose covariance never falls below what the mapped landmarks of the last
+  // frame that saw two or more imply by that uncertainty alone
+  // ((sum H_x^T (H_m W_j H_m^T)^-1 H_x)^-1, W_j the spread at mapping).
+  bool landmark_uncertainty = false;
 };
 
 void validate(const FilterOptions& options);
