@@ -380,8 +380,53 @@ TEST(FastSlam2, DelayedSamplingThroughACameraGap) {
 // frame_uncertainty keeps it as a floor under the output covariance: the
 // estimates stay bit-identical, the covariance never shrinks, and the pose NEES
 // against the truth falls inside its 95 % bound more often.
+// Feeds a run to two filters that differ only in an output option: their
+// estimates must stay bit-identical and `with`'s covariance never below
+// `without`'s. Counts the steps from from_s on whose pose NEES is under its 95 %
+// bound; before_frame runs before every camera frame.
+struct NeesBelowBound {
+  int with = 0, without = 0, steps = 0;
+};
+void run_side_by_side(FastSlam2& with, FastSlam2& without, const sim::WorldRun& run, double from_s,
+                      NeesBelowBound& count, const std::function<void()>& before_frame = {}) {
+  std::size_t i = 0, k = 0;
+  while (i < run.odometry.size() || k < run.frames.size()) {
+    if (k == run.frames.size() || (i < run.odometry.size() && run.odometry[i].t_s <= run.frames[k].t_s)) {
+      with.add_odometry(run.odometry[i]);
+      without.add_odometry(run.odometry[i]);
+      ++i;
+    } else {
+      if (before_frame) before_frame();
+      with.add_observations(run.frames[k]);
+      without.add_observations(run.frames[k]);
+      ++k;
+    }
+    const PoseEstimate a = with.pose_estimate(), b = without.pose_estimate();
+    ASSERT_TRUE(a.mean == b.mean && a.best == b.best) << "step " << i + k;
+    const Eigen::Matrix3d excess = a.cov - b.cov;
+    ASSERT_GE(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(excess).eigenvalues().minCoeff(),
+              -1e-12 * (1.0 + b.cov.norm()))
+        << "step " << i + k;
+    if (i == 0 || run.odometry[i - 1].t_s < from_s) continue;
+    const eval::TimedPose& truth = run.truth[i - 1];
+    const Eigen::Vector3d err(truth.x_m - a.mean.x(), truth.y_m - a.mean.y(),
+                              wrap_angle(truth.theta_rad - a.mean.z()));
+    count.with += err.dot(a.cov.inverse() * err) < 9.3484 ? 1 : 0;
+    count.without += err.dot(b.cov.inverse() * err) < 9.3484 ? 1 : 0;
+    ++count.steps;
+  }
+}
+
+// With the option, more than `margin` more steps under the bound.
+void expect_more_below_bound(const NeesBelowBound& count, int margin) {
+  ASSERT_GT(count.steps, 1000);
+  std::printf("NEES below its 95 %% bound: %d with, %d without, of %d steps\n", count.with, count.without,
+              count.steps);
+  EXPECT_GT(count.with, count.without + margin) << count.with << " vs " << count.without << " of " << count.steps;
+}
+
 TEST(FastSlam2, FrameUncertaintyFloorsTheCovarianceAndLeavesTheEstimatesAlone) {
-  int inside_with = 0, inside_without = 0, steps = 0;
+  NeesBelowBound count;
   for (int r = 1; r <= 3; ++r) {
     sim::WorldOptions w;
     sim::WorldRun run = noisy_world(300 + r, 0.05, 0.1, w);
@@ -391,41 +436,15 @@ TEST(FastSlam2, FrameUncertaintyFloorsTheCovarianceAndLeavesTheEstimatesAlone) {
     o.frame_uncertainty = true;
     FastSlam2 with(o, run.initial_pose);
     double heading_var_at_first_map = -1.0;
-    std::size_t i = 0, k = 0;
-    while (i < run.odometry.size() || k < run.frames.size()) {
-      if (k == run.frames.size() || (i < run.odometry.size() && run.odometry[i].t_s <= run.frames[k].t_s)) {
-        with.add_odometry(run.odometry[i]);
-        without.add_odometry(run.odometry[i]);
-        ++i;
-      } else {
-        if (heading_var_at_first_map < 0.0) heading_var_at_first_map = without.pose_estimate().cov(2, 2);
-        with.add_observations(run.frames[k]);
-        without.add_observations(run.frames[k]);
-        ++k;
-      }
-      const PoseEstimate a = with.pose_estimate(), b = without.pose_estimate();
-      ASSERT_TRUE(a.mean == b.mean && a.best == b.best) << "run " << r << " step " << i + k;
-      const Eigen::Matrix3d excess = a.cov - b.cov;
-      ASSERT_GE(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(excess).eigenvalues().minCoeff(),
-                -1e-12 * (1.0 + b.cov.norm()))
-          << "run " << r << " step " << i + k;
-      if (i == 0 || run.odometry[i - 1].t_s < 40.0) continue;
-      const eval::TimedPose& truth = run.truth[i - 1];
-      const Eigen::Vector3d err(truth.x_m - a.mean.x(), truth.y_m - a.mean.y(),
-                                wrap_angle(truth.theta_rad - a.mean.z()));
-      inside_with += err.dot(a.cov.inverse() * err) < 9.3484 ? 1 : 0;
-      inside_without += err.dot(b.cov.inverse() * err) < 9.3484 ? 1 : 0;
-      ++steps;
-    }
+    run_side_by_side(with, without, run, 40.0, count, [&] {
+      if (heading_var_at_first_map < 0.0) heading_var_at_first_map = without.pose_estimate().cov(2, 2);
+    });
     // The frame's heading uncertainty from the first mapping stays to the end.
     ASSERT_GT(heading_var_at_first_map, 0.0);
     EXPECT_GE(with.pose_estimate().cov(2, 2), 0.5 * heading_var_at_first_map) << "run " << r;
     EXPECT_LT(without.pose_estimate().cov(2, 2), 0.5 * heading_var_at_first_map) << "run " << r;
   }
-  ASSERT_GT(steps, 1000);
-  RecordProperty("nees_inside_with_without", std::to_string(inside_with) + " " + std::to_string(inside_without) +
-                                                 " of " + std::to_string(steps));
-  EXPECT_GT(inside_with, inside_without + steps / 10) << inside_with << " vs " << inside_without << " of " << steps;
+  expect_more_below_bound(count, count.steps / 10);
 }
 
 // FilterOptions::landmark_uncertainty: the camera is blind from 15 to 45 s, so
@@ -434,7 +453,7 @@ TEST(FastSlam2, FrameUncertaintyFloorsTheCovarianceAndLeavesTheEstimatesAlone) {
 // estimates stay bit-identical, the covariance never shrinks, and after the
 // blind stretch the pose NEES falls under its 95 % bound more often.
 TEST(FastSlam2, LandmarkUncertaintyFloorsTheCovarianceAndLeavesTheEstimatesAlone) {
-  int inside_with = 0, inside_without = 0, steps = 0;
+  NeesBelowBound count;
   for (int r = 1; r <= 3; ++r) {
     sim::WorldOptions w;
     sim::WorldRun run = noisy_world(310 + r, 0.05, 0.1, w);
@@ -444,38 +463,9 @@ TEST(FastSlam2, LandmarkUncertaintyFloorsTheCovarianceAndLeavesTheEstimatesAlone
     FastSlam2 without(o, run.initial_pose);
     o.landmark_uncertainty = true;
     FastSlam2 with(o, run.initial_pose);
-    std::size_t i = 0, k = 0;
-    while (i < run.odometry.size() || k < run.frames.size()) {
-      if (k == run.frames.size() || (i < run.odometry.size() && run.odometry[i].t_s <= run.frames[k].t_s)) {
-        with.add_odometry(run.odometry[i]);
-        without.add_odometry(run.odometry[i]);
-        ++i;
-      } else {
-        with.add_observations(run.frames[k]);
-        without.add_observations(run.frames[k]);
-        ++k;
-      }
-      const PoseEstimate a = with.pose_estimate(), b = without.pose_estimate();
-      ASSERT_TRUE(a.mean == b.mean && a.best == b.best) << "run " << r << " step " << i + k;
-      const Eigen::Matrix3d excess = a.cov - b.cov;
-      ASSERT_GE(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(excess).eigenvalues().minCoeff(),
-                -1e-12 * (1.0 + b.cov.norm()))
-          << "run " << r << " step " << i + k;
-      if (i == 0 || run.odometry[i - 1].t_s < 50.0) continue;
-      const eval::TimedPose& truth = run.truth[i - 1];
-      const Eigen::Vector3d err(truth.x_m - a.mean.x(), truth.y_m - a.mean.y(),
-                                wrap_angle(truth.theta_rad - a.mean.z()));
-      inside_with += err.dot(a.cov.inverse() * err) < 9.3484 ? 1 : 0;
-      inside_without += err.dot(b.cov.inverse() * err) < 9.3484 ? 1 : 0;
-      ++steps;
-    }
+    run_side_by_side(with, without, run, 50.0, count);
   }
-  ASSERT_GT(steps, 1000);
-  RecordProperty("nees_inside_with_without", std::to_string(inside_with) + " " + std::to_string(inside_without) +
-                                                 " of " + std::to_string(steps));
-  std::printf("NEES below its 95 %% bound after the blind stretch: %d with, %d without, of %d steps\n", inside_with,
-              inside_without, steps);
-  EXPECT_GT(inside_with, inside_without + steps / 20) << inside_with << " vs " << inside_without << " of " << steps;
+  expect_more_below_bound(count, count.steps / 20);
 }
 
 // Odometry is composed and applied to the particles at the next frame;
