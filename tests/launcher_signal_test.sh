@@ -18,9 +18,12 @@ work=$(mktemp -d "${TMPDIR:-/tmp}/pixyslam_launcher_signals.XXXXXX")
 tag=$$
 launcher_pid=""
 
-# PIDs of the processes whose command line holds "sleep 40<k>.<tag>"; the
-# pattern is a regular expression that does not match its own text.
-marked() { grep -las -E "40[0-9][0-9]\.${tag}" /proc/[0-9]*/cmdline | sed 's#/proc/\([0-9]*\)/cmdline#\1#' || true; }
+# PIDs of the processes whose command line matches the regular expression $1
+# (which does not match its own text). grep exits 2 when a process listed by
+# the glob is gone before it is read (pipefail would end the script): ignored.
+pids_matching() { grep -las -E "$1" /proc/[0-9]*/cmdline | sed 's#/proc/\([0-9]*\)/cmdline#\1#' || true; }
+# The run's processes: command line holds "sleep 40<k>.<tag>".
+marked() { pids_matching "40[0-9][0-9]\.${tag}"; }
 cleanup() {
   [[ -n $launcher_pid ]] && kill -9 "$launcher_pid" 2>/dev/null || true
   for pid in $(marked); do kill -9 "$pid" 2>/dev/null || true; done
@@ -68,7 +71,7 @@ YAML
   # Children start with default dispositions: SIGINT (bit 2) not ignored by
   # the plain sleep although the launcher was started with it ignored.
   local plain_pid
-  plain_pid=$(grep -las -E "40[0-9]1\.${tag}" /proc/[0-9]*/cmdline | sed 's#/proc/\([0-9]*\)/cmdline#\1#' | head -1)
+  plain_pid=$(pids_matching "40[0-9]1\.${tag}" | sed -n 1p)
   local ignored
   ignored=$(awk '/^SigIgn:/ {print $2}' "/proc/$plain_pid/status")
   if (( (16#$ignored & 2) != 0 )); then
