@@ -216,5 +216,51 @@ TEST_F(MrclamTest, RobotNumberOutOfRangeThrows) {
   EXPECT_THROW(load_robot((dir_ / "absent").string(), 1), std::runtime_error);
 }
 
+TEST_F(MrclamTest, WrittenRobotReadsBackExactly) {
+  RobotData d;
+  d.robot = 3;
+  d.odometry = {{0.1, 0.2, -0.3}, {0.15, 1.0 / 3.0, 1e-9}};
+  d.frames = {{0.12, {{6, 2.5, 0.25}, {9, 1.0 / 7.0, -0.5}}}, {0.2, {{6, 2.25, 0.3}}}};
+  d.groundtruth = {{0.1, 1.0, -2.0, 3.0}, {0.2, 1.1, -2.1, -3.1}};
+  d.landmarks = {{6, 0.5, -0.25}, {9, 4.0 / 3.0, 7.0}};
+  const std::string out = (dir_ / "written").string();
+  write_robot(out, d);
+  const RobotData r = load_robot(out, 3);
+  ASSERT_EQ(r.odometry.size(), 2u);
+  EXPECT_EQ(r.odometry[1].v_mps, 1.0 / 3.0);
+  EXPECT_EQ(r.odometry[1].w_radps, 1e-9);
+  ASSERT_EQ(r.frames.size(), 2u);
+  ASSERT_EQ(r.frames[0].detections.size(), 2u);
+  EXPECT_EQ(r.frames[0].detections[1].subject, 9);
+  EXPECT_EQ(r.frames[0].detections[1].range_m, 1.0 / 7.0);
+  EXPECT_EQ(r.frames[1].t_s, 0.2);
+  ASSERT_EQ(r.groundtruth.size(), 2u);
+  EXPECT_EQ(r.groundtruth[1].theta_rad, -3.1);
+  ASSERT_EQ(r.landmarks.size(), 2u);
+  EXPECT_EQ(r.landmarks[1].x_m, 4.0 / 3.0);
+  EXPECT_EQ(r.counts.landmark_rows, 3u);
+  EXPECT_EQ(r.counts.unknown_barcode_rows + r.counts.robot_rows, 0u);
+  // Robot 1 of the same folder was not written.
+  EXPECT_THROW(load_robot(out, 1), std::runtime_error);
+}
+
+TEST_F(MrclamTest, WritingRefusesRobotNumbersAsLandmarks) {
+  RobotData d;
+  d.robot = 1;
+  d.landmarks = {{5, 0.0, 0.0}};
+  try {
+    write_robot((dir_ / "bad").string(), d);
+    ADD_FAILURE() << "expected std::runtime_error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("landmark subject 5"), std::string::npos) << e.what();
+  }
+  d.landmarks = {{6, 0.0, 0.0}};
+  d.frames = {{1.0, {{2, 1.0, 0.0}}}};
+  EXPECT_THROW(write_robot((dir_ / "bad").string(), d), std::runtime_error);
+  d.robot = 6;
+  d.frames.clear();
+  EXPECT_THROW(write_robot((dir_ / "bad").string(), d), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace pixyslam::mrclam

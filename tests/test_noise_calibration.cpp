@@ -5,6 +5,7 @@
 // blind (the filter's own innovations) and against the ground truth.
 #include <cmath>
 #include <cstdio>
+#include <functional>
 
 #include <gtest/gtest.h>
 
@@ -23,7 +24,7 @@ struct Simulated {
   NoiseParameters truth;
 };
 
-Simulated simulated(std::uint64_t seed) {
+Simulated simulated(std::uint64_t seed, const std::function<void(sim::WorldOptions&)>& change = {}) {
   sim::WorldOptions w;
   w.seed = seed;
   w.duration_s = 400.0;
@@ -34,6 +35,7 @@ Simulated simulated(std::uint64_t seed) {
   w.w_sigma_radps = 0.1;
   w.range_sigma_m = 0.05;
   w.bearing_sigma_rad = 0.02;
+  if (change) change(w);
   const sim::WorldRun run = sim::simulate(w);
   Simulated s;
   s.raw.initial_pose = run.initial_pose;
@@ -147,6 +149,40 @@ TEST(NoiseCalibration, BlindCalibrationNeverReadsTheGroundTruth) {
   EXPECT_EQ(with.parameters.range_scale, without.parameters.range_scale);
   EXPECT_EQ(with.parameters.range_cos_bearing_exponent, without.parameters.range_cos_bearing_exponent);
   EXPECT_EQ(with.parameters.odometry_delay_s, without.parameters.odometry_delay_s);
+}
+
+// A 20 Hz camera whose errors persist (time constant 0.5 s), and one whose
+// errors are white: the time constant from pairs of sightings, against the
+// ground truth and blind.
+TEST(NoiseCalibration, ErrorCorrelationTimeFromPairsOfSightings) {
+  NoiseCalibrationOptions o;
+  o.fit_error_correlation = true;
+  o.max_iterations = 2;
+  for (const double tau : {0.0, 0.5}) {
+    const Simulated s = simulated(14, [tau](sim::WorldOptions& w) {
+      w.duration_s = 60.0;
+      w.odometry_rate_hz = 20.0;
+      w.camera_rate_hz = 20.0;
+      w.error_correlation_s = tau;
+    });
+    const NoiseCalibration truth = calibrate_noise_with_truth(s.raw, s.truth, o);
+    const NoiseCalibration blind = calibrate_noise(s.raw, base_options(), s.truth, o);
+    std::printf("error correlation %.2f s: with the ground truth %.2f s, blind %.2f s\n", tau,
+                truth.parameters.error_correlation_s, blind.parameters.error_correlation_s);
+    for (const NoiseCalibration* c : {&truth, &blind}) {
+      if (tau == 0.0) {
+        EXPECT_LE(c->parameters.error_correlation_s, 0.05);
+      } else {
+        EXPECT_GE(c->parameters.error_correlation_s, 0.5 * tau);
+        EXPECT_LE(c->parameters.error_correlation_s, 2.0 * tau);
+      }
+    }
+  }
+  // Not asked for: the start value stays.
+  const Simulated s = simulated(15, [](sim::WorldOptions& w) { w.duration_s = 60.0; });
+  NoiseParameters start = s.truth;
+  start.error_correlation_s = 0.3;
+  EXPECT_EQ(calibrate_noise_with_truth(s.raw, start, {}).parameters.error_correlation_s, 0.3);
 }
 
 TEST(NoiseCalibration, TooFewInnovationsThrow) {

@@ -55,10 +55,11 @@ constexpr const char* kUsage =
     "       pixyslam_calibrate noise --mrclam DIR --robot N --config BASE.yaml --out FILE.yaml [--ground-truth]\n"
     "                                [--fit-range-scale] [--keys v_sigma,w_sigma,range_sigma,bearing_sigma,...]\n"
     "           (odometry noise densities, range/bearing sigmas, the range's cos-bearing exponent, command\n"
-    "            lag (and with --fit-range-scale the range scale) from the filter's innovations, without\n"
-    "            ground truth; --ground-truth also fits them with it and prints both with the relative\n"
-    "            difference; --keys: write only these of v_sigma, w_sigma, range_sigma, bearing_sigma,\n"
-    "            range_scale, range_exponent, odometry_delay)\n";
+    "            lag (and with --fit-range-scale the range scale) from the filter's innovations, and the\n"
+    "            measurement errors' correlation time from pairs of sightings, without ground truth;\n"
+    "            --ground-truth also fits them with it and prints both with the relative difference;\n"
+    "            --keys: write only these of v_sigma, w_sigma, range_sigma, bearing_sigma, range_scale,\n"
+    "            range_exponent, odometry_delay, error_correlation)\n";
 
 std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -213,13 +214,31 @@ std::string rounded(double value) {
 
 void print_parameters(const char* title, const calibration::NoiseParameters& p) {
   std::printf("%s: v_sigma %.5f m/sqrt(s), w_sigma %.5f rad/sqrt(s), range_sigma %.4f m, bearing_sigma %.4f rad, "
-              "range_scale %.4f, range_cos_bearing_exponent %.3f, odometry_delay %.3f s\n",
+              "range_scale %.4f, range_cos_bearing_exponent %.3f, odometry_delay %.3f s, error_correlation %.2f s\n",
               title, p.v_sigma_m_per_sqrt_s, p.w_sigma_rad_per_sqrt_s, p.range_sigma_m, p.bearing_sigma_rad,
-              p.range_scale, p.range_cos_bearing_exponent, p.odometry_delay_s);
+              p.range_scale, p.range_cos_bearing_exponent, p.odometry_delay_s, p.error_correlation_s);
 }
 
 int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_scale) {
   const std::string config_path = args.get("config");
+  // --keys: which of the values to write (default all but the range scale,
+  // which --fit-range-scale adds). The error correlation is fitted, and used by
+  // the calibration's own filter passes, only when it is written.
+  std::set<std::string> keys{"v_sigma",        "w_sigma",        "range_sigma",      "bearing_sigma",
+                             "range_exponent", "odometry_delay", "error_correlation"};
+  if (fit_range_scale) keys.insert("range_scale");
+  if (args.has("keys")) {
+    keys.clear();
+    for (const std::string& key : config::split_comma_list(args.get("keys"))) {
+      if (key != "v_sigma" && key != "w_sigma" && key != "range_sigma" && key != "bearing_sigma" &&
+          key != "range_scale" && key != "range_exponent" && key != "odometry_delay" && key != "error_correlation") {
+        throw std::invalid_argument("--keys: unknown value '" + key +
+                                    "' (v_sigma, w_sigma, range_sigma, bearing_sigma, range_scale, range_exponent, "
+                                    "odometry_delay, error_correlation)");
+      }
+      keys.insert(key);
+    }
+  }
   const std::string base_text = read_file(config_path);
   config::YamlReader root = config::YamlReader::from_string(base_text, config_path);
   config::YamlReader filter_yaml = root.child("filter");
@@ -233,6 +252,7 @@ int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_s
   start.range_scale = model.range_scale;
   start.range_cos_bearing_exponent = model.range_cos_bearing_exponent;
   start.odometry_delay_s = model.odometry_delay_s;
+  start.error_correlation_s = base.error_correlation_s;
   // The calibration applies its own range model and delay to the raw input.
   model.range_scale = 1.0;
   model.range_cos_bearing_exponent = 0.0;
@@ -253,12 +273,15 @@ int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_s
   // MRCLAM robots' odometry (commanded speeds, slower while turning) makes it
   // wrong there (docs/calibration.md): only on request.
   noise_options.fit_range_scale = fit_range_scale;
+  noise_options.fit_error_correlation = keys.count("error_correlation") > 0;
   const calibration::NoiseCalibration result = calibration::calibrate_noise(
       blind, base, start, noise_options, [&](const calibration::NoiseIteration& it) {
-        char title[128];
-        std::snprintf(title, sizeof title, "pass %d (%zu innovations, %zu outliers, mean NIS %.2f, log-lik %.3f)",
+        char title[192];
+        std::snprintf(title, sizeof title,
+                      "pass %d (%zu innovations, %zu outliers, mean NIS %.2f, log-lik %.3f; %zu pairs: sigmas %.4f m, %.4f rad)",
                       ++pass, it.statistics.innovations, it.statistics.outliers, it.statistics.mean_nis,
-                      it.statistics.mean_log_likelihood);
+                      it.statistics.mean_log_likelihood, it.statistics.correlation_pairs,
+                      it.statistics.pair_range_sigma_m, it.statistics.pair_bearing_sigma_rad);
         print_parameters(title, it.parameters);
       });
   const calibration::NoiseParameters& p = result.parameters;
@@ -274,7 +297,9 @@ int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_s
 
   if (with_ground_truth) {
     const offline::RunInput with_truth = offline::mrclam_input(data, model);
-    const calibration::NoiseCalibration fit = calibration::calibrate_noise_with_truth(with_truth, start, {});
+    calibration::NoiseCalibrationOptions truth_options;
+    truth_options.fit_error_correlation = noise_options.fit_error_correlation;
+    const calibration::NoiseCalibration fit = calibration::calibrate_noise_with_truth(with_truth, start, truth_options);
     print_parameters("fit with ground truth", fit.parameters);
     const calibration::NoiseParameters& g = fit.parameters;
     const auto row = [](const char* name, double blind_value, double truth_value) {
@@ -289,26 +314,20 @@ int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_s
     row("range_scale", p.range_scale, g.range_scale);
     row("range_cos_bearing_exponent", p.range_cos_bearing_exponent, g.range_cos_bearing_exponent);
     row("odometry_delay_s", p.odometry_delay_s, g.odometry_delay_s);
+    row("error_correlation_s", p.error_correlation_s, g.error_correlation_s);
   }
 
-  // --keys: which of the values to write (default all that were fitted).
-  std::set<std::string> keys{"v_sigma", "w_sigma", "range_sigma", "bearing_sigma", "range_exponent", "odometry_delay"};
-  if (fit_range_scale) keys.insert("range_scale");
-  if (args.has("keys")) {
-    keys.clear();
-    for (const std::string& key : config::split_comma_list(args.get("keys"))) {
-      if (key != "v_sigma" && key != "w_sigma" && key != "range_sigma" && key != "bearing_sigma" &&
-          key != "range_scale" && key != "range_exponent" && key != "odometry_delay") {
-        throw std::invalid_argument(
-            "--keys: unknown value '" + key +
-            "' (v_sigma, w_sigma, range_sigma, bearing_sigma, range_scale, range_exponent, odometry_delay)");
-      }
-      keys.insert(key);
-    }
-  }
   std::string out = base_text;
   const auto replace = [&](const char* key, const char* section, const char* yaml_key, const std::string& value) {
-    if (keys.count(key)) out = calibration::replace_yaml_value(out, section, yaml_key, value);
+    if (!keys.count(key)) return;
+    try {
+      out = calibration::replace_yaml_value(out, section, yaml_key, value);
+    } catch (const std::invalid_argument&) {
+      if (args.has("keys")) throw;  // asked for by name: the base must have the line
+      // Written by default: older bases lack the line.
+      std::printf("note: %s has no '%s:' line under %s:, so %s %s is not written\n", config_path.c_str(), yaml_key,
+                  section, yaml_key, value.c_str());
+    }
   };
   replace("v_sigma", "filter", "v_sigma_m_per_sqrt_s", rounded(p.v_sigma_m_per_sqrt_s));
   replace("w_sigma", "filter", "w_sigma_rad_per_sqrt_s", rounded(p.w_sigma_rad_per_sqrt_s));
@@ -319,6 +338,8 @@ int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_s
           config::yaml_number(std::round(p.range_cos_bearing_exponent * 1000.0) / 1000.0));
   replace("odometry_delay", "mrclam", "odometry_delay_s",
           config::yaml_number(std::round(p.odometry_delay_s * 1000.0) / 1000.0));
+  replace("error_correlation", "filter", "error_correlation_s",
+          config::yaml_number(std::round(p.error_correlation_s * 100.0) / 100.0));
   // Read back with the programs' own readers before writing.
   config::YamlReader check = config::YamlReader::from_string(out, args.get("out"));
   config::YamlReader check_filter = check.child("filter");

@@ -222,4 +222,75 @@ RobotData load_robot(const std::string& dataset_dir, int robot) {
   return data;
 }
 
+namespace {
+
+// Opens `path` for writing, calls write(stream), and checks that it all reached the file.
+template <class Write>
+void write_file(const fs::path& path, Write&& write) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("mrclam: cannot write " + path.string());
+  out.precision(17);
+  write(out);
+  out.close();
+  if (!out) throw std::runtime_error("mrclam: write failed: " + path.string());
+}
+
+}  // namespace
+
+void write_robot(const std::string& dataset_dir, const RobotData& data) {
+  if (data.robot < kFirstRobot || data.robot > kLastRobot) {
+    throw std::runtime_error("mrclam: robot number must be in 1..5, got " + std::to_string(data.robot));
+  }
+  std::set<int> subjects;
+  for (const eval::LandmarkPoint& l : data.landmarks) {
+    if (l.id <= kLastRobot || !subjects.insert(l.id).second) {
+      throw std::runtime_error("mrclam: landmark subject " + std::to_string(l.id) +
+                               (l.id <= kLastRobot ? " is a robot's number (1..5)" : " given twice"));
+    }
+  }
+  for (const MeasurementFrame& f : data.frames) {
+    for (const Detection& d : f.detections) {
+      if (d.subject <= kLastRobot) {
+        throw std::runtime_error("mrclam: detection of subject " + std::to_string(d.subject) +
+                                 " at t = " + std::to_string(f.t_s) + " s: landmark subjects are above 5");
+      }
+      subjects.insert(d.subject);
+    }
+  }
+  const fs::path dir(dataset_dir);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("mrclam: cannot create " + dataset_dir + ": " + ec.message());
+  const std::string prefix = "Robot" + std::to_string(data.robot) + "_";
+  write_file(dir / kBarcodeFile, [&](std::ostream& out) {
+    out << "# Subject #\tBarcode #\n";
+    for (int r = kFirstRobot; r <= kLastRobot; ++r) out << r << '\t' << r << '\n';
+    for (int s : subjects) out << s << '\t' << s << '\n';
+  });
+  write_file(dir / kLandmarkFile, [&](std::ostream& out) {
+    out << "# Subject #\tx [m]\ty [m]\tx std-dev [m]\ty std-dev [m]\n";
+    for (const eval::LandmarkPoint& l : data.landmarks) out << l.id << '\t' << l.x_m << '\t' << l.y_m << "\t0\t0\n";
+  });
+  write_file(dir / (prefix + "Odometry.dat"), [&](std::ostream& out) {
+    out << "# Time [s]\tv [m/s]\tw [rad/s]\n";
+    for (const OdometryRow& o : data.odometry) out << o.t_s << '\t' << o.v_mps << '\t' << o.w_radps << '\n';
+  });
+  write_file(dir / (prefix + "Measurement.dat"), [&](std::ostream& out) {
+    out << "# Time [s]\tBarcode #\trange [m]\tbearing [rad]\n";
+    for (const MeasurementFrame& f : data.frames) {
+      for (const Detection& d : f.detections) {
+        out << f.t_s << '\t' << d.subject << '\t' << d.range_m << '\t' << d.bearing_rad << '\n';
+      }
+    }
+  });
+  if (!data.groundtruth.empty()) {
+    write_file(dir / (prefix + "Groundtruth.dat"), [&](std::ostream& out) {
+      out << "# Time [s]\tx [m]\ty [m]\torientation [rad]\n";
+      for (const eval::TimedPose& g : data.groundtruth) {
+        out << g.t_s << '\t' << g.x_m << '\t' << g.y_m << '\t' << g.theta_rad << '\n';
+      }
+    });
+  }
+}
+
 }  // namespace pixyslam::mrclam

@@ -69,4 +69,13 @@ struct RobotData {
 // to two subjects, or a landmark listed twice. Prints nothing.
 RobotData load_robot(const std::string& dataset_dir, int robot);
 
+// Writes `data` as robot data.robot (1..5) of an MRCLAM data set in the folder
+// `dataset_dir` (created if missing): its odometry, measurement and ground
+// truth files, Landmark_Groundtruth.dat (standard deviations 0) and
+// Barcodes.dat (barcode = subject number; robots 1..5 and every landmark).
+// Landmark subjects must be above 5; numbers are written with round-trip
+// precision, so load_robot reads back what was written. Throws
+// std::runtime_error naming the file that cannot be written or the bad subject.
+void write_robot(const std::string& dataset_dir, const RobotData& data);
+
 }  // namespace pixyslam::mrclam

@@ -1,10 +1,11 @@
 // slam_offline: runs the FastSLAM 2.0 core without DDS.
-//   slam_offline sim    --config FILE --out DIR [--seed S]
+//   slam_offline sim    --config FILE --out DIR [--seed S] [--write-dataset DIR]
 //   slam_offline mrclam --dataset DIR --robot N --config FILE --out DIR [--seed S] [--optimise]
 // Writes DIR/trajectory.csv and DIR/landmarks.csv and prints the evaluation.
 // --optimise (any mode): the map optimiser over the whole run after the filter;
 // trajectory.csv and landmarks.csv are then its solution, the filter's go to
 // filter_trajectory.csv and filter_landmarks.csv, and both are evaluated.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -29,14 +30,18 @@ namespace {
 using namespace pixyslam;
 
 constexpr const char* kUsage =
-    "usage: slam_offline sim    --config FILE --out DIR [--seed S] [--optimise]\n"
+    "usage: slam_offline sim    --config FILE --out DIR [--seed S] [--optimise] [--write-dataset DIR]\n"
     "       slam_offline mrclam --dataset DIR --robot N --config FILE --out DIR [--seed S] [--optimise]\n"
     "       slam_offline hardware --config FILE --sim-config FILE --out DIR [--seed S] [--duration S] [--optimise]\n"
     "         (hardware: the robot_sim hardware decoded by the bridges' parsers; the\n"
     "          pixy/encoder configs are taken from beside --sim-config)\n"
     "  --optimise  also solve the whole run with the map optimiser (Ceres); its\n"
     "              solution goes to trajectory.csv and landmarks.csv, the filter's\n"
-    "              to filter_trajectory.csv and filter_landmarks.csv\n";
+    "              to filter_trajectory.csv and filter_landmarks.csv\n"
+    "  --write-dataset DIR  (sim) also write the simulated recording as robot 1 of\n"
+    "              an MRCLAM data set in DIR, with its ground truth, for slam_offline\n"
+    "              mrclam, mrclam_eval and pixyslam_calibrate noise (landmark subjects\n"
+    "              are the pole ids shifted to start above 5 when needed)\n";
 
 struct Args {
   std::string mode;
@@ -62,12 +67,16 @@ Args parse_args(int argc, char** argv) {
       a.optimise = true;
       continue;
     }
-    static const char* known[] = {"--config", "--out", "--seed", "--dataset", "--robot", "--sim-config", "--duration"};
+    static const char* known[] = {"--config", "--out",        "--seed",     "--dataset",
+                                  "--robot",  "--sim-config", "--duration", "--write-dataset"};
     bool ok = false;
     for (const char* k : known) ok = ok || key == k;
     if (!ok) throw std::invalid_argument("unknown argument '" + key + "'");
     if (i + 1 >= argc) throw std::invalid_argument(key + " needs a value");
     a.values[key.substr(2)] = argv[++i];
+  }
+  if (a.values.count("write-dataset") && a.mode != "sim") {
+    throw std::invalid_argument("--write-dataset: only in sim mode");
   }
   return a;
 }
@@ -88,6 +97,27 @@ offline::RunInput sim_input(const sim::WorldRun& run) {
   in.truth = run.truth;
   for (const sim::Pole& p : run.poles) in.landmarks.push_back({p.id, p.x_m, p.y_m});
   return in;
+}
+
+// The simulated recording as MRCLAM robot 1: odometry and camera frames as
+// measured, truth at every odometry sample, pole ids shifted so that the
+// smallest is above the robots' subject numbers 1..5.
+mrclam::RobotData sim_recording(const sim::WorldRun& run) {
+  int smallest = 6;
+  for (const sim::Pole& p : run.poles) smallest = std::min(smallest, p.id);
+  const int shift = 6 - smallest;
+  mrclam::RobotData d;
+  d.robot = 1;
+  for (const slam::OdometrySample& o : run.odometry) d.odometry.push_back({o.t_s, o.v_mps, o.w_radps});
+  for (const slam::ObservationFrame& f : run.frames) {
+    mrclam::MeasurementFrame frame{f.t_s, {}};
+    for (const slam::RangeBearing& z : f.detections) frame.detections.push_back({z.landmark_id + shift, z.range_m, z.bearing_rad});
+    d.frames.push_back(std::move(frame));
+  }
+  d.groundtruth = run.truth;
+  for (const sim::Pole& p : run.poles) d.landmarks.push_back({p.id + shift, p.x_m, p.y_m});
+  if (shift != 0) std::printf("dataset: landmark subjects are the pole ids + %d\n", shift);
+  return d;
 }
 
 #ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
@@ -130,6 +160,10 @@ int run(const Args& args) {
     root.finish();
     const sim::WorldRun run = sim::simulate(world);
     input = sim_input(run);
+    if (args.values.count("write-dataset")) {
+      mrclam::write_robot(args.get("write-dataset"), sim_recording(run));
+      std::printf("wrote the recording as robot 1 of the MRCLAM data set %s\n", args.get("write-dataset").c_str());
+    }
     title = "simulated world, " + std::to_string(run.poles.size()) + " poles, " +
             std::to_string(run.frames.size()) + " camera frames";
   } else {

@@ -27,6 +27,9 @@ WorldOptions read_world_options(config::YamlReader& w) {
   o.w_sigma_radps = w.number("w_sigma_radps", 0.0, 10.0, o.w_sigma_radps);
   o.range_sigma_m = w.number("range_sigma_m", 0.0, 10.0, o.range_sigma_m);
   o.bearing_sigma_rad = w.number("bearing_sigma_rad", 0.0, 1.0, o.bearing_sigma_rad);
+  o.range_bias_m = w.number("range_bias_m", -10.0, 10.0, o.range_bias_m);
+  o.error_correlation_s = w.number("error_correlation_s", 0.0, 1e4, o.error_correlation_s);
+  o.odometry_lead_s = w.number("odometry_lead_s", 0.0, 10.0, o.odometry_lead_s);
   o.field_of_view_rad = w.number("field_of_view_rad", 0.01, 2.0 * M_PI, o.field_of_view_rad);
   o.min_range_m = w.number("min_range_m", 0.0, 100.0, o.min_range_m);
   o.max_range_m = w.number("max_range_m", 0.01, 1000.0, o.max_range_m);
@@ -141,6 +144,20 @@ WorldRun simulate(const WorldOptions& o) {
   const double odo_dt = 1.0 / o.odometry_rate_hz;
   const double cam_dt = 1.0 / o.camera_rate_hz;
   const double sim_dt = std::min(0.01, 0.5 * std::min(odo_dt, cam_dt));
+  // Per pole: the current (range, bearing) error in sigmas and when it was drawn.
+  struct PoleError {
+    double range = 0.0, bearing = 0.0, t_s = -1.0;
+  };
+  std::vector<PoleError> pole_error(run.poles.size());
+  // Two normals per detection whether or not the errors are correlated, so a
+  // world keeps its random sequence.
+  const auto next_error = [&](PoleError& e, double t_s) {
+    const double n_range = normal(rng), n_bearing = normal(rng);
+    const double a = (o.error_correlation_s > 0.0 && e.t_s >= 0.0) ? std::exp(-(t_s - e.t_s) / o.error_correlation_s)
+                                                                   : 0.0;
+    const double b = std::sqrt(1.0 - a * a);
+    e = PoleError{a * e.range + b * n_range, a * e.bearing + b * n_bearing, t_s};
+  };
   slam::Pose2 pose = run.initial_pose;
   double next_odo = 0.0;
   double next_cam = cam_dt;
@@ -149,7 +166,8 @@ WorldRun simulate(const WorldOptions& o) {
     const double t = static_cast<double>(step) * sim_dt;
     if (t + 1e-9 >= next_odo) {
       const PathCommand c = path.command_at(t);
-      run.odometry.push_back({t, c.v_mps + o.v_sigma_mps * normal(rng), c.w_radps + o.w_sigma_radps * normal(rng)});
+      const double v = c.v_mps + o.v_sigma_mps * normal(rng);
+      run.odometry.push_back({t - o.odometry_lead_s, v, c.w_radps + o.w_sigma_radps * normal(rng)});
       run.truth.push_back({t, pose.x(), pose.y(), pose.z()});
       next_odo += odo_dt;
     }
@@ -166,8 +184,9 @@ WorldRun simulate(const WorldOptions& o) {
         ++run.frames_detected[i];
         slam::RangeBearing d;
         d.landmark_id = p.id;
-        d.range_m = z.z.x() + o.range_sigma_m * normal(rng);
-        d.bearing_rad = slam::wrap_angle(z.z.y() + o.bearing_sigma_rad * normal(rng));
+        next_error(pole_error[i], t);
+        d.range_m = z.z.x() + o.range_bias_m + o.range_sigma_m * pole_error[i].range;
+        d.bearing_rad = slam::wrap_angle(z.z.y() + o.bearing_sigma_rad * pole_error[i].bearing);
         frame.detections.push_back(d);
       }
       run.pole_sightings += frame.detections.size();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <Eigen/Dense>
@@ -29,6 +30,7 @@ slam::FilterOptions with_parameters(slam::FilterOptions options, const NoisePara
   options.motion.w_sigma_rad_per_sqrt_s = p.w_sigma_rad_per_sqrt_s;
   options.range_sigma_m = p.range_sigma_m;
   options.bearing_sigma_rad = p.bearing_sigma_rad;
+  options.error_correlation_s = p.error_correlation_s;
   return options;
 }
 
@@ -197,6 +199,123 @@ std::vector<Row> collect_rows(const offline::RunInput& in, const References& ref
   return rows;
 }
 
+// A pair of sightings of one landmark: the second predicted from the first
+// moved by the odometry over `lag_s` (no map, no reference pose: the pair's
+// geometry is the same wherever the first frame was).
+struct PairRow {
+  Eigen::Vector2d e;
+  Eigen::Vector2d a_v, a_w;  // diag of H A H^T for unit odometry densities
+  double lag_s = 0.0;
+};
+
+std::vector<PairRow> collect_correlation_pairs(const offline::RunInput& in, const NoiseCalibrationOptions& o) {
+  std::vector<PairRow> pairs;
+  std::vector<slam::OdometrySample> odometry = in.odometry;
+  std::stable_sort(odometry.begin(), odometry.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  Predictor predictor(odometry, 0.0, true);
+  const std::size_t n = in.frames.size();
+  for (std::size_t j = 0; j < n; ++j) {
+    const slam::ObservationFrame& start = in.frames[j];
+    predictor.reset(slam::Pose2::Zero(), start.t_s, Eigen::Matrix3d::Zero());
+    double next_lag = o.min_lag_s;
+    for (std::size_t k = j + 1; k < n && in.frames[k].t_s - start.t_s <= o.max_lag_s; ++k) {
+      const slam::ObservationFrame& f = in.frames[k];
+      const double lag = f.t_s - start.t_s;
+      if (lag < next_lag) continue;
+      while (next_lag <= lag) next_lag *= 1.5;
+      predictor.advance_to(f.t_s);
+      for (const slam::RangeBearing& d : f.detections) {
+        for (const slam::RangeBearing& d0 : start.detections) {
+          if (d0.landmark_id != d.landmark_id) continue;
+          const Eigen::Vector2d landmark(d0.range_m * std::cos(d0.bearing_rad), d0.range_m * std::sin(d0.bearing_rad));
+          const slam::PredictedObservation p = slam::predict_observation(predictor.mean(), landmark);
+          PairRow r;
+          r.e = slam::innovation(Eigen::Vector2d(d.range_m, d.bearing_rad), p.z);
+          r.a_v = (p.h_pose * predictor.cov_v() * p.h_pose.transpose()).diagonal();
+          r.a_w = (p.h_pose * predictor.cov_w() * p.h_pose.transpose()).diagonal();
+          r.lag_s = lag;
+          if (r.e.allFinite()) pairs.push_back(r);
+        }
+      }
+    }
+  }
+  return pairs;
+}
+
+struct CorrelationFit {
+  double tau_s = 0.0;
+  double range_var = 0.0, bearing_var = 0.0;
+  double log_likelihood = -std::numeric_limits<double>::infinity();
+};
+
+// Fits (range variance, bearing variance, v and w densities squared) to the
+// pairs' squared innovations for one time constant (iteratively reweighted
+// least squares, as fit_noise) and scores it by the mean log-likelihood
+// (normalised innovations capped at the outlier gate).
+CorrelationFit fit_pairs(const std::vector<PairRow>& pairs, double tau_s, const NoiseParameters& start,
+                         const NoiseCalibrationOptions& o) {
+  using Vector4d = Eigen::Vector4d;
+  // Twice the share of the error variance that has changed after each pair's lag.
+  std::vector<double> two_g(pairs.size(), 2.0);
+  if (tau_s > 0.0) {
+    for (std::size_t i = 0; i < pairs.size(); ++i) two_g[i] = 2.0 * (1.0 - std::exp(-pairs[i].lag_s / tau_s));
+  }
+  Vector4d u(start.range_sigma_m * start.range_sigma_m, start.bearing_sigma_rad * start.bearing_sigma_rad,
+             start.v_sigma_m_per_sqrt_s * start.v_sigma_m_per_sqrt_s,
+             start.w_sigma_rad_per_sqrt_s * start.w_sigma_rad_per_sqrt_s);
+  const Vector4d floor(o.min_range_sigma_m * o.min_range_sigma_m, o.min_bearing_sigma_rad * o.min_bearing_sigma_rad,
+                       o.min_odometry_sigma * o.min_odometry_sigma, o.min_odometry_sigma * o.min_odometry_sigma);
+  const double gate2 = o.outlier_sigmas * o.outlier_sigmas;
+  const auto variances = [&](std::size_t i) {
+    const PairRow& r = pairs[i];
+    return Eigen::Vector2d(two_g[i] * u(0) + u(2) * r.a_v.x() + u(3) * r.a_w.x() + 1e-12,
+                           two_g[i] * u(1) + u(2) * r.a_v.y() + u(3) * r.a_w.y() + 1e-12);
+  };
+  for (int pass = 0; pass < 6; ++pass) {
+    Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
+    Vector4d rhs = Vector4d::Zero();
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      const PairRow& r = pairs[i];
+      const Eigen::Vector2d s = variances(i);
+      if (r.e.x() * r.e.x() > gate2 * s.x() || r.e.y() * r.e.y() > gate2 * s.y()) continue;
+      const Vector4d range_row(two_g[i], 0.0, r.a_v.x(), r.a_w.x());
+      const Vector4d bearing_row(0.0, two_g[i], r.a_v.y(), r.a_w.y());
+      normal += range_row * range_row.transpose() / (s.x() * s.x());
+      rhs += range_row * (r.e.x() * r.e.x()) / (s.x() * s.x());
+      normal += bearing_row * bearing_row.transpose() / (s.y() * s.y());
+      rhs += bearing_row * (r.e.y() * r.e.y()) / (s.y() * s.y());
+    }
+    const Vector4d next = normal.ldlt().solve(rhs);
+    if (!next.allFinite()) break;
+    u = next.cwiseMax(floor);
+  }
+  CorrelationFit fit;
+  fit.tau_s = tau_s;
+  fit.range_var = u(0);
+  fit.bearing_var = u(1);
+  double log_likelihood = 0.0;
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const PairRow& r = pairs[i];
+    const Eigen::Vector2d s = variances(i);
+    log_likelihood -= 0.5 * (std::min(r.e.x() * r.e.x() / s.x(), gate2) + std::min(r.e.y() * r.e.y() / s.y(), gate2) +
+                             std::log(4.0 * M_PI * M_PI * s.x() * s.y()));
+  }
+  fit.log_likelihood = log_likelihood / static_cast<double>(pairs.size());
+  return fit;
+}
+
+// The most likely time constant on a grid (0: white errors).
+CorrelationFit fit_error_correlation(const std::vector<PairRow>& pairs, const NoiseParameters& start,
+                                     const NoiseCalibrationOptions& o) {
+  static constexpr double kGrid[] = {0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 5.0};
+  CorrelationFit best;
+  for (double tau : kGrid) {
+    const CorrelationFit fit = fit_pairs(pairs, tau, start, o);
+    if (fit.log_likelihood > best.log_likelihood) best = fit;
+  }
+  return best;
+}
+
 }  // namespace
 
 NoiseParameters fit_noise(const offline::RunInput& raw, const References& references, const NoiseParameters& current,
@@ -342,6 +461,16 @@ NoiseParameters fit_noise(const offline::RunInput& raw, const References& refere
           std::clamp(current.range_cos_bearing_exponent + std::clamp(sxe / sxx, -1.0, 1.0), 0.0, 3.0);
     }
   }
+  if (options.fit_error_correlation) {
+    const std::vector<PairRow> pairs = collect_correlation_pairs(in, options);
+    stats.correlation_pairs = pairs.size();
+    if (pairs.size() >= 20) {
+      const CorrelationFit fit = fit_error_correlation(pairs, current, options);
+      out.error_correlation_s = fit.tau_s;
+      stats.pair_range_sigma_m = std::sqrt(fit.range_var);
+      stats.pair_bearing_sigma_rad = std::sqrt(fit.bearing_var);
+    }
+  }
   stats.mean_nis = stats.innovations > 0 ? nis / static_cast<double>(stats.innovations) : 0.0;
   stats.range_bias_m = bias_weight > 0.0 ? bias / bias_weight : 0.0;
   stats.mean_log_likelihood = log_likelihood / static_cast<double>(rows.size());
@@ -429,7 +558,7 @@ NoiseParameters average_of_passes(const std::vector<NoiseIteration>& passes, std
   const std::size_t first = best >= 2 ? 2 : best;
   NoiseParameters sum;
   sum.v_sigma_m_per_sqrt_s = sum.w_sigma_rad_per_sqrt_s = sum.range_sigma_m = sum.bearing_sigma_rad = 0.0;
-  sum.range_scale = sum.range_cos_bearing_exponent = sum.odometry_delay_s = 0.0;
+  sum.range_scale = sum.range_cos_bearing_exponent = sum.odometry_delay_s = sum.error_correlation_s = 0.0;
   for (std::size_t i = first; i <= best; ++i) {
     const NoiseParameters& p = passes[i].parameters;
     sum.v_sigma_m_per_sqrt_s += p.v_sigma_m_per_sqrt_s;
@@ -439,6 +568,7 @@ NoiseParameters average_of_passes(const std::vector<NoiseIteration>& passes, std
     sum.range_scale += p.range_scale;
     sum.range_cos_bearing_exponent += p.range_cos_bearing_exponent;
     sum.odometry_delay_s += p.odometry_delay_s;
+    sum.error_correlation_s += p.error_correlation_s;
   }
   const double n = static_cast<double>(best - first + 1);
   sum.v_sigma_m_per_sqrt_s /= n;
@@ -448,6 +578,7 @@ NoiseParameters average_of_passes(const std::vector<NoiseIteration>& passes, std
   sum.range_scale /= n;
   sum.range_cos_bearing_exponent /= n;
   sum.odometry_delay_s /= n;
+  sum.error_correlation_s /= n;
   return sum;
 }
 

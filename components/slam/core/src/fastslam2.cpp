@@ -255,6 +255,7 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
     const double sb = d.bearing_sigma_rad > 0.0 ? d.bearing_sigma_rad : options_.bearing_sigma_rad;
     r_[k] = Eigen::Vector2d(sr * sr, sb * sb).asDiagonal();
     if (options_.association == Association::kKnownId) slots_[k] = slot_for(d.landmark_id);
+    if (options_.error_correlation_s > 0.0) r_[k] *= correlated_error_factor(slots_[k], frame.t_s);
     new_log_likelihood_[k] = 0.0;  // associate() sets it per particle
   }
   if (valid.empty()) return;
@@ -286,6 +287,16 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
   refresh_caches();
   update_output_frame();
   if (landmark_floor) update_landmark_floor(valid);
+}
+
+double FastSlam2::correlated_error_factor(std::uint32_t slot, double t_s) {
+  if (last_sighting_s_.size() <= slot) last_sighting_s_.resize(slot + 1, std::numeric_limits<double>::quiet_NaN());
+  const double last = last_sighting_s_[slot];
+  last_sighting_s_[slot] = t_s;
+  if (std::isnan(last)) return 1.0;
+  // Two sightings in one frame (or out of order) count as 1 ms apart: bounded.
+  const double rho = std::exp(-std::max(t_s - last, 1e-3) / options_.error_correlation_s);
+  return (1.0 + rho) / (1.0 - rho);
 }
 
 void FastSlam2::capture_mapped_spread(const std::vector<RangeBearing>& valid) {

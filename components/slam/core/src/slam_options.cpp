@@ -37,6 +37,10 @@ void validate(const FilterOptions& o) {
   require_positive(o.range_sigma_m, "range_sigma_m");
   require_non_negative(o.range_sigma_per_m, "range_sigma_per_m");
   require_positive(o.bearing_sigma_rad, "bearing_sigma_rad");
+  require(std::isfinite(o.error_correlation_s) && o.error_correlation_s >= 0.0 && o.error_correlation_s <= 100.0,
+          "error_correlation_s", o.error_correlation_s, "must be in [0, 100] s");
+  require(o.error_correlation_s == 0.0 || o.association == Association::kKnownId, "error_correlation_s",
+          o.error_correlation_s, "needs association known_id (a landmark's last sighting is tracked by its id)");
   require_non_negative(o.min_range_m, "min_range_m");
   require(std::isfinite(o.max_range_m) && o.max_range_m > o.min_range_m, "max_range_m", o.max_range_m,
           "must be finite and greater than min_range_m");

@@ -29,6 +29,7 @@ FilterOptions read_filter_options(config::YamlReader& f) {
     o.range_sigma_m = z.number("range_sigma_m", 1e-6, 100.0, o.range_sigma_m);
     o.range_sigma_per_m = z.number("range_sigma_per_m", 0.0, 10.0, o.range_sigma_per_m);
     o.bearing_sigma_rad = z.number("bearing_sigma_rad", 1e-6, 3.0, o.bearing_sigma_rad);
+    o.error_correlation_s = z.number("error_correlation_s", 0.0, 100.0, o.error_correlation_s);
     o.min_range_m = z.number("min_range_m", 0.0, 1000.0, o.min_range_m);
     o.max_range_m = z.number("max_range_m", 0.0, 1000.0, o.max_range_m);
     z.finish();

@@ -58,6 +58,14 @@ struct WorldOptions {
   double w_sigma_radps = 0.0349;       // paper: 2 deg turn
   double range_sigma_m = 0.07;         // paper: 70 mm
   double bearing_sigma_rad = 0.027;    // paper: 0.027 rad
+  // Real sensors' errors are neither zero-mean nor white: a constant range
+  // bias, and per pole range and bearing errors that decay with this time
+  // constant (first-order Gauss-Markov, same sigmas; 0: white).
+  double range_bias_m = 0.0;
+  double error_correlation_s = 0.0;
+  // Odometry stamped this long before the motion it reports (MRCLAM's command
+  // lag: a command is logged when sent, executed later).
+  double odometry_lead_s = 0.0;
   double field_of_view_rad = 1.309;    // Pixy: 75 deg horizontal
   double min_range_m = 0.2;
   double max_range_m = 3.0;

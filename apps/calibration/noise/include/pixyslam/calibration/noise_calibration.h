@@ -24,6 +24,8 @@ struct NoiseParameters {
   double range_scale = 1.0;
   double range_cos_bearing_exponent = 0.0;
   double odometry_delay_s = 0.0;
+  // Time constant of the measurement errors (filter.observation.error_correlation_s; 0: white).
+  double error_correlation_s = 0.0;
 };
 
 struct NoiseCalibrationOptions {
@@ -54,6 +56,12 @@ struct NoiseCalibrationOptions {
   // independent of the map, which a filter pass builds with the ranges it is
   // given and so absorbs a range scale. calibrate_noise sets it.
   bool range_scale_from_pairs = false;
+  // The measurement errors' time constant from the same pairs at lags spaced
+  // by factors of 1.5 from min_lag_s: the variance of a pair's innovation is
+  // 2 R (1 - exp(-lag / tau)) plus the odometry's part; tau is the grid value
+  // under which the pairs are most likely (0 when white errors explain them
+  // best). Off: the start value is kept (and used by the filter passes).
+  bool fit_error_correlation = false;
 };
 
 // Where the robot was at each frame and where the landmarks are: from the
@@ -87,6 +95,10 @@ struct FitStatistics {
   // references explain the data. A filter pass that diverged gives references
   // that explain little, whatever values are fitted to them.
   double mean_log_likelihood = 0.0;
+  std::size_t correlation_pairs = 0;  // pairs the error correlation was fitted on
+  // The pairs' marginal sigmas under the fitted time constant (reported only).
+  double pair_range_sigma_m = 0.0;
+  double pair_bearing_sigma_rad = 0.0;
 };
 
 struct NoiseIteration {
@@ -108,7 +120,7 @@ struct NoiseCalibration {
 // cos(bearing)^exponent, odometry stamps moved by +delay.
 offline::RunInput apply_parameters(const offline::RunInput& raw, const NoiseParameters& p);
 
-// The filter options with the parameters' sigmas.
+// The filter options with the parameters' sigmas and error correlation.
 slam::FilterOptions with_parameters(slam::FilterOptions options, const NoiseParameters& p);
 
 // One maximisation step: given references, re-estimates every value from the

@@ -216,6 +216,10 @@ class FastSlam2 {
 
   std::unordered_map<int, std::uint32_t> slot_of_id_;
   std::vector<int> id_of_slot_;
+  // FilterOptions::error_correlation_s: per slot the time of its last sighting
+  // (NaN: never), and the factor on R of a sighting after it.
+  std::vector<double> last_sighting_s_;
+  double correlated_error_factor(std::uint32_t slot, double t_s);
 
   // Per-frame working memory (reused to avoid allocation).
   std::vector<Eigen::Vector2d> z_;

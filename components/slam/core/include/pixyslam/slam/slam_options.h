@@ -77,6 +77,13 @@ struct FilterOptions {
   double range_sigma_m = 0.07;
   double range_sigma_per_m = 0.0;
   double bearing_sigma_rad = 0.027;
+  // Time constant of each landmark's measurement errors (first-order
+  // Gauss-Markov; 0: white, the paper's model). Real cameras repeat much of
+  // an error from frame to frame, so a landmark seen again after dt carries
+  // less news: its R is scaled by (1 + rho) / (1 - rho), rho = exp(-dt / tau),
+  // the variance of the mean of such errors. The information per second then
+  // no longer grows with the frame rate. Known-id association only.
+  double error_correlation_s = 0.0;
   // Detections outside [min_range_m, max_range_m] are rejected as invalid.
   double min_range_m = 0.05;
   double max_range_m = 50.0;
