@@ -121,12 +121,10 @@ void FastSlam2::move_particles() {
 void FastSlam2::refresh_caches() {
   const std::size_t n = particles_.size();
   heading_cs_.resize(n);
-  std::vector<double> log_w(n);
   for (std::size_t i = 0; i < n; ++i) {
     heading_cs_[i] = Eigen::Vector2d(std::cos(particles_[i].pose.mean.z()), std::sin(particles_[i].pose.mean.z()));
-    log_w[i] = particles_[i].log_weight;
   }
-  weights_ = normalised_weights(log_w);
+  weights_ = normalised_particle_weights();
   // The weighted moments pose_estimate() expands its sums into.
   Moments m;
   m.effective_sample_size = effective_sample_size(weights_);
@@ -282,8 +280,9 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
     }
   }
   const bool landmark_floor = options_.landmark_uncertainty && options_.association == Association::kKnownId;
-  if (landmark_floor) capture_mapped_spread(valid);
-  resample_if_needed();
+  const std::vector<double> weights = normalised_particle_weights();
+  if (landmark_floor) capture_mapped_spread(valid, weights);
+  resample_if_needed(weights);
   refresh_caches();
   update_output_frame();
   if (landmark_floor) update_landmark_floor(valid);
@@ -299,11 +298,14 @@ double FastSlam2::correlated_error_factor(std::uint32_t slot, double t_s) {
   return (1.0 + rho) / (1.0 - rho);
 }
 
-void FastSlam2::capture_mapped_spread(const std::vector<RangeBearing>& valid) {
-  // Before resampling: the spread of each newly mapped landmark over all particles.
+std::vector<double> FastSlam2::normalised_particle_weights() const {
   std::vector<double> log_w(particles_.size());
   for (std::size_t i = 0; i < particles_.size(); ++i) log_w[i] = particles_[i].log_weight;
-  const std::vector<double> w = normalised_weights(log_w);
+  return normalised_weights(log_w);
+}
+
+void FastSlam2::capture_mapped_spread(const std::vector<RangeBearing>& valid, const std::vector<double>& w) {
+  // Before resampling: the spread of each newly mapped landmark over all particles.
   mapped_spread_.resize(id_of_slot_.size(), Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN()));
   for (std::size_t k = 0; k < valid.size(); ++k) {
     const std::uint32_t slot = slots_[k];
@@ -618,10 +620,7 @@ void FastSlam2::finish_joint(Particle& p) {
   p.joint.clear();
 }
 
-void FastSlam2::resample_if_needed() {
-  std::vector<double> log_w(particles_.size());
-  for (std::size_t i = 0; i < particles_.size(); ++i) log_w[i] = particles_[i].log_weight;
-  const std::vector<double> w = normalised_weights(log_w);
+void FastSlam2::resample_if_needed(const std::vector<double>& w) {
   const double n_eff = effective_sample_size(w);
   const bool resample = options_.resample_mode == ResampleMode::kEveryFrame ||
                         n_eff < options_.resample_neff_fraction * static_cast<double>(particles_.size());

@@ -146,7 +146,9 @@ class FastSlam2 {
   void update_particle(Particle& p, const std::vector<RangeBearing>& detections);
   void update_particle_joint(Particle& p, const std::vector<RangeBearing>& detections);
   void finish_joint(Particle& p);
-  void resample_if_needed();
+  // The particles' weights normalised (from their log weights).
+  std::vector<double> normalised_particle_weights() const;
+  void resample_if_needed(const std::vector<double>& weights);
   std::size_t best_index() const;
   const std::vector<double>& weights() const { return weights_; }  // normalised importance weights
   // Anchors the output frame once the first landmarks pin it, then keeps the
@@ -204,7 +206,7 @@ class FastSlam2 {
   // particles when first mapped (NaN until then), and the pose floor it implies.
   std::vector<Eigen::Matrix2d> mapped_spread_;
   Eigen::Matrix3d landmark_floor_ = Eigen::Matrix3d::Zero();
-  void capture_mapped_spread(const std::vector<RangeBearing>& valid);
+  void capture_mapped_spread(const std::vector<RangeBearing>& valid, const std::vector<double>& weights);
   void update_landmark_floor(const std::vector<RangeBearing>& valid);
   double output_rotation_rad_ = 0.0;
   Eigen::Vector2d output_translation_m_ = Eigen::Vector2d::Zero();
