@@ -9,6 +9,7 @@
 #include <exception>
 
 #include "pixyslam/app/command_line.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/dds/endpoints.h"
@@ -54,10 +55,5 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   pixyslam::app::StopSignal::install();
-  try {
-    return pixyslam::run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "spy_test_publisher: %s\n", e.what());
-    return 1;
-  }
+  return pixyslam::app::run_main("spy_test_publisher", [&] { return pixyslam::run(argc, argv); });
 }

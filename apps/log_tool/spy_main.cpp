@@ -32,6 +32,9 @@
 #include "pixyslam/config/yaml_text.h"
 #include "spy_commands.h"
 
+#ifndef PIXYSLAM_TOOL_NAME  // pixyslam_spy or pixyslam_log: the same program
+#define PIXYSLAM_TOOL_NAME "pixyslam_spy"
+#endif
 #ifndef PIXYSLAM_DEFAULT_PROFILES_FILE
 #define PIXYSLAM_DEFAULT_PROFILES_FILE ""
 #endif
@@ -39,15 +42,15 @@
 namespace {
 
 constexpr const char* kUsage =
-    "usage: pixyslam_spy participants [--seconds N] [DDS options]\n"
-    "       pixyslam_spy topics [--seconds N] [DDS options]\n"
-    "       pixyslam_spy echo TOPIC [--json] [--count N] [--seconds N] [DDS options]\n"
-    "       pixyslam_spy hz TOPIC [--seconds N] [DDS options]\n"
-    "       pixyslam_spy diagnostics [--seconds N] [DDS options]\n"
-    "       pixyslam_spy info FILE.mcap\n"
-    "       pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]\n"
-    "       pixyslam_spy print FILE.mcap [--topic TOPIC] [--json]\n"
-    "       pixyslam_spy compare A.mcap B.mcap --topic TOPIC [--ignore FIELD,...] [--tolerance X]\n"
+    "usage: " PIXYSLAM_TOOL_NAME " participants [--seconds N] [DDS options]\n"
+    "       " PIXYSLAM_TOOL_NAME " topics [--seconds N] [DDS options]\n"
+    "       " PIXYSLAM_TOOL_NAME " echo TOPIC [--json] [--count N] [--seconds N] [DDS options]\n"
+    "       " PIXYSLAM_TOOL_NAME " hz TOPIC [--seconds N] [DDS options]\n"
+    "       " PIXYSLAM_TOOL_NAME " diagnostics [--seconds N] [DDS options]\n"
+    "       " PIXYSLAM_TOOL_NAME " info FILE.mcap\n"
+    "       " PIXYSLAM_TOOL_NAME " check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]\n"
+    "       " PIXYSLAM_TOOL_NAME " print FILE.mcap [--topic TOPIC] [--json]\n"
+    "       " PIXYSLAM_TOOL_NAME " compare A.mcap B.mcap --topic TOPIC [--ignore FIELD,...] [--tolerance X]\n"
     "DDS options: --dds-config FILE (YAML with a dds: mapping; default " PIXYSLAM_DEFAULT_PROFILES_FILE
     ", domain 0)\n"
     "             --domain N (overrides the file's domain_id)\n"
@@ -179,7 +182,7 @@ int main(int argc, char** argv) {
     }
     a = parse(command, args);
   } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "pixyslam_spy: %s\n%s", e.what(), kUsage);
+    std::fprintf(stderr, PIXYSLAM_TOOL_NAME ": %s\n%s", e.what(), kUsage);
     return 2;
   }
 
@@ -209,10 +212,10 @@ int main(int argc, char** argv) {
     request.seconds = a.seconds < 0 ? 0.0 : a.seconds;
     return log_tool::run_echo(options, request, std::cout);
   } catch (const config::ConfigError& e) {
-    std::fprintf(stderr, "pixyslam_spy: config error: %s\n", e.what());
+    std::fprintf(stderr, PIXYSLAM_TOOL_NAME ": config error: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "pixyslam_spy: %s\n", e.what());
+    std::fprintf(stderr, PIXYSLAM_TOOL_NAME ": %s\n", e.what());
     return 1;
   }
 }
