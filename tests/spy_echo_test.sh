@@ -2,7 +2,8 @@
 # Integration test of pixyslam_spy on loopback, on a DDS domain of its own:
 # spy_test_publisher publishes Odometry whose values follow from header.seq;
 # `echo --json --count 3` must print exactly those values (every field),
-# `echo` (YAML) one document, `participants` the publisher with its pid and
+# `echo` (YAML) one document, `echo` of a topic with a kept history (30
+# MapStates) the newest, `participants` the publisher with its pid and
 # host, `topics` its writer with the QoS of the profile, `hz` a rate.
 #   spy_echo_test.sh SPY PUBLISHER CONFIG_DIR
 set -euo pipefail
@@ -24,7 +25,7 @@ sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/config/*.yaml
 cfg="$work/config/encoder_bridge.yaml"
 fail() { echo "FAIL: $*"; exit 1; }
 
-"$publisher" --dds-config "$cfg" --rate-hz 20 > "$work/publisher.log" 2>&1 &
+"$publisher" --dds-config "$cfg" --rate-hz 20 --map-states 30 > "$work/publisher.log" 2>&1 &
 pub_pid=$!
 for _ in $(seq 100); do  # its participant and writer exist once it says so
   grep -q "publishing on domain" "$work/publisher.log" && break
@@ -60,6 +61,10 @@ seq=$(grep -oE '^  seq: [0-9]+' "$work/echo.yaml" | grep -oE '[0-9]+')
 grep -qx -- "---" "$work/echo.yaml" || fail "no YAML document start"
 grep -qx "v_mps: $seq.5" "$work/echo.yaml" || fail "v_mps of seq $seq"
 grep -qx "encoder_samples: $((seq + 3))" "$work/echo.yaml" || fail "encoder_samples of seq $seq"
+
+echo "== echo of a kept history (30 MapStates, transient local) --count 1: the newest"
+"$spy" echo pixyslam/map_state --domain "$domain" --json --count 1 --seconds 20 | tee "$work/map.json"
+grep -q '"seq":30,' "$work/map.json" || fail "echo printed another MapState than the newest (seq 30)"
 
 echo "== topics"
 "$spy" topics --dds-config "$cfg" --seconds 4 | tee "$work/topics.txt"

@@ -18,9 +18,10 @@ namespace pixyslam {
 namespace {
 
 int run(int argc, char** argv) {
-    const app::CommandLine args(argc, argv, {"dds-config", "rate-hz"});
+    const app::CommandLine args(argc, argv, {"dds-config", "rate-hz", "map-states"});
     if (args.help()) {
-      std::printf("usage: spy_test_publisher --dds-config FILE [--rate-hz HZ]\n");
+      std::printf("usage: spy_test_publisher --dds-config FILE [--rate-hz HZ] [--map-states N]\n"
+                  "  --map-states N  first publish N MapStates (seq 1..N, transient local: kept for late readers)\n");
       return 0;
     }
     const std::string file = args.get("dds-config");
@@ -31,6 +32,14 @@ int run(int argc, char** argv) {
 
     dds::Participant participant(options, "spy_test_publisher");
     dds::Writer<msg::Odometry> writer(participant);
+    dds::Writer<msg::MapState> maps(participant);
+    const auto map_states = static_cast<std::uint64_t>(args.number("map-states", 0.0));
+    for (std::uint64_t n = 1; n <= map_states; ++n) {
+      msg::MapState m;
+      m.header().stamp_ns(1000000000000000000ull + n);
+      m.header().frame_id("map");
+      maps.publish(m);
+    }
     std::fprintf(stderr, "spy_test_publisher: publishing on domain %d\n", options.domain_id);
     const auto period = std::chrono::milliseconds(static_cast<int>(1000.0 / rate_hz));
     while (!app::StopSignal::wait_for(period)) {

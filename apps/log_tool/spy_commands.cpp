@@ -302,28 +302,71 @@ int run_topics(const dds::DdsOptions& dds, double seconds, std::ostream& out) {
   return 0;
 }
 
+namespace {
+
+// Which writer a sample comes from, as far as echo tells them apart: the
+// robot and frame, and for diagnostics the process.
+template <class Message>
+std::string writer_key(const Message& m) {
+  return m.header().robot_id() + "/" + m.header().frame_id();
+}
+std::string writer_key(const msg::Diagnostics& m) {
+  return m.header().robot_id() + "/" + m.process() + "/" + std::to_string(m.pid());
+}
+
+// A reader that joins late gets each transient-local writer's kept history at
+// once, oldest first: of what arrives within this time of the first sample,
+// echo prints only the newest per writer (the current map, not one seconds old).
+constexpr auto kHistoryWindow = std::chrono::milliseconds(300);
+
+struct PendingSample {
+  std::string text;
+  std::string writer;
+};
+
+// The newest sample per writer, in arrival order.
+void keep_newest_per_writer(std::deque<PendingSample>& pending) {
+  std::map<std::string, std::size_t> newest;
+  for (std::size_t i = 0; i < pending.size(); ++i) newest[pending[i].writer] = i;
+  std::deque<PendingSample> kept;
+  for (std::size_t i = 0; i < pending.size(); ++i) {
+    if (newest[pending[i].writer] == i) kept.push_back(std::move(pending[i]));
+  }
+  pending.swap(kept);
+}
+
+}  // namespace
+
 int run_echo(const dds::DdsOptions& options, const EchoRequest& request, std::ostream& out) {
   return with_topic_type(request.topic, [&](auto tag) {
     using Message = decltype(tag);
     std::mutex mutex;
     std::condition_variable cv;
-    std::deque<std::string> pending;
+    std::deque<PendingSample> pending;
+    Clock::time_point first_arrival{};
     dds::Participant participant(options, "pixyslam_spy");
     dds::Reader<Message> reader(participant, [&](const Message& m) {
       const Value value = to_value(m);
       std::string text = request.json ? to_json_line(value) + "\n" : to_yaml_document(value);
       std::lock_guard<std::mutex> lock(mutex);
-      pending.push_back(std::move(text));
+      if (first_arrival == Clock::time_point{}) first_arrival = Clock::now();
+      pending.push_back({std::move(text), writer_key(m)});
       cv.notify_all();
     });
     std::size_t printed = 0;
+    bool history_done = false;
     const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(request.seconds));
     while (!app::StopSignal::requested() && (request.count == 0 || printed < request.count) &&
            (request.seconds <= 0.0 || Clock::now() < end)) {
       std::unique_lock<std::mutex> lock(mutex);
       cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return !pending.empty(); });
+      if (!history_done) {
+        if (pending.empty() || Clock::now() < first_arrival + kHistoryWindow) continue;
+        keep_newest_per_writer(pending);
+        history_done = true;
+      }
       while (!pending.empty() && (request.count == 0 || printed < request.count)) {
-        out << pending.front();
+        out << pending.front().text;
         pending.pop_front();
         ++printed;
       }
