@@ -420,7 +420,28 @@ int run_hz(const dds::DdsOptions& options, const std::string& topic, double seco
       arrivals_s.push_back(t);
       stamps_s.push_back(static_cast<double>(m.header().stamp_ns()) * 1e-9);
     });
-    wait(seconds, [] { return false; });
+    // A line every second while listening (as ros2 topic hz): the rate over the
+    // last second and over everything so far.
+    std::size_t reported = 0;
+    for (double next_report_s = 1.0;; next_report_s += 1.0) {
+      const double remaining_s = seconds > 0.0 ? seconds - std::chrono::duration<double>(Clock::now() - start).count()
+                                               : next_report_s;
+      if (remaining_s <= 0.0) break;
+      const double now_s = std::chrono::duration<double>(Clock::now() - start).count();
+      wait(std::max(1e-3, std::min(remaining_s, next_report_s - now_s)), [] { return false; });  // 0 would wait for ever
+      if (app::StopSignal::requested() ||
+          (seconds > 0.0 && std::chrono::duration<double>(Clock::now() - start).count() >= seconds)) {
+        break;
+      }
+      std::lock_guard<std::mutex> lock(mutex);
+      const GapStats so_far = gap_stats(arrivals_s);
+      const std::size_t last_second = arrivals_s.size() - reported;
+      reported = arrivals_s.size();
+      char line[160];
+      std::snprintf(line, sizeof(line), "  %4.0f s: %zu messages in the last second, %.3f Hz since the start\n",
+                    next_report_s, last_second, so_far.messages >= 2 ? so_far.rate_hz : 0.0);
+      out << line << std::flush;
+    }
     const double listened_s = std::chrono::duration<double>(Clock::now() - start).count();
     std::lock_guard<std::mutex> lock(mutex);
     const GapStats arrival = gap_stats(arrivals_s);
