@@ -156,7 +156,14 @@ void LogPlayer::wait_for_readers() {
   const auto until = std::chrono::steady_clock::now() +
                      std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                          std::chrono::duration<double>(options_.wait_timeout_s));
+  bool said = false;
   for (const auto& channel : channels_) {
+    if (!said && channel->matched_readers() < options_.wait_readers) {
+      log_ << "pixyslam_play: waiting up to " << options_.wait_timeout_s << " s for " << options_.wait_readers
+           << " reader(s) per topic (--wait-readers 0: do not wait)\n";
+      log_.flush();
+      said = true;
+    }
     while (channel->matched_readers() < options_.wait_readers) {
       if (std::chrono::steady_clock::now() >= until || app::StopSignal::requested()) {
         log_ << "pixyslam_play: warning: " << channel->report().topic << " has " << channel->matched_readers()
