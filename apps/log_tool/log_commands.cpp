@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <ctime>
 #include <iomanip>
+#include <map>
+#include <string>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -17,6 +20,18 @@
 namespace pixyslam::log_tool {
 
 namespace {
+
+// "2026-11-25 14:03:07.123 UTC" for nanoseconds since the epoch.
+std::string utc_time(std::uint64_t ns) {
+  const std::time_t t = static_cast<std::time_t>(ns / 1000000000ull);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char text[40];
+  std::strftime(text, sizeof(text), "%Y-%m-%d %H:%M:%S", &tm);
+  char out[48];
+  std::snprintf(out, sizeof(out), "%s.%03u UTC", text, static_cast<unsigned>((ns / 1000000ull) % 1000ull));
+  return out;
+}
 
 const char* yes_no(bool b) { return b ? "yes" : "no"; }
 
@@ -109,13 +124,22 @@ int run_info(const std::string& path, std::ostream& out, std::ostream& err) {
   std::uint64_t first = std::numeric_limits<std::uint64_t>::max();
   std::uint64_t last = 0;
   std::map<std::uint16_t, std::uint64_t> per_channel;
+  std::map<std::uint16_t, std::pair<std::uint64_t, std::uint64_t>> channel_span;  // first, last log time
   for (const logger::McapMessage& m : messages) {
     first = std::min(first, m.log_time_ns);
     last = std::max(last, m.log_time_ns);
     ++per_channel[m.channel_id];
+    auto [it, inserted] = channel_span.try_emplace(m.channel_id, m.log_time_ns, m.log_time_ns);
+    if (!inserted) {
+      it->second.first = std::min(it->second.first, m.log_time_ns);
+      it->second.second = std::max(it->second.second, m.log_time_ns);
+    }
   }
   out << "messages:    " << messages.size();
-  if (!messages.empty()) out << " over " << seconds(last - first) << " (log time " << first << " .. " << last << " ns)";
+  if (!messages.empty()) {
+    out << " over " << seconds(last - first) << ", " << utc_time(first) << " .. " << utc_time(last) << " (log time "
+        << first << " .. " << last << " ns)";
+  }
   out << "\n";
 
   std::map<std::string, std::uint64_t> by_compression;
@@ -145,8 +169,16 @@ int run_info(const std::string& path, std::ostream& out, std::ostream& err) {
   out << "topics:      " << reader.channels().size() << "\n";
   for (const logger::McapChannel& c : reader.channels()) {
     const logger::McapSchema* schema = reader.find_schema(c.schema_id);
+    // The topic's rate between its own first and last message.
+    char rate[32] = "";
+    const auto span = channel_span.find(c.id);
+    if (span != channel_span.end() && span->second.second > span->second.first) {
+      std::snprintf(rate, sizeof(rate), "%9.2f Hz", static_cast<double>(per_channel[c.id] - 1) /
+                                                        (static_cast<double>(span->second.second - span->second.first) * 1e-9));
+    }
     out << "  " << std::left << std::setw(32) << c.topic << std::right << std::setw(8) << per_channel[c.id]
-        << " messages  " << (schema ? schema->name : std::string("(no schema)")) << "  " << c.message_encoding;
+        << " messages" << rate << "  " << (schema ? schema->name : std::string("(no schema)")) << "  "
+        << c.message_encoding;
     for (const auto& [key, value] : c.metadata) out << "  " << key << "=" << value;
     out << "\n";
   }
