@@ -6,13 +6,31 @@
 # ends by itself after two laps (~90 s) and prints the pose and landmark errors,
 # messages per topic and where the MCAP log is. Exit code 0 only if every
 # process ended cleanly and the ATE is under 0.10 m.
-#   scripts/run_demo.sh [--run-dir DIR] [--duration S]
+#   scripts/run_demo.sh [--run-dir DIR] [any other pixyslam_launch option, e.g. --duration S]
+# The run folder (default build/demo_run) is emptied first.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-"$root/scripts/install_deps.sh"
-"$root/scripts/build.sh"
 build_dir=${BUILD_DIR:-$root/build}
 run_dir="$build_dir/demo_run"
-if [[ "${1:-}" == "--run-dir" ]]; then run_dir=$2; shift 2; fi
+launch_args=()
+while (($#)); do
+  case $1 in
+    -h | --help)
+      sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'
+      exit 0
+      ;;
+    --run-dir)
+      (($# >= 2)) || { echo "run_demo.sh: --run-dir needs a folder" >&2; exit 2; }
+      run_dir=$2
+      shift 2
+      ;;
+    *)
+      launch_args+=("$1")
+      shift
+      ;;
+  esac
+done
+"$root/scripts/install_deps.sh"
+"$root/scripts/build.sh"
 rm -rf "$run_dir"
-exec "$build_dir/bin/pixyslam_launch" "$root/config/launch_sim.yaml" --run-dir "$run_dir" "$@"
+exec "$build_dir/bin/pixyslam_launch" "$root/config/launch_sim.yaml" --run-dir "$run_dir" "${launch_args[@]}"
