@@ -1,5 +1,5 @@
-# ctest script (logger_process_smoke): the `logger` executable and pixyslam_log
-# end to end. Arguments: LOGGER, LOG_TOOL, CONFIG (config/logger.yaml),
+# ctest script (logger_process_smoke): the `logger` executable (also --topics)
+# and pixyslam_log end to end. Arguments: LOGGER, LOG_TOOL, CONFIG (config/logger.yaml),
 # RECORDING (a complete file made by test_logger), WORK_DIR.
 cmake_minimum_required(VERSION 3.22)
 
@@ -49,6 +49,20 @@ expect_match("pixyslam_log info on the logger's file" "${info}" "status: +comple
 expect_match("pixyslam_log info on the logger's file" "${info}" "schemas: +6")  # every topic of config/logger.yaml
 execute_process(COMMAND ${LOG_TOOL} check ${out} --expect pixyslam/odometry=0 RESULT_VARIABLE rc OUTPUT_VARIABLE check)
 expect_status("pixyslam_log check on the logger's empty file:\n${check}" "${rc}" 0)
+
+# 2b. --topics records only those (two channels, two schemas); a bad pattern
+#     is a usage error (exit 2) naming it.
+set(two ${WORK_DIR}/two_topics.mcap)
+execute_process(COMMAND ${TIMEOUT} --preserve-status -s INT 2 ${LOGGER} --config ${config} --out ${two}
+  --topics pixyslam/odometry,pixyslam/map_state RESULT_VARIABLE rc OUTPUT_VARIABLE stdout ERROR_VARIABLE err)
+expect_status("logger --topics (stderr: ${err})" "${rc}" 0)
+expect_match("logger --topics effective configuration" "${stdout}" "topics: \\[pixyslam/odometry, pixyslam/map_state\\]")
+execute_process(COMMAND ${LOG_TOOL} info ${two} RESULT_VARIABLE rc OUTPUT_VARIABLE info)
+expect_match("pixyslam_log info on the two-topic file" "${info}" "schemas: +2")
+expect_match("pixyslam_log info on the two-topic file" "${info}" "topics: +2")
+execute_process(COMMAND ${LOGGER} --config ${config} --topics pixyslam/nope RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+expect_status("logger --topics with an unknown topic" "${rc}" 2)
+expect_match("logger --topics with an unknown topic" "${err}" "--topics: 'pixyslam/nope'")
 
 # 3. A copy of the recording cut at 60 %: info reports the recovery, check
 #    refuses it unless --allow-recovered (then the recovered prefix checks).

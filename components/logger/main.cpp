@@ -1,7 +1,8 @@
 // logger: records DDS topics to an MCAP file until SIGINT/SIGTERM.
-//   logger --config config/logger.yaml [--out FILE.mcap]
+//   logger --config config/logger.yaml [--out FILE.mcap] [--topics LIST]
 // --out overrides logger.output_file (with rotation: the base of the names,
-// run.mcap -> run_000.mcap, run_001.mcap, ...). Prints the effective
+// run.mcap -> run_000.mcap, run_001.mcap, ...); --topics logger.topics
+// (comma-separated names or patterns, as the config's list). Prints the effective
 // configuration to stdout, logs to stderr; on a stop it drains what was
 // received, closes the file (summary and footer) and prints per-topic counts,
 // then one line per file: "logger: file PATH: M messages, C chunks, B bytes".
@@ -15,26 +16,47 @@
 #include <cstdio>
 #include <exception>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/config/yaml_text.h"
+#include "pixyslam/logger_node/cdr_payload.h"
 #include "pixyslam/logger_node/logger_node.h"
+#include "pixyslam/logger_node/topic_selection.h"
 
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();  // first: every thread inherits the blocked signals
-  constexpr const char* kUsage = "usage: logger --config FILE [--out FILE.mcap]";
+  constexpr const char* kUsage =
+      "usage: logger --config FILE [--out FILE.mcap] [--topics LIST]\n"
+      "  --out FILE.mcap  the recording (overrides logger.output_file)\n"
+      "  --topics LIST    topics to record, comma-separated names or patterns (overrides logger.topics),\n"
+      "                   e.g. pixyslam/odometry,pixyslam/map_state or 'pixyslam/*,!pixyslam/diagnostics'";
 
   logger_node::LoggerOptions options;
   try {
-    const app::CommandLine args(argc, argv, {"config", "out"});
+    const app::CommandLine args(argc, argv, {"config", "out", "topics"});
     if (args.help()) {
       std::puts(kUsage);
       return 0;
     }
     options = logger_node::read_logger_options_file(args.get("config"));
     if (args.has("out")) options.output_file = args.get("out");
+    if (args.has("topics")) {
+      const std::vector<std::string> patterns = config::split_comma_list(args.get("topics"));
+      std::vector<std::string> known;
+      for (const logger_node::TopicInfo& t : logger_node::known_topics()) known.push_back(t.topic);
+      const logger_node::TopicSelection selection = logger_node::select_topics(patterns, known);
+      if (patterns.empty() || !selection.error.empty()) {
+        throw std::invalid_argument("--topics: " + (patterns.empty() ? std::string("empty list")
+                                                                     : "'" + patterns[selection.bad_pattern] +
+                                                                           "': " + selection.error));
+      }
+      options.topics = selection.topics;
+    }
   } catch (const config::ConfigError& e) {
     std::fprintf(stderr, "logger: config error: %s\n", e.what());
     return 2;
