@@ -99,7 +99,7 @@ std::vector<std::string> PixyNode::status_lines_locked() const {
   const pixy::DetectionCounters& k = detection_counters_;
   const pixy::FrameRateCounters& r = rate_limiter_.counters();
   std::ostringstream stream, detections;
-  stream << "status: frames " << p.frames << " (timed out " << frames_timed_out_ << ", over the frame rate limit "
+  stream << "status: frames " << p.frames << " (ended by the pause after them " << frames_timed_out_ << ", over the frame rate limit "
          << r.rate_limited << ", of which without blocks " << r.empty_rate_limited << "), blocks " << p.blocks_ok
          << " (colour code " << p.colour_code_blocks_ok << ", outside a frame " << p.blocks_outside_frame
          << "), checksum errors " << p.checksum_errors << ", signature 0 " << p.zero_signature_blocks
