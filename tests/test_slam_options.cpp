@@ -1,7 +1,9 @@
 // Tests of read_filter_options: values round-trip from YAML, and every kind of
 // configuration mistake is a config::ConfigError naming the origin and key path.
 
+#include <cmath>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -244,6 +246,98 @@ TEST(SlamOptionsYaml, MissingFileNamesThePath) {
     FAIL() << "expected ConfigError";
   } catch (const ConfigError& e) {
     EXPECT_TRUE(contains(e.what(), "pixyslam_missing_filter.yaml")) << e.what();
+  }
+}
+
+// ---- The parameter table (filter_parameters()): one declaration per parameter.
+
+// Every member of FilterOptions is in the table: the effective configuration
+// printed from a changed struct reads back into the same struct.
+TEST(FilterParameters, EffectiveConfigurationReadsBackIntoTheSameOptions) {
+  FilterOptions o;
+  o.particles = 321;
+  o.seed = 987654321;
+  o.motion.w_sigma_rad_per_sqrt_s = 0.0225;
+  o.error_correlation_s = 0.7;
+  o.gate_enabled = false;
+  o.association = Association::kKnownId;
+  o.resample_mode = ResampleMode::kEveryFrame;
+  o.delayed_sampling.enabled = true;
+  o.delayed_sampling.max_landmarks = 24;
+  o.anchor_frame.min_spread_m = 0.75;
+  o.landmark_uncertainty = true;
+  const std::string yaml = parameters::to_yaml(o, filter_parameters(), "filter");
+  const FilterOptions back = read(yaml);
+  for (const auto& p : filter_parameters()) {
+    EXPECT_EQ(parameters::value_text(p, back), parameters::value_text(p, o)) << p.path << "\n" << yaml;
+  }
+  EXPECT_EQ(back.seed, 987654321u);
+  EXPECT_EQ(back.resample_mode, ResampleMode::kEveryFrame);
+  EXPECT_TRUE(contains(yaml, "    w_sigma_rad_per_sqrt_s: 0.0225  # rad/sqrt(s)\n")) << yaml;
+}
+
+TEST(FilterParameters, PathsAreUniqueAndTheDefaultsInRange) {
+  const auto& table = filter_parameters();
+  EXPECT_GE(table.size(), 30u);
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    EXPECT_FALSE(table[i].help.empty()) << table[i].path;
+    for (std::size_t j = i + 1; j < table.size(); ++j) EXPECT_NE(table[i].path, table[j].path);
+  }
+  EXPECT_NO_THROW(validate(FilterOptions{}));
+  const std::string help = parameters::help_text(table, "filter");
+  for (const auto& p : table) EXPECT_TRUE(contains(help, "filter." + p.path + "  ")) << p.path;
+}
+
+TEST(FilterParameters, OverridesCheckNameTypeAndRange) {
+  FilterOptions o;
+  parameters::apply_override(o, filter_parameters(), "filter", "filter.particles=250");
+  parameters::apply_override(o, filter_parameters(), "filter", "filter.gate.enabled=false");
+  parameters::apply_override(o, filter_parameters(), "filter", "filter.association.mode=maximum_likelihood");
+  parameters::apply_override(o, filter_parameters(), "filter", "filter.observation.range_sigma_m=0.125");
+  EXPECT_EQ(o.particles, 250);
+  EXPECT_FALSE(o.gate_enabled);
+  EXPECT_EQ(o.association, Association::kMaximumLikelihood);
+  EXPECT_DOUBLE_EQ(o.range_sigma_m, 0.125);
+  const auto error = [&](const std::string& assignment) {
+    try {
+      parameters::apply_override(o, filter_parameters(), "filter", assignment);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    ADD_FAILURE() << "expected an error for " << assignment;
+    return std::string();
+  };
+  EXPECT_TRUE(contains(error("filter.particles=0"), "filter.particles = '0': out of range ([1, 1000000])"));
+  EXPECT_TRUE(contains(error("filter.particles=2.5"), "not an integer"));
+  EXPECT_TRUE(contains(error("filter.particles=many"), "not a number"));
+  EXPECT_TRUE(contains(error("filter.gate.enabled=yes"), "not true or false"));
+  EXPECT_TRUE(contains(error("filter.resample.mode=often"), "effective_sample_size | every_frame"));
+  EXPECT_TRUE(contains(error("filter.particle=3"), "unknown parameter 'filter.particle'"));
+  EXPECT_TRUE(contains(error("estimator.particles=3"), "not a parameter of 'filter'"));
+  EXPECT_TRUE(contains(error("filter.particles"), "expected KEY=VALUE"));
+  EXPECT_EQ(o.particles, 250);  // a refused override leaves the value
+}
+
+TEST(FilterParameters, ValidateNamesTheParameterWithItsRange) {
+  FilterOptions o;
+  o.particles = 0;
+  try {
+    validate(o);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_TRUE(contains(e.what(), "filter.particles = 0: must be in [1, 1000000]")) << e.what();
+  }
+  o = FilterOptions{};
+  o.motion.v_sigma_m_per_sqrt_s = std::nan("");
+  EXPECT_THROW(validate(o), std::invalid_argument);
+  o = FilterOptions{};
+  o.error_correlation_s = 0.5;
+  o.association = Association::kMaximumLikelihood;
+  try {
+    validate(o);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_TRUE(contains(e.what(), "filter.observation.error_correlation_s")) << e.what();
   }
 }
 

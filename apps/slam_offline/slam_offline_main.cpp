@@ -21,6 +21,7 @@
 #include "optimised_run.h"
 #endif
 #include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/config/yaml_text.h"
 #include "pixyslam/eval/csv_io.h"
 #include "pixyslam/sim/sim_world.h"
 #include "pixyslam/slam/slam_options_yaml.h"
@@ -30,11 +31,15 @@ namespace {
 using namespace pixyslam;
 
 constexpr const char* kUsage =
-    "usage: slam_offline sim    --config FILE --out DIR [--seed S] [--optimise] [--write-dataset DIR]\n"
-    "       slam_offline mrclam --dataset DIR --robot N --config FILE --out DIR [--seed S] [--optimise]\n"
-    "       slam_offline hardware --config FILE --sim-config FILE --out DIR [--seed S] [--duration S] [--optimise]\n"
+    "usage: slam_offline sim    --config FILE --out DIR [--seed S] [--set ...] [--optimise] [--write-dataset DIR]\n"
+    "       slam_offline mrclam --dataset DIR --robot N --config FILE --out DIR [--seed S] [--set ...] [--optimise]\n"
+    "       slam_offline hardware --config FILE --sim-config FILE --out DIR [--seed S] [--set ...] [--duration S]\n"
+    "                           [--optimise]\n"
     "         (hardware: the robot_sim hardware decoded by the bridges' parsers; the\n"
     "          pixy/encoder configs are taken from beside --sim-config)\n"
+    "  --set KEY=VALUE,...  override filter parameters of the config, e.g.\n"
+    "              --set filter.particles=300,filter.resample.mode=every_frame\n"
+    "              (slam_estimator --help lists them)\n"
     "  --optimise  also solve the whole run with the map optimiser (Ceres); its\n"
     "              solution goes to trajectory.csv and landmarks.csv, the filter's\n"
     "              to filter_trajectory.csv and filter_landmarks.csv\n"
@@ -67,8 +72,8 @@ Args parse_args(int argc, char** argv) {
       a.optimise = true;
       continue;
     }
-    static const char* known[] = {"--config", "--out",        "--seed",     "--dataset",
-                                  "--robot",  "--sim-config", "--duration", "--write-dataset"};
+    static const char* known[] = {"--config",     "--out",      "--seed",          "--dataset", "--robot",
+                                  "--sim-config", "--duration", "--write-dataset", "--set"};
     bool ok = false;
     for (const char* k : known) ok = ok || key == k;
     if (!ok) throw std::invalid_argument("unknown argument '" + key + "'");
@@ -137,7 +142,19 @@ int run(const Args& args) {
   config::YamlReader root = config::YamlReader::from_file(config_path);
   config::YamlReader filter_yaml = root.child("filter");
   slam::FilterOptions options = slam::read_filter_options(filter_yaml);
-  if (args.values.count("seed")) options.seed = static_cast<std::uint64_t>(parse_long(args.get("seed"), "--seed"));
+  try {
+    if (args.values.count("seed")) {
+      parameters::set_from_text(options, slam::filter_parameters(), "filter", "seed", args.get("seed"));
+    }
+    if (args.values.count("set")) {
+      for (const std::string& assignment : config::split_comma_list(args.get("set"))) {
+        parameters::apply_override(options, slam::filter_parameters(), "filter", assignment);
+      }
+    }
+    slam::validate(options);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string(args.values.count("set") ? "--set: " : "--seed: ") + e.what());
+  }
 
   offline::RunInput input;
   std::string title;

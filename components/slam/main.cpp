@@ -1,6 +1,7 @@
 // slam_estimator: FastSLAM 2.0 over DDS. Odometry + LandmarkObservation in,
 // MapState out, until SIGINT/SIGTERM.
 //   slam_estimator --config config/slam_estimator.yaml [--seed S] [--out DIR] [--checkpoint FILE]
+//                  [--set filter.KEY=VALUE,...]
 // --checkpoint (or estimator.checkpoint.file) saves the pose and map every
 // period and resumes from the file at start when it is fresh (a restart).
 // --out writes DIR/trajectory.csv (every MapState's mean pose) and DIR/landmarks.csv at exit.
@@ -11,6 +12,8 @@
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
+#include "pixyslam/config/yaml_text.h"
+#include "pixyslam/slam/slam_options.h"
 #include "pixyslam/slam_node/estimator_node.h"
 #include "pixyslam/eval/csv_io.h"
 
@@ -42,13 +45,29 @@ int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
   return app::run_main("slam_estimator", [&] {
-    const app::CommandLine args(argc, argv, {"config", "seed", "out", "checkpoint"});
+    const app::CommandLine args(argc, argv, {"config", "seed", "out", "checkpoint", "set"});
     if (args.help()) {
-      std::puts("usage: slam_estimator --config FILE [--seed S] [--out DIR] [--checkpoint FILE]");
+      std::puts("usage: slam_estimator --config FILE [--seed S] [--out DIR] [--checkpoint FILE] [--set KEY=VALUE,...]\n"
+                "  --set   override filter parameters of the config, e.g. --set filter.particles=300,filter.gate.enabled=false\n"
+                "  --seed  the same as --set filter.seed=S\n"
+                "filter parameters (the config's filter: section):");
+      std::fputs(parameters::help_text(slam::filter_parameters(), "filter").c_str(), stdout);
       return 0;
     }
     slam_node::EstimatorOptions options = slam_node::read_estimator_options_file(args.get("config"));
-    if (args.has("seed")) options.filter.seed = static_cast<std::uint64_t>(args.number("seed", 0));
+    try {
+      if (args.has("seed")) {
+        parameters::set_from_text(options.filter, slam::filter_parameters(), "filter", "seed", args.get("seed"));
+      }
+      if (args.has("set")) {
+        for (const std::string& assignment : config::split_comma_list(args.get("set"))) {
+          parameters::apply_override(options.filter, slam::filter_parameters(), "filter", assignment);
+        }
+      }
+      slam::validate(options.filter);
+    } catch (const std::invalid_argument& e) {
+      throw app::UsageError(std::string(args.has("set") ? "--set: " : "--seed: ") + e.what());
+    }
     if (args.has("checkpoint")) options.checkpoint.file = args.get("checkpoint");
     std::fprintf(stderr, "slam_estimator: %d particles, seed %llu, DDS domain %d, profiles '%s'\n",
                  options.filter.particles, static_cast<unsigned long long>(options.filter.seed),

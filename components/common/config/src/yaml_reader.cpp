@@ -311,6 +311,19 @@ std::string YamlReader::choice(const std::string& key, std::initializer_list<con
   return or_fallback(key, fallback, [&] { return choice(key, allowed); });
 }
 
+std::string YamlReader::choice(const std::string& key, const std::vector<std::string>& allowed,
+                               const std::string& fallback) {
+  return or_fallback(key, fallback, [&] {
+    const std::string s = text(key);
+    std::string list;
+    for (const std::string& a : allowed) {
+      if (s == a) return s;
+      list += list.empty() ? a : ", " + a;
+    }
+    fail(key, "value '" + s + "' is not one of: " + list);
+  });
+}
+
 void YamlReader::finish() const {
   for (const auto& kv : node_) {
     const std::string key = key_text(kv.first);

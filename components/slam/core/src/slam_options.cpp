@@ -5,71 +5,123 @@
 #include <stdexcept>
 
 namespace pixyslam::slam {
-namespace {
 
-void require(bool ok, const char* field, double value, const char* rule) {
-  if (ok) return;
-  std::ostringstream os;
-  os << "filter option '" << field << "' = " << value << ": " << rule;
-  throw std::invalid_argument(os.str());
+const parameters::Table<FilterOptions>& filter_parameters() {
+  using O = FilterOptions;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::integer<O, int>("particles", 1, 1000000, "", "M, the number of particles",
+                         [](O& o) -> int& { return o.particles; }),
+      P::integer<O, std::uint64_t>("seed", 0, std::uint64_t{1} << 53, "",
+                                   "random seed: the same seed and input give bit-identical output",
+                                   [](O& o) -> std::uint64_t& { return o.seed; }),
+      P::real<O>("motion.v_sigma_m_per_sqrt_s", 0.0, 10.0, "m/sqrt(s)", "white-noise density of the forward speed",
+                 [](O& o) -> double& { return o.motion.v_sigma_m_per_sqrt_s; }),
+      P::real<O>("motion.w_sigma_rad_per_sqrt_s", 0.0, 10.0, "rad/sqrt(s)", "white-noise density of the turn rate",
+                 [](O& o) -> double& { return o.motion.w_sigma_rad_per_sqrt_s; }),
+      P::real<O>("motion.distance_sigma_per_sqrt_m", 0.0, 10.0, "1/sqrt(m)",
+                 "distance noise growing with the distance driven (wheel slip)",
+                 [](O& o) -> double& { return o.motion.distance_sigma_per_sqrt_m; }),
+      P::real<O>("motion.heading_sigma_rad_per_sqrt_m", 0.0, 10.0, "rad/sqrt(m)",
+                 "heading noise growing with the distance driven",
+                 [](O& o) -> double& { return o.motion.heading_sigma_rad_per_sqrt_m; }),
+      P::real<O>("motion.rotation_sigma_per_sqrt_rad", 0.0, 10.0, "1/sqrt(rad)",
+                 "heading noise growing with the angle turned",
+                 [](O& o) -> double& { return o.motion.rotation_sigma_per_sqrt_rad; }),
+      P::real<O>("max_speed_mps", 1e-3, 1000.0, "m/s", "odometry faster than this is impossible: dropped and counted",
+                 [](O& o) -> double& { return o.max_speed_mps; }),
+      P::real<O>("max_turn_rate_radps", 1e-3, 1000.0, "rad/s",
+                 "odometry turning faster than this is impossible: dropped and counted",
+                 [](O& o) -> double& { return o.max_turn_rate_radps; }),
+      P::real<O>("control_timeout_s", 1e-3, 3600.0, "s", "a command held longer than this counts as stopped",
+                 [](O& o) -> double& { return o.control_timeout_s; }),
+      P::real<O>("observation.range_sigma_m", 1e-6, 100.0, "m",
+                 "range sd (+ range_sigma_per_m * range) of a detection without sigmas",
+                 [](O& o) -> double& { return o.range_sigma_m; }),
+      P::real<O>("observation.range_sigma_per_m", 0.0, 10.0, "m/m", "range sd growing with the range",
+                 [](O& o) -> double& { return o.range_sigma_per_m; }),
+      P::real<O>("observation.bearing_sigma_rad", 1e-6, 3.0, "rad", "bearing sd of a detection without sigmas",
+                 [](O& o) -> double& { return o.bearing_sigma_rad; }),
+      P::real<O>("observation.error_correlation_s", 0.0, 100.0, "s",
+                 "how long a landmark's measurement errors persist (0: white; known_id only)",
+                 [](O& o) -> double& { return o.error_correlation_s; }),
+      P::real<O>("observation.min_range_m", 0.0, 1000.0, "m", "detections nearer than this are invalid",
+                 [](O& o) -> double& { return o.min_range_m; }),
+      P::real<O>("observation.max_range_m", 0.0, 1000.0, "m",
+                 "detections farther than this are invalid (> min_range_m)",
+                 [](O& o) -> double& { return o.max_range_m; }),
+      P::boolean<O>("gate.enabled", "Mahalanobis gate on observations of mapped landmarks",
+                    [](O& o) -> bool& { return o.gate_enabled; }),
+      P::real<O>("gate.probability", 0.5, 0.999999999, "", "chi-square (2 dof) quantile of the gate",
+                 [](O& o) -> double& { return o.gate_probability; }),
+      P::integer<O, int>("gate.readmit_after", 1, 1000000, "",
+                         "consecutive rejections before a landmark is let back in",
+                         [](O& o) -> int& { return o.gate_readmit_after; }),
+      P::choice<O, Association>("association.mode",
+                                {{"known_id", Association::kKnownId},
+                                 {"maximum_likelihood", Association::kMaximumLikelihood}},
+                                "landmarks by the detection's id, or per particle the most likely",
+                                [](O& o) -> Association& { return o.association; }),
+      P::real<O>("association.new_landmark_probability", 0.5, 0.999999999, "",
+                 "maximum_likelihood: chi-square (2 dof) quantile beyond which a detection starts a landmark",
+                 [](O& o) -> double& { return o.new_landmark_probability; }),
+      P::choice<O, ResampleMode>("resample.mode",
+                                 {{"effective_sample_size", ResampleMode::kEffectiveSampleSize},
+                                  {"every_frame", ResampleMode::kEveryFrame}},
+                                 "when to resample: N_eff below neff_fraction * M, or every frame (the paper)",
+                                 [](O& o) -> ResampleMode& { return o.resample_mode; }),
+      P::real<O>("resample.neff_fraction", 1e-6, 1.0, "", "resample when N_eff < this * M",
+                 [](O& o) -> double& { return o.resample_neff_fraction; }),
+      P::boolean<O>("delayed_sampling.enabled", "keep uncertain poses and their new landmarks joint until pinned",
+                    [](O& o) -> bool& { return o.delayed_sampling.enabled; }),
+      P::real<O>("delayed_sampling.enter_heading_sigma_rad", 1e-6, 10.0, "rad", "heading sd that starts a joint state",
+                 [](O& o) -> double& { return o.delayed_sampling.enter_heading_sigma_rad; }),
+      P::real<O>("delayed_sampling.enter_position_sigma_m", 1e-6, 1000.0, "m",
+                 "position sd (worst direction) that starts a joint state",
+                 [](O& o) -> double& { return o.delayed_sampling.enter_position_sigma_m; }),
+      P::real<O>("delayed_sampling.exit_heading_sigma_rad", 1e-6, 10.0, "rad",
+                 "heading sd that ends it (<= enter_heading_sigma_rad)",
+                 [](O& o) -> double& { return o.delayed_sampling.exit_heading_sigma_rad; }),
+      P::real<O>("delayed_sampling.exit_position_sigma_m", 1e-6, 1000.0, "m",
+                 "position sd that ends it (<= enter_position_sigma_m)",
+                 [](O& o) -> double& { return o.delayed_sampling.exit_position_sigma_m; }),
+      P::integer<O, int>("delayed_sampling.max_landmarks", 1, 1000, "", "landmarks a joint state holds at most",
+                         [](O& o) -> int& { return o.delayed_sampling.max_landmarks; }),
+      P::boolean<O>("anchor_frame.enabled", "keep the output on the first landmarks' frame",
+                    [](O& o) -> bool& { return o.anchor_frame.enabled; }),
+      P::integer<O, int>("anchor_frame.min_landmarks", 2, 64, "", "landmarks that pin the frame (a rotation needs two)",
+                         [](O& o) -> int& { return o.anchor_frame.min_landmarks; }),
+      P::integer<O, int>("anchor_frame.min_observations", 1, 1000000, "", "observations of each in the best particle",
+                         [](O& o) -> int& { return o.anchor_frame.min_observations; }),
+      P::real<O>("anchor_frame.min_spread_m", 1e-3, 1000.0, "m", "their RMS spread around their centroid",
+                 [](O& o) -> double& { return o.anchor_frame.min_spread_m; }),
+      P::boolean<O>("frame_uncertainty.enabled", "output covariance floored at the map frame's uncertainty",
+                    [](O& o) -> bool& { return o.frame_uncertainty; }),
+      P::boolean<O>("frame_uncertainty.landmarks", "and at what the seen landmarks' spread when mapped implies",
+                    [](O& o) -> bool& { return o.landmark_uncertainty; }),
+  };
+  return table;
 }
-
-void require_non_negative(double v, const char* field) {
-  require(std::isfinite(v) && v >= 0.0, field, v, "must be a finite number >= 0");
-}
-
-void require_positive(double v, const char* field) {
-  require(std::isfinite(v) && v > 0.0, field, v, "must be a finite number > 0");
-}
-
-}  // namespace
 
 void validate(const FilterOptions& o) {
-  require(o.particles >= 1 && o.particles <= 1000000, "particles", o.particles, "must be in [1, 1000000]");
-  require_non_negative(o.motion.v_sigma_m_per_sqrt_s, "motion.v_sigma_m_per_sqrt_s");
-  require_non_negative(o.motion.w_sigma_rad_per_sqrt_s, "motion.w_sigma_rad_per_sqrt_s");
-  require_non_negative(o.motion.distance_sigma_per_sqrt_m, "motion.distance_sigma_per_sqrt_m");
-  require_non_negative(o.motion.heading_sigma_rad_per_sqrt_m, "motion.heading_sigma_rad_per_sqrt_m");
-  require_non_negative(o.motion.rotation_sigma_per_sqrt_rad, "motion.rotation_sigma_per_sqrt_rad");
-  require_positive(o.max_speed_mps, "max_speed_mps");
-  require_positive(o.max_turn_rate_radps, "max_turn_rate_radps");
-  require_positive(o.control_timeout_s, "control_timeout_s");
-  require_positive(o.range_sigma_m, "range_sigma_m");
-  require_non_negative(o.range_sigma_per_m, "range_sigma_per_m");
-  require_positive(o.bearing_sigma_rad, "bearing_sigma_rad");
-  require(std::isfinite(o.error_correlation_s) && o.error_correlation_s >= 0.0 && o.error_correlation_s <= 100.0,
-          "error_correlation_s", o.error_correlation_s, "must be in [0, 100] s");
-  require(o.error_correlation_s == 0.0 || o.association == Association::kKnownId, "error_correlation_s",
-          o.error_correlation_s, "needs association known_id (a landmark's last sighting is tracked by its id)");
-  require_non_negative(o.min_range_m, "min_range_m");
-  require(std::isfinite(o.max_range_m) && o.max_range_m > o.min_range_m, "max_range_m", o.max_range_m,
-          "must be finite and greater than min_range_m");
-  require(o.gate_probability > 0.0 && o.gate_probability < 1.0, "gate_probability", o.gate_probability,
-          "must be in (0, 1)");
-  require(o.new_landmark_probability > 0.0 && o.new_landmark_probability < 1.0, "new_landmark_probability",
-          o.new_landmark_probability, "must be in (0, 1)");
-  require(o.gate_readmit_after >= 1, "gate_readmit_after", o.gate_readmit_after, "must be >= 1");
-  require(o.resample_neff_fraction > 0.0 && o.resample_neff_fraction <= 1.0, "resample_neff_fraction",
-          o.resample_neff_fraction, "must be in (0, 1]");
+  parameters::check_ranges(o, filter_parameters(), "filter");
+  // Rules between parameters.
+  const auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw std::invalid_argument(what);
+  };
+  require(o.max_range_m > o.min_range_m, "filter.observation.max_range_m = " + parameters::number_text(o.max_range_m) +
+                                             ": must be greater than min_range_m (" +
+                                             parameters::number_text(o.min_range_m) + ")");
+  require(o.error_correlation_s == 0.0 || o.association == Association::kKnownId,
+          "filter.observation.error_correlation_s = " + parameters::number_text(o.error_correlation_s) +
+              ": needs association known_id (a landmark's last sighting is tracked by its id)");
   const DelayedSamplingOptions& d = o.delayed_sampling;
-  require_positive(d.enter_heading_sigma_rad, "delayed_sampling.enter_heading_sigma_rad");
-  require_positive(d.enter_position_sigma_m, "delayed_sampling.enter_position_sigma_m");
-  require(std::isfinite(d.exit_heading_sigma_rad) && d.exit_heading_sigma_rad > 0.0 &&
-              d.exit_heading_sigma_rad <= d.enter_heading_sigma_rad,
-          "delayed_sampling.exit_heading_sigma_rad", d.exit_heading_sigma_rad,
-          "must be > 0 and <= enter_heading_sigma_rad");
-  require(std::isfinite(d.exit_position_sigma_m) && d.exit_position_sigma_m > 0.0 &&
-              d.exit_position_sigma_m <= d.enter_position_sigma_m,
-          "delayed_sampling.exit_position_sigma_m", d.exit_position_sigma_m,
-          "must be > 0 and <= enter_position_sigma_m");
-  require(d.max_landmarks >= 1 && d.max_landmarks <= 1000, "delayed_sampling.max_landmarks", d.max_landmarks,
-          "must be in [1, 1000]");
-  const AnchorFrameOptions& a = o.anchor_frame;
-  require(a.min_landmarks >= 2 && a.min_landmarks <= 64, "anchor_frame.min_landmarks", a.min_landmarks,
-          "must be in [2, 64] (a rotation needs two points)");
-  require(a.min_observations >= 1, "anchor_frame.min_observations", a.min_observations, "must be >= 1");
-  require(std::isfinite(a.min_spread_m) && a.min_spread_m > 0.0, "anchor_frame.min_spread_m", a.min_spread_m,
-          "must be a finite number > 0");
+  require(d.exit_heading_sigma_rad <= d.enter_heading_sigma_rad,
+          "filter.delayed_sampling.exit_heading_sigma_rad = " + parameters::number_text(d.exit_heading_sigma_rad) +
+              ": must be <= enter_heading_sigma_rad (" + parameters::number_text(d.enter_heading_sigma_rad) + ")");
+  require(d.exit_position_sigma_m <= d.enter_position_sigma_m,
+          "filter.delayed_sampling.exit_position_sigma_m = " + parameters::number_text(d.exit_position_sigma_m) +
+              ": must be <= enter_position_sigma_m (" + parameters::number_text(d.enter_position_sigma_m) + ")");
 }
 
 double gate_mahalanobis2(const FilterOptions& o) {

@@ -70,6 +70,7 @@ class YamlReader {
   std::string choice(const std::string& key, std::initializer_list<const char*> allowed);
   std::string choice(const std::string& key, std::initializer_list<const char*> allowed,
                      const std::string& fallback);
+  std::string choice(const std::string& key, const std::vector<std::string>& allowed, const std::string& fallback);
 
   // Throws ConfigError naming the first key of this mapping that was never read.
   void finish() const;

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <string>
 
+#include "pixyslam/parameters/parameters.h"
 #include "pixyslam/slam/motion_model.h"
 
 namespace pixyslam::slam {
@@ -57,8 +58,8 @@ struct AnchorFrameOptions {
   double min_spread_m = 0.5;
 };
 
-// Everything that configures FastSlam2. Units in the names; validate() checks
-// ranges and throws std::invalid_argument naming the field.
+// Everything that configures FastSlam2. Units in the names; ranges in
+// filter_parameters().
 struct FilterOptions {
   int particles = 100;
   std::uint64_t seed = 1;
@@ -121,6 +122,13 @@ struct FilterOptions {
   bool landmark_uncertainty = false;
 };
 
+// Every parameter of FilterOptions, once: YAML key below `filter:`, range,
+// unit, help (pixyslam/parameters/parameters.h). Reading, validate(), the
+// effective configuration and `--set filter.KEY=VALUE` all use it.
+const parameters::Table<FilterOptions>& filter_parameters();
+
+// The table's ranges, then the rules between parameters; throws
+// std::invalid_argument naming the parameter ("filter.<path> = v: ...").
 void validate(const FilterOptions& options);
 
 // Squared Mahalanobis distance of the gate: chi-square quantile with 2 dof.

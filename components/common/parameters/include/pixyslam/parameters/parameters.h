@@ -1,0 +1,242 @@
+#pragma once
+
+// One declaration per parameter: a table beside an options struct gives, for
+// every member, its key path below the struct's YAML section, kind, range,
+// unit, default and help text. Range checks, the effective configuration,
+// `--set path=value` overrides and the help text all come from the table
+// (YAML reading: pixyslam/config/parameters_yaml.h). Pure (std only).
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace pixyslam::parameters {
+
+enum class Kind { kReal, kInteger, kBoolean, kChoice };
+
+template <class Options>
+struct Parameter {
+  std::string path;  // below the section, mappings joined by '.': "motion.v_sigma_m_per_sqrt_s"
+  Kind kind = Kind::kReal;
+  double min = 0.0, max = 0.0;              // kReal, kInteger: inclusive range
+  std::vector<std::string> choices;         // kChoice
+  std::string unit;                         // "m/sqrt(s)"; empty for none
+  std::string help;
+  // The member, as a number (kReal, kInteger, kBoolean: 0 / 1) or a choice's name.
+  std::function<double(const Options&)> get;
+  std::function<void(Options&, double)> set;
+  std::function<std::string(const Options&)> get_choice;
+  std::function<void(Options&, const std::string&)> set_choice;
+};
+
+template <class Options>
+using Table = std::vector<Parameter<Options>>;
+
+// ---- Declaring: one call per member.
+
+template <class Options>
+Parameter<Options> real(std::string path, double min, double max, std::string unit, std::string help,
+                        std::function<double&(Options&)> member) {
+  Parameter<Options> p{std::move(path), Kind::kReal, min, max, {}, std::move(unit), std::move(help), {}, {}, {}, {}};
+  p.get = [member](const Options& o) { return member(const_cast<Options&>(o)); };
+  p.set = [member](Options& o, double v) { member(o) = v; };
+  return p;
+}
+
+// Integers up to 2^53 (exact in a double).
+template <class Options, class Int>
+Parameter<Options> integer(std::string path, Int min, Int max, std::string unit, std::string help,
+                           std::function<Int&(Options&)> member) {
+  Parameter<Options> p{std::move(path), Kind::kInteger, static_cast<double>(min), static_cast<double>(max), {},
+                       std::move(unit), std::move(help), {}, {}, {}, {}};
+  p.get = [member](const Options& o) { return static_cast<double>(member(const_cast<Options&>(o))); };
+  p.set = [member](Options& o, double v) { member(o) = static_cast<Int>(v); };
+  return p;
+}
+
+template <class Options>
+Parameter<Options> boolean(std::string path, std::string help, std::function<bool&(Options&)> member) {
+  Parameter<Options> p{std::move(path), Kind::kBoolean, 0.0, 1.0, {}, "", std::move(help), {}, {}, {}, {}};
+  p.get = [member](const Options& o) { return member(const_cast<Options&>(o)) ? 1.0 : 0.0; };
+  p.set = [member](Options& o, double v) { member(o) = v != 0.0; };
+  return p;
+}
+
+// An enum given by name: `names` pairs each value with its YAML text.
+template <class Options, class Enum>
+Parameter<Options> choice(std::string path, std::vector<std::pair<std::string, Enum>> names, std::string help,
+                          std::function<Enum&(Options&)> member) {
+  Parameter<Options> p{std::move(path), Kind::kChoice, 0.0, 0.0, {}, "", std::move(help), {}, {}, {}, {}};
+  for (const auto& n : names) p.choices.push_back(n.first);
+  p.get_choice = [member, names](const Options& o) {
+    for (const auto& n : names) {
+      if (n.second == member(const_cast<Options&>(o))) return n.first;
+    }
+    return std::string("?");
+  };
+  p.set_choice = [member, names](Options& o, const std::string& text) {
+    for (const auto& n : names) {
+      if (n.first == text) {
+        member(o) = n.second;
+        return;
+      }
+    }
+    throw std::invalid_argument("not one of the choices");
+  };
+  return p;
+}
+
+// ---- Using the table.
+
+inline std::string number_text(double v) {
+  std::ostringstream os;
+  if (std::isfinite(v) && v == std::floor(v) && std::abs(v) <= 9007199254740992.0) {
+    os << static_cast<long long>(v);  // whole numbers in full
+  } else {
+    os << std::setprecision(15) << v;
+  }
+  return os.str();
+}
+
+template <class Options>
+std::string range_text(const Parameter<Options>& p) {
+  if (p.kind == Kind::kChoice) {
+    std::string list;
+    for (const std::string& c : p.choices) list += (list.empty() ? "" : " | ") + c;
+    return list;
+  }
+  if (p.kind == Kind::kBoolean) return "true | false";
+  return "[" + number_text(p.min) + ", " + number_text(p.max) + "]";
+}
+
+// The member's value as YAML text.
+template <class Options>
+std::string value_text(const Parameter<Options>& p, const Options& o) {
+  switch (p.kind) {
+    case Kind::kChoice: return p.get_choice(o);
+    case Kind::kBoolean: return p.get(o) != 0.0 ? "true" : "false";
+    default: return number_text(p.get(o));
+  }
+}
+
+// Every number within its range (and an integer's value whole); throws
+// std::invalid_argument "<section>.<path> = <value>: must be in [min, max] <unit>".
+template <class Options>
+void check_ranges(const Options& o, const Table<Options>& table, const std::string& section) {
+  for (const Parameter<Options>& p : table) {
+    if (p.kind != Kind::kReal && p.kind != Kind::kInteger) continue;
+    const double v = p.get(o);
+    if (std::isfinite(v) && v >= p.min && v <= p.max) continue;
+    throw std::invalid_argument(section + "." + p.path + " = " + number_text(v) + ": must be in " + range_text(p) +
+                                (p.unit.empty() ? "" : " " + p.unit));
+  }
+}
+
+template <class Options>
+const Parameter<Options>* find(const Table<Options>& table, const std::string& path) {
+  for (const Parameter<Options>& p : table) {
+    if (p.path == path) return &p;
+  }
+  return nullptr;
+}
+
+// Sets the parameter at `path` from text (a number, true/false, or a choice's
+// name), checking its range; throws std::invalid_argument naming the path.
+template <class Options>
+void set_from_text(Options& o, const Table<Options>& table, const std::string& section, const std::string& path,
+                   const std::string& text) {
+  const Parameter<Options>* p = find(table, path);
+  const std::string name = section + "." + path;
+  if (p == nullptr) throw std::invalid_argument("unknown parameter '" + name + "'");
+  const auto fail = [&](const std::string& why) {
+    throw std::invalid_argument(name + " = '" + text + "': " + why + " (" + range_text(*p) +
+                                (p->unit.empty() ? "" : " " + p->unit) + ")");
+  };
+  switch (p->kind) {
+    case Kind::kChoice:
+      try {
+        p->set_choice(o, text);
+      } catch (const std::invalid_argument&) {
+        fail("not one of the choices");
+      }
+      return;
+    case Kind::kBoolean:
+      if (text != "true" && text != "false") fail("not true or false");
+      p->set(o, text == "true" ? 1.0 : 0.0);
+      return;
+    default: {
+      std::size_t used = 0;
+      double v = 0.0;
+      try {
+        v = std::stod(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != text.size() || !std::isfinite(v)) fail("not a number");
+      if (p->kind == Kind::kInteger && v != std::floor(v)) fail("not an integer");
+      if (v < p->min || v > p->max) fail("out of range");
+      p->set(o, v);
+    }
+  }
+}
+
+// "path=value": set_from_text for one override (e.g. from `--set`).
+template <class Options>
+void apply_override(Options& o, const Table<Options>& table, const std::string& section, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw std::invalid_argument("'" + assignment + "': expected KEY=VALUE, e.g. " + section + "." +
+                                (table.empty() ? std::string("key") : table.front().path) + "=...");
+  }
+  std::string key = assignment.substr(0, eq);
+  if (key.rfind(section + ".", 0) != 0) {
+    throw std::invalid_argument("'" + key + "': not a parameter of '" + section + "'");
+  }
+  set_from_text(o, table, section, key.substr(section.size() + 1), assignment.substr(eq + 1));
+}
+
+// The section as YAML (nested mappings, each value with its unit as a comment).
+template <class Options>
+std::string to_yaml(const Options& o, const Table<Options>& table, const std::string& section) {
+  std::ostringstream os;
+  os << section << ":\n";
+  std::vector<std::string> open;  // mappings opened so far, outermost first
+  for (const Parameter<Options>& p : table) {
+    std::vector<std::string> parts;
+    std::string rest = p.path;
+    for (auto dot = rest.find('.'); dot != std::string::npos; dot = rest.find('.')) {
+      parts.push_back(rest.substr(0, dot));
+      rest = rest.substr(dot + 1);
+    }
+    std::size_t common = 0;
+    while (common < open.size() && common < parts.size() && open[common] == parts[common]) ++common;
+    open.resize(common);
+    for (std::size_t i = common; i < parts.size(); ++i) {
+      os << std::string(2 * (i + 1), ' ') << parts[i] << ":\n";
+      open.push_back(parts[i]);
+    }
+    os << std::string(2 * (parts.size() + 1), ' ') << rest << ": " << value_text(p, o);
+    if (!p.unit.empty()) os << "  # " << p.unit;
+    os << "\n";
+  }
+  return os.str();
+}
+
+// One line per parameter: key, range and unit, default, help.
+template <class Options>
+std::string help_text(const Table<Options>& table, const std::string& section, const Options& defaults = Options{}) {
+  std::ostringstream os;
+  for (const Parameter<Options>& p : table) {
+    os << "  " << section << "." << p.path << "  " << range_text(p) << (p.unit.empty() ? "" : " " + p.unit)
+       << ", default " << value_text(p, defaults) << "\n      " << p.help << "\n";
+  }
+  return os.str();
+}
+
+}  // namespace pixyslam::parameters
