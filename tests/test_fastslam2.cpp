@@ -471,17 +471,17 @@ TEST(FastSlam2, LandmarkUncertaintyFloorsTheCovarianceAndLeavesTheEstimatesAlone
 // FilterOptions::error_correlation_s: a 30 Hz camera whose errors persist for
 // about a second (first-order Gauss-Markov, tau = 1 s). Treated as white, each
 // frame counts as news and the pose covariance collapses (NEES under its 95 %
-// bound at 0 of 2002 steps); with tau at 77 % of them (armhf 66 %), and the
-// error stays below dead reckoning's (0.100 m; white 0.123 m, dead reckoning
-// 0.209 m; with 50 particles tau was less accurate than white, 0.153 against
-// 0.113 m, and on armhf 0.137 against 0.112 m).
+// bound at 0 of 1201 steps, seed 321, 70 s); with tau at 66 % of them, and the
+// error stays below dead reckoning's (0.165 m, white the same, dead reckoning
+// 0.271 m; seeds 321-322 over 60 s: 0.100 against white 0.123 m, but with 50
+// particles 0.153 against 0.113 m, and on armhf 0.137 against 0.112 m).
 TEST(FastSlam2, CorrelatedErrorsKeepThePoseConsistentAtHighFrameRates) {
   NeesBelowBound count;
   double error_white = 0.0, error_correlated = 0.0, error_dead_reckoning = 0.0;
-  for (int r = 1; r <= 2; ++r) {
+  for (int r = 1; r <= 1; ++r) {
     sim::WorldOptions w;
     w.seed = 320 + static_cast<std::uint64_t>(r);
-    w.duration_s = 60.0;
+    w.duration_s = 70.0;
     w.odometry_rate_hz = 20.0;
     w.camera_rate_hz = 30.0;
     w.v_sigma_mps = 0.03;
