@@ -635,17 +635,17 @@ TEST(FastSlam2, ValidateNamesTheOffendingField) {
   {
     FilterOptions o;
     o.gate_probability = 1.0;
-    EXPECT_NE(invalid_argument_of(o).find("gate_probability"), std::string::npos);
+    EXPECT_NE(invalid_argument_of(o).find("filter.gate.probability"), std::string::npos);
   }
   {
     FilterOptions o;
     o.resample_neff_fraction = 0.0;
-    EXPECT_NE(invalid_argument_of(o).find("resample_neff_fraction"), std::string::npos);
+    EXPECT_NE(invalid_argument_of(o).find("filter.resample.neff_fraction"), std::string::npos);
   }
   {
     FilterOptions o;
     o.gate_readmit_after = 0;
-    EXPECT_NE(invalid_argument_of(o).find("gate_readmit_after"), std::string::npos);
+    EXPECT_NE(invalid_argument_of(o).find("filter.gate.readmit_after"), std::string::npos);
   }
   {
     FilterOptions o;

@@ -70,7 +70,7 @@ const parameters::Table<FilterOptions>& filter_parameters() {
                                   {"every_frame", ResampleMode::kEveryFrame}},
                                  "when to resample: N_eff below neff_fraction * M, or every frame (the paper)",
                                  [](O& o) -> ResampleMode& { return o.resample_mode; }),
-      P::real<O>("resample.neff_fraction", 1e-6, 1.0, "", "resample when N_eff < this * M",
+      P::real<O>("resample.neff_fraction", 1e-9, 1.0, "", "resample when N_eff < this * M (tiny: almost never)",
                  [](O& o) -> double& { return o.resample_neff_fraction; }),
       P::boolean<O>("delayed_sampling.enabled", "keep uncertain poses and their new landmarks joint until pinned",
                     [](O& o) -> bool& { return o.delayed_sampling.enabled; }),
