@@ -6,6 +6,7 @@
 // 2 command-line or config error.
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <iostream>
 #include <stdexcept>
 #include <string>
@@ -16,6 +17,7 @@
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/yaml_text.h"
+#include "pixyslam/parameters/parameters.h"
 
 #ifndef PIXYSLAM_DEFAULT_PROFILES_FILE
 #define PIXYSLAM_DEFAULT_PROFILES_FILE ""
@@ -38,15 +40,9 @@ constexpr const char* kUsage =
     "  --quiet           no progress lines\n";
 
 double number(const std::string& flag, const std::string& text) {
-  std::size_t used = 0;
-  double v = 0.0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != text.size()) throw std::invalid_argument(flag + " needs a number, got '" + text + "'");
-  return v;
+  const std::optional<double> v = pixyslam::parameters::parse_number(text);
+  if (!v) throw std::invalid_argument(flag + " needs a number, got '" + text + "'");
+  return *v;
 }
 
 int integer(const std::string& flag, const std::string& text, int min, int max) {

@@ -10,6 +10,7 @@
 #include <functional>
 #include <iomanip>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -94,6 +95,19 @@ Parameter<Options> choice(std::string path, std::vector<std::pair<std::string, E
 
 // ---- Using the table.
 
+// The whole of `text` as a finite number, or nothing.
+inline std::optional<double> parse_number(const std::string& text) {
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
 inline std::string number_text(double v) {
   std::ostringstream os;
   if (std::isfinite(v) && v == std::floor(v) && std::abs(v) <= 9007199254740992.0) {
@@ -171,14 +185,9 @@ void set_from_text(Options& o, const Table<Options>& table, const std::string& s
       p->set(o, text == "true" ? 1.0 : 0.0);
       return;
     default: {
-      std::size_t used = 0;
-      double v = 0.0;
-      try {
-        v = std::stod(text, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != text.size() || !std::isfinite(v)) fail("not a number");
+      const std::optional<double> parsed = parse_number(text);
+      if (!parsed) fail("not a number");
+      const double v = *parsed;
       if (p->kind == Kind::kInteger && v != std::floor(v)) fail("not an integer");
       if (v < p->min || v > p->max) fail("out of range");
       p->set(o, v);
