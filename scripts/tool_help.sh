@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Prints docs/tools.md: every shipped executable's --help text, from the build.
+#   scripts/tool_help.sh > docs/tools.md      (after scripts/build.sh)
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+bin=${BUILD_DIR:-$root/build}/bin
+tools=(encoder_bridge pixy_bridge slam_estimator map_optimizer logger pixyslam_launch pixyslam_spy pixyslam_play
+  map_view robot_sim sim_evaluator slam_offline mrclam_eval pixyslam_calibrate paper_experiments camera_eval
+  bench_latency bench_logger_throughput bench_map_optimizer bench_mrclam_frame link_emulator)
+cat <<'TEXT'
+# Every executable's command line
+
+What each program prints for `--help` (exit 0, nothing started: ctest `help_all_executables` checks
+that for every executable of the build, and that an unknown flag exits 2). Exit codes everywhere:
+0 ok, 1 runtime failure, 2 usage or configuration error; `sim_evaluator` exits 3 when its check
+fails; the evaluations and benchmarks on the MRCLAM data set (`mrclam_eval`, `bench_mrclam_frame`,
+`bench_map_optimizer`) exit 77 when it is absent (skipped), `slam_offline mrclam` 1.
+`pixyslam_log` is `pixyslam_spy` under its old name. Regenerate with
+`scripts/tool_help.sh > docs/tools.md`.
+TEXT
+for tool in "${tools[@]}"; do
+  [[ -x $bin/$tool ]] || continue  # optional parts (map_view, the optimiser) may be off
+  printf '\n## `%s`\n\n```\n' "$tool"
+  "$bin/$tool" --help 2>&1 | sed "s#$root#<checkout>#g"
+  printf '```\n'
+done
