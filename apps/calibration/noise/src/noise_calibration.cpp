@@ -118,11 +118,25 @@ struct Row {
 
 constexpr double kDelayStep = 0.02;
 
-std::vector<Row> collect_rows(const offline::RunInput& in, const References& refs, const NoiseCalibrationOptions& o,
-                              std::size_t* start_frames, std::vector<Row>* pair_rows) {
-  std::vector<Row> rows;
+// The odometry in time order (stable: equal stamps keep their input order).
+std::vector<slam::OdometrySample> sorted_odometry(const offline::RunInput& in) {
   std::vector<slam::OdometrySample> odometry = in.odometry;
   std::stable_sort(odometry.begin(), odometry.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  return odometry;
+}
+
+// Log-likelihood of a (range, bearing) innovation with variances s, each
+// normalised square capped at gate2 (an outlier counts as at the gate).
+double capped_log_likelihood(const Eigen::Vector2d& e, const Eigen::Vector2d& s, double gate2) {
+  return -0.5 * (std::min(e.x() * e.x() / s.x(), gate2) + std::min(e.y() * e.y() / s.y(), gate2) +
+                 std::log(4.0 * M_PI * M_PI * s.x() * s.y()));
+}
+
+// `odometry`: in.odometry, sorted_odometry().
+std::vector<Row> collect_rows(const offline::RunInput& in, const std::vector<slam::OdometrySample>& odometry,
+                              const References& refs, const NoiseCalibrationOptions& o, std::size_t* start_frames,
+                              std::vector<Row>* pair_rows) {
+  std::vector<Row> rows;
   Predictor base(odometry, 0.0, true), shifted(odometry, kDelayStep, false);
   const std::size_t n = in.frames.size();
   *start_frames = 0;
@@ -208,10 +222,10 @@ struct PairRow {
   double lag_s = 0.0;
 };
 
-std::vector<PairRow> collect_correlation_pairs(const offline::RunInput& in, const NoiseCalibrationOptions& o) {
+std::vector<PairRow> collect_correlation_pairs(const offline::RunInput& in,
+                                               const std::vector<slam::OdometrySample>& odometry,
+                                               const NoiseCalibrationOptions& o) {
   std::vector<PairRow> pairs;
-  std::vector<slam::OdometrySample> odometry = in.odometry;
-  std::stable_sort(odometry.begin(), odometry.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
   Predictor predictor(odometry, 0.0, true);
   const std::size_t n = in.frames.size();
   for (std::size_t j = 0; j < n; ++j) {
@@ -297,8 +311,7 @@ CorrelationFit fit_pairs(const std::vector<PairRow>& pairs, double tau_s, const 
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     const PairRow& r = pairs[i];
     const Eigen::Vector2d s = variances(i);
-    log_likelihood -= 0.5 * (std::min(r.e.x() * r.e.x() / s.x(), gate2) + std::min(r.e.y() * r.e.y() / s.y(), gate2) +
-                             std::log(4.0 * M_PI * M_PI * s.x() * s.y()));
+    log_likelihood += capped_log_likelihood(r.e, s, gate2);
   }
   fit.log_likelihood = log_likelihood / static_cast<double>(pairs.size());
   return fit;
@@ -323,7 +336,8 @@ NoiseParameters fit_noise(const offline::RunInput& raw, const References& refere
   const offline::RunInput in = apply_parameters(raw, current);
   FitStatistics stats;
   std::vector<Row> pair_rows;
-  const std::vector<Row> rows = collect_rows(in, references, options, &stats.start_frames, &pair_rows);
+  const std::vector<slam::OdometrySample> odometry = sorted_odometry(in);
+  const std::vector<Row> rows = collect_rows(in, odometry, references, options, &stats.start_frames, &pair_rows);
   if (rows.size() < 20) {
     throw std::invalid_argument("noise calibration: only " + std::to_string(rows.size()) +
                                 " innovations (needs landmarks seen at frames less than max_lag_s apart)");
@@ -405,8 +419,7 @@ NoiseParameters fit_noise(const offline::RunInput& raw, const References& refere
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
     const Eigen::Vector2d s = variances(r);
-    log_likelihood -= 0.5 * (std::min(r.e.x() * r.e.x() / s.x(), gate2) + std::min(r.e.y() * r.e.y() / s.y(), gate2) +
-                             std::log(4.0 * M_PI * M_PI * s.x() * s.y()));
+    log_likelihood += capped_log_likelihood(r.e, s, gate2);
     if (r.e.x() * r.e.x() > gate2 * s.x() || r.e.y() * r.e.y() > gate2 * s.y()) {
       ++stats.outliers;
       continue;
@@ -462,7 +475,7 @@ NoiseParameters fit_noise(const offline::RunInput& raw, const References& refere
     }
   }
   if (options.fit_error_correlation) {
-    const std::vector<PairRow> pairs = collect_correlation_pairs(in, options);
+    const std::vector<PairRow> pairs = collect_correlation_pairs(in, odometry, options);
     stats.correlation_pairs = pairs.size();
     if (pairs.size() >= 20) {
       const CorrelationFit fit = fit_error_correlation(pairs, current, options);
@@ -507,8 +520,7 @@ References filter_references(const offline::RunInput& raw, const slam::FilterOpt
   refs.has_pose.resize(in.frames.size(), false);
   refs.frame_cov.resize(in.frames.size(), Eigen::Matrix3d::Zero());
   // Time order as offline::run_filter: odometry first on equal stamps.
-  std::vector<slam::OdometrySample> odometry = in.odometry;
-  std::stable_sort(odometry.begin(), odometry.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  const std::vector<slam::OdometrySample> odometry = sorted_odometry(in);
   refs.frame_landmarks.resize(in.frames.size());
   slam::OdometrySample control{in.start_time_s, 0.0, 0.0};
   filter.add_odometry(control);
