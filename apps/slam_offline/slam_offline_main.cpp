@@ -13,6 +13,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "hardware_input.h"
 #include "mrclam_dataset.h"
@@ -142,18 +143,15 @@ int run(const Args& args) {
   config::YamlReader root = config::YamlReader::from_file(config_path);
   config::YamlReader filter_yaml = root.child("filter");
   slam::FilterOptions options = slam::read_filter_options(filter_yaml);
+  std::vector<std::string> overrides;
+  if (args.values.count("seed")) overrides.push_back("filter.seed=" + args.get("seed"));
+  if (args.values.count("set")) {
+    for (const std::string& assignment : config::split_comma_list(args.get("set"))) overrides.push_back(assignment);
+  }
   try {
-    if (args.values.count("seed")) {
-      parameters::set_from_text(options, slam::filter_parameters(), "filter", "seed", args.get("seed"));
-    }
-    if (args.values.count("set")) {
-      for (const std::string& assignment : config::split_comma_list(args.get("set"))) {
-        parameters::apply_override(options, slam::filter_parameters(), "filter", assignment);
-      }
-    }
-    slam::validate(options);
+    slam::apply_overrides(options, overrides);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(std::string(args.values.count("set") ? "--set: " : "--seed: ") + e.what());
+    throw std::invalid_argument(std::string("--seed/--set: ") + e.what());
   }
 
   offline::RunInput input;

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/app/process_main.h"
@@ -55,18 +56,15 @@ int main(int argc, char** argv) {
       return 0;
     }
     slam_node::EstimatorOptions options = slam_node::read_estimator_options_file(args.get("config"));
+    std::vector<std::string> overrides;
+    if (args.has("seed")) overrides.push_back("filter.seed=" + args.get("seed"));
+    if (args.has("set")) {
+      for (const std::string& assignment : config::split_comma_list(args.get("set"))) overrides.push_back(assignment);
+    }
     try {
-      if (args.has("seed")) {
-        parameters::set_from_text(options.filter, slam::filter_parameters(), "filter", "seed", args.get("seed"));
-      }
-      if (args.has("set")) {
-        for (const std::string& assignment : config::split_comma_list(args.get("set"))) {
-          parameters::apply_override(options.filter, slam::filter_parameters(), "filter", assignment);
-        }
-      }
-      slam::validate(options.filter);
+      slam::apply_overrides(options.filter, overrides);
     } catch (const std::invalid_argument& e) {
-      throw app::UsageError(std::string(args.has("set") ? "--set: " : "--seed: ") + e.what());
+      throw app::UsageError(std::string("--seed/--set: ") + e.what());
     }
     if (args.has("checkpoint")) options.checkpoint.file = args.get("checkpoint");
     std::fprintf(stderr, "slam_estimator: %d particles, seed %llu, DDS domain %d, profiles '%s'\n",

@@ -124,6 +124,13 @@ void validate(const FilterOptions& o) {
               ": must be <= enter_position_sigma_m (" + parameters::number_text(d.enter_position_sigma_m) + ")");
 }
 
+void apply_overrides(FilterOptions& options, const std::vector<std::string>& assignments) {
+  for (const std::string& assignment : assignments) {
+    parameters::apply_override(options, filter_parameters(), "filter", assignment);
+  }
+  validate(options);
+}
+
 double gate_mahalanobis2(const FilterOptions& o) {
   // Chi-square with 2 degrees of freedom: P(d2 <= x) = 1 - exp(-x / 2).
   return -2.0 * std::log(1.0 - o.gate_probability);

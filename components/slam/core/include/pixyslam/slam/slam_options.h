@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "pixyslam/parameters/parameters.h"
 #include "pixyslam/slam/motion_model.h"
@@ -130,6 +131,10 @@ const parameters::Table<FilterOptions>& filter_parameters();
 // The table's ranges, then the rules between parameters; throws
 // std::invalid_argument naming the parameter ("filter.<path> = v: ...").
 void validate(const FilterOptions& options);
+
+// Applies "filter.KEY=VALUE" assignments (command-line overrides) in order,
+// then validate(); throws std::invalid_argument naming the first bad one.
+void apply_overrides(FilterOptions& options, const std::vector<std::string>& assignments);
 
 // Squared Mahalanobis distance of the gate: chi-square quantile with 2 dof.
 double gate_mahalanobis2(const FilterOptions& options);
