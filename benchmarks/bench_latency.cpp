@@ -56,6 +56,7 @@ int run(int argc, char** argv) {
 
   dds::DdsOptions dds_options;
   dds_options.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/profiles.xml";
+  dds::resolve_settings(dds_options);  // as the estimator does
   dds::Participant participant(dds_options, "bench_latency");
   dds::Writer<msg::Odometry> odometry_writer(participant);
   dds::Writer<msg::LandmarkObservation> observation_writer(participant);

@@ -104,6 +104,7 @@ int run(int argc, char** argv) {
   dds_options.profiles_file = profiles;
   dds_options.domain_id = domain;
   dds_options.robot_id = "bench";
+  dds::resolve_settings(dds_options);  // as the logger does with its file
   dds::Participant participant(dds_options, "bench_logger_throughput");
   dds::Writer<msg::Odometry> writer(participant);
   if (!writer.wait_for_readers(1, std::chrono::seconds(20))) {

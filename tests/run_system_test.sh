@@ -8,11 +8,13 @@
 # The log is kept as KEEP_LOG when given (for the replay test). LAUNCH names
 # another launch file of CONFIG_DIR (launch_sim_camera.yaml: the camera backend
 # on robot_sim's rendered images); with it 3/4 of the poles must be mapped, none
-# under a wrong id.
-#   [LAUNCH=FILE] run_system_test.sh BIN_DIR CONFIG_DIR SIM_DURATION_S MAX_ATE_M [KEEP_LOG]
+# under a wrong id. LAUNCH_ARGS are launch arguments (e.g. "particles:=150
+# seed:=2"): the estimator must report running with them.
+#   [LAUNCH=FILE] [LAUNCH_ARGS=...] run_system_test.sh BIN_DIR CONFIG_DIR SIM_DURATION_S MAX_ATE_M [KEEP_LOG]
 set -euo pipefail
 bin=$1 config=$2 duration=$3 max_ate=$4 keep_log=${5:-}
 launch=${LAUNCH:-launch_sim.yaml}
+read -r -a launch_args <<< "${LAUNCH_ARGS:-}"
 work=$(mktemp -d /tmp/pixyslam_system_test.XXXXXX)
 trap 'rm -rf "$work"' EXIT
 cp -r "$config" "$work/config"
@@ -22,7 +24,7 @@ sed -i "s/^  duration_s: [0-9.]* /  duration_s: $duration /" "$work/config/robot
 sed -i "s/--max-ate, '0.10'/--max-ate, '$max_ate'/" "$work/config/$launch"
 
 status=0
-"$bin/pixyslam_launch" "$work/config/$launch" --run-dir "$work/run" > "$work/out.log" 2>&1 &
+"$bin/pixyslam_launch" "$work/config/$launch" "${launch_args[@]}" --run-dir "$work/run" > "$work/out.log" 2>&1 &
 launcher=$!
 trap 'kill "$launcher" 2>/dev/null || true; rm -rf "$work"' EXIT
 trap 'exit 130' INT TERM  # a killed test still cleans up (the EXIT trap)
@@ -42,6 +44,16 @@ if [[ $status -ne 0 ]]; then
   echo "FAIL: pixyslam_launch exited with $status"
   exit 1
 fi
+
+# The launch arguments reached the estimator (particles:=N, seed:=S).
+for a in "${launch_args[@]}"; do
+  case $a in
+    particles:=*) grep -qE "slam_estimator: ${a#particles:=} particles," "$work/out.log" ||
+                    { echo "FAIL: the estimator did not run with $a"; exit 1; } ;;
+    seed:=*) grep -qE "slam_estimator: [0-9]+ particles, seed ${a#seed:=}," "$work/out.log" ||
+               { echo "FAIL: the estimator did not run with $a"; exit 1; } ;;
+  esac
+done
 
 # The map optimiser ran beside the filter: its solutions reached the evaluator,
 # which scored the newest against the truth.

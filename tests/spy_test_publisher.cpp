@@ -27,7 +27,8 @@ int run(int argc, char** argv) {
     const std::string file = args.get("dds-config");
     config::YamlReader root = config::YamlReader::from_file(file);
     config::YamlReader dds_yaml = root.child("dds");
-    const dds::DdsOptions options = dds::read_dds_options(dds_yaml, app::folder_of(file));
+    dds::DdsOptions options = dds::read_dds_options(dds_yaml, app::folder_of(file));
+    dds::resolve_settings(options);
     const double rate_hz = args.number("rate-hz", 20.0);
 
     dds::Participant participant(options, "spy_test_publisher");

@@ -343,6 +343,71 @@ TEST(DdsOptions, BadEnvironmentNamesTheVariable) {
   }
 }
 
+// The settings resolved once, in the process's main: file, then environment,
+// then command line; a Participant takes them as given.
+TEST(DdsOptions, ResolvedFromFileThenEnvironmentThenCommandLine) {
+  auto reader = config::YamlReader::from_string("dds:\n  domain_id: 7\n  participant_profile: lan_peers\n", "t.yaml");
+  auto dds = reader.child("dds");
+  DdsOptions o = read_dds_options(dds, "");
+  ASSERT_EQ(setenv("PIXYSLAM_DDS_DOMAIN", "9", 1), 0);
+  ASSERT_EQ(setenv("PIXYSLAM_DDS_PEERS", "10.1.0.1,10.1.0.2", 1), 0);
+  DdsOptions from_environment = o;
+  resolve_settings(from_environment);
+  EXPECT_EQ(from_environment.domain_id, 9);
+  EXPECT_EQ(from_environment.participant_profile, "lan_peers");  // not in the environment: the file's
+  EXPECT_EQ(from_environment.initial_peers, (std::vector<std::string>{"10.1.0.1", "10.1.0.2"}));
+  DdsOptions from_command_line = o;
+  resolve_settings(from_command_line, {domain_override("11"), "dds.robot_id=r7"});
+  EXPECT_EQ(from_command_line.domain_id, 11);
+  EXPECT_EQ(from_command_line.robot_id, "r7");
+  // A bad value names where it came from.
+  for (const auto& overrides : std::vector<std::vector<std::string>>{{domain_override("233")},
+                                                                      {"dds.interfaces=10.0.0"},
+                                                                      {"dds.no_such_key=1"}}) {
+    DdsOptions bad = o;
+    try {
+      resolve_settings(bad, overrides);
+      ADD_FAILURE() << "expected an error for " << overrides.front();
+    } catch (const config::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("command line"), std::string::npos) << e.what();
+    }
+  }
+  ASSERT_EQ(setenv("PIXYSLAM_DDS_DOMAIN", "300", 1), 0);
+  try {
+    resolve_settings(o);
+    ADD_FAILURE() << "expected an error";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("PIXYSLAM_DDS_DOMAIN"), std::string::npos) << e.what();
+  }
+  // Participant reads no environment: the domain it was given.
+  DdsOptions given = loopback_options();
+  given.domain_id = 3;
+  {
+    Participant participant(given, "test_no_environment");
+    EXPECT_EQ(participant.native().get_domain_id(), 3u);
+  }
+  unsetenv("PIXYSLAM_DDS_DOMAIN");
+  unsetenv("PIXYSLAM_DDS_PEERS");
+}
+
+// The printed effective configuration reads back as the same settings.
+TEST(DdsOptions, EffectiveConfigurationReadsBack) {
+  DdsOptions o;
+  o.domain_id = 12;
+  o.profiles_file = "/etc/it's/profiles.xml";
+  o.interfaces = {"10.0.0.1", "10.0.0.2"};
+  o.discovery_server = "10.0.0.3:11811";
+  o.announce_identity = false;
+  o.diagnostics_period_s = 0.25;
+  auto reader = config::YamlReader::from_string(to_yaml(o), "printed.yaml");
+  auto dds = reader.child("dds");
+  const DdsOptions back = read_dds_options(dds, "");
+  EXPECT_EQ(to_yaml(back), to_yaml(o));
+  EXPECT_EQ(back.profiles_file, o.profiles_file);
+  EXPECT_EQ(back.interfaces, o.interfaces);
+  EXPECT_EQ(back.announce_identity, o.announce_identity);
+}
+
 TEST(DdsLoopback, SecureProfileWithoutSecurityFilesIsRefused) {
   DdsOptions o = loopback_options();
   o.participant_profile = "secure";

@@ -91,6 +91,43 @@ TEST(LaunchPlan, UnknownVariableAndDuplicateNameAreErrors) {
   std::remove(twice.c_str());
 }
 
+// Launch arguments: NAME:=VALUE as in `ros2 launch`, declared in the file.
+TEST(LaunchPlan, LaunchArgumentsSubstituteAndAddWordsOnlyWhenGiven) {
+  const std::string path = write_temp(
+      "launch:\n  arguments:\n    particles: {help: particle count}\n"
+      "    rate: {default: '10', help: publish rate}\n  processes:\n"
+      "    - name: slam\n      command: [slam, --rate, '${rate}']\n"
+      "      if_given: {particles: [--set, 'filter.particles=${particles}']}\n");
+  const LaunchPlan defaults = read_launch_plan(path, {});
+  EXPECT_EQ(defaults.processes[0].command, (std::vector<std::string>{"slam", "--rate", "10"}));
+  ASSERT_EQ(defaults.arguments.size(), 2u);
+  EXPECT_NE(arguments_text(defaults).find("particles  particle count"), std::string::npos) << arguments_text(defaults);
+
+  std::vector<std::string> words{"particles:=300", "--run-dir", "d", "rate:=5", "duration:=30"};
+  const auto given = split_launch_arguments(words);
+  EXPECT_EQ(words, (std::vector<std::string>{"--run-dir", "d"}));
+  const LaunchPlan plan = read_launch_plan(path, {}, given);
+  EXPECT_EQ(plan.processes[0].command,
+            (std::vector<std::string>{"slam", "--rate", "5", "--set", "filter.particles=300"}));
+  EXPECT_DOUBLE_EQ(plan.duration_s, 30.0);
+
+  // An undeclared name lists the declared ones; a bad duration and a repeated name are refused.
+  try {
+    read_launch_plan(path, {}, {{"particle", "3"}});
+    ADD_FAILURE() << "expected an error";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("particles, rate"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(read_launch_plan(path, {}, {{"duration", "soon"}}), config::ConfigError);
+  std::vector<std::string> twice{"a:=1", "a:=2"};
+  EXPECT_THROW(split_launch_arguments(twice), std::invalid_argument);
+  std::remove(path.c_str());
+  const std::string clash = write_temp("launch:\n  arguments:\n    run_dir: {help: x}\n  processes:\n"
+                                       "    - {name: a, command: [p]}\n");
+  EXPECT_THROW(read_launch_plan(clash, {{"run_dir", "/r"}}), config::ConfigError);
+  std::remove(clash.c_str());
+}
+
 TEST(LineSplitter, SplitsAtNewlinesAcrossChunksAndCutsLongLines) {
   LineSplitter splitter(8);
   auto lines = splitter.feed("ab\ncd", 5);

@@ -310,7 +310,7 @@ TEST(LoggerOptions, ErrorsNameTheFileAndTheKey) {
       {"logger:\n  compression: gzip\n", "key 'logger.compression': value 'gzip' is not one of"},
       {"logger:\n  flush_period_s: -1\n", "key 'logger.flush_period_s': value -1 is out of range"},
       {"logger:\n  chunk_size_bytes: 10\n", "key 'logger.chunk_size_bytes'"},
-      {"logger:\n  output_file: ''\n", "key 'logger.output_file': must not be empty"},
+      {"logger:\n  output_file: ''\n", "key 'logger.output_file': value '' is empty"},
       {"logger:\n  fsync: maybe\n", "key 'logger.fsync'"},
       {"dds: {}\n", "key 'logger': missing"},
       {"logger: {}\ndds:\n  domain_id: 999\n", "key 'dds.domain_id'"},

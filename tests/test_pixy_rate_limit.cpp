@@ -265,7 +265,7 @@ TEST(PixyRateLimitOptions, BadRatesAreNamed) {
     validate(bad);
     ADD_FAILURE() << "expected invalid_argument";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("max_frame_rate_hz must be >= frame_rate_hz (50; is 10)"),
+    EXPECT_NE(std::string(e.what()).find("pixy.max_frame_rate_hz: value 10 is below frame_rate_hz (50)"),
               std::string::npos)
         << e.what();
   }

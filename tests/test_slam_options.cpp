@@ -325,7 +325,7 @@ TEST(FilterParameters, ValidateNamesTheParameterWithItsRange) {
     validate(o);
     FAIL() << "expected std::invalid_argument";
   } catch (const std::invalid_argument& e) {
-    EXPECT_TRUE(contains(e.what(), "filter.particles = 0: must be in [1, 1000000]")) << e.what();
+    EXPECT_TRUE(contains(e.what(), "filter.particles: value 0 is out of range [1, 1000000]")) << e.what();
   }
   o = FilterOptions{};
   o.motion.v_sigma_m_per_sqrt_s = std::nan("");

@@ -9,9 +9,12 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/config/yaml_reader.h"
 
 namespace pixyslam::config {
@@ -381,6 +384,98 @@ TEST(YamlReaderUnknownKeys, NullValuedTypoIsAnUnknownKey) {
     EXPECT_EQ(section.number("other", 0.0, 1.0, 0.5), 0.5);  // absent optional keys do not excuse it
     const std::string n = config_error_of([&] { section.finish(); });
     EXPECT_TRUE(contains(n, "null_nested.yaml: key 'section.typo': unknown key")) << value << ": " << n;
+  }
+}
+
+}  // namespace
+}  // namespace pixyslam::config
+
+namespace pixyslam::config {
+namespace {
+
+// ---- Parameter tables (pixyslam/parameters, read by config::read_parameters):
+// texts, lists, required keys and rules reported on their key.
+namespace table_test {
+
+struct Options {
+  std::string name = "robot1";
+  std::vector<std::string> peers;
+  double rate_hz = 10.0;
+  double max_rate_hz = 12.0;
+};
+
+const parameters::Table<Options>& table() {
+  using O = Options;
+  namespace P = parameters;
+  static const P::Table<O> t = {
+      P::text<O>("name", "a name", [](O& o) -> std::string& { return o.name; },
+                 [](const std::string& v) {
+                   if (v.empty()) throw std::invalid_argument("empty");
+                 }),
+      P::list<O>("peers", "addresses", [](O& o) -> std::vector<std::string>& { return o.peers; },
+                 [](const std::string& v) {
+                   if (v.find('.') == std::string::npos) throw std::invalid_argument("not dotted");
+                 }),
+      P::required(P::real<O>("rate_hz", 0.1, 100.0, "Hz", "the rate", [](O& o) -> double& { return o.rate_hz; })),
+      P::real<O>("max_rate_hz", 0.1, 1000.0, "Hz", "the most", [](O& o) -> double& { return o.max_rate_hz; }),
+  };
+  return t;
+}
+
+void validate(const Options& o) {
+  parameters::check_ranges(o, table(), "s");
+  if (o.max_rate_hz < o.rate_hz) throw parameters::RuleError("s", "max_rate_hz", "value below rate_hz");
+}
+
+Options read(const std::string& yaml) {
+  YamlReader root = YamlReader::from_string(yaml, "t.yaml");
+  YamlReader s = root.child("s");
+  Options o;
+  read_parameters(s, table(), o);
+  s.finish();
+  check_rules(s, [&] { validate(o); });
+  return o;
+}
+
+}  // namespace table_test
+
+TEST(ParameterTable, ReadsTextsListsAndRequiredKeys) {
+  const table_test::Options o = table_test::read("s:\n  name: r2\n  peers: [10.0.0.1, 10.0.0.2]\n  rate_hz: 5\n");
+  EXPECT_EQ(o.name, "r2");
+  EXPECT_EQ(o.peers, (std::vector<std::string>{"10.0.0.1", "10.0.0.2"}));
+  EXPECT_EQ(o.rate_hz, 5.0);
+  // The printed section reads back as the same values.
+  const std::string printed = parameters::to_yaml(o, table_test::table(), "s");
+  EXPECT_EQ(parameters::to_yaml(table_test::read(printed), table_test::table(), "s"), printed);
+  EXPECT_NE(parameters::help_text(table_test::table(), "s").find("s.rate_hz  [0.1, 100] Hz, required"),
+            std::string::npos);
+}
+
+TEST(ParameterTable, ErrorsNameTheKey) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"s:\n  name: r2\n", "key 's.rate_hz': missing"},
+      {"s:\n  rate_hz: 5\n  name: ''\n", "key 's.name': value '' is empty"},
+      {"s:\n  rate_hz: 5\n  peers: [a, 10.0.0.1]\n", "key 's.peers': value [a,10.0.0.1] is not dotted"},
+      {"s:\n  rate_hz: 500\n", "key 's.rate_hz': value 500 is out of range"},
+      {"s:\n  rate_hz: 50\n  max_rate_hz: 20\n", "key 's.max_rate_hz': value below rate_hz"},
+  };
+  for (const auto& [yaml, expected] : cases) {
+    const std::string e = config_error_of([&] { table_test::read(yaml); });
+    EXPECT_NE(e.find("t.yaml: " + expected), std::string::npos) << "got: " << e << "\nfor:\n" << yaml;
+  }
+}
+
+TEST(ParameterTable, OverridesFromTextCheckLikeTheFile) {
+  table_test::Options o;
+  parameters::apply_override(o, table_test::table(), "s", "s.peers=10.0.0.3, 10.0.0.4");
+  EXPECT_EQ(o.peers, (std::vector<std::string>{"10.0.0.3", "10.0.0.4"}));
+  parameters::apply_override(o, table_test::table(), "s", "s.name=it's");
+  EXPECT_EQ(o.name, "it's");
+  EXPECT_NE(parameters::to_yaml(o, table_test::table(), "s").find("name: 'it''s'"), std::string::npos);
+  for (const char* bad : {"s.peers=nodots", "s.rate_hz=fast", "s.rate_hz=0", "s.colour=red", "other.rate_hz=1"}) {
+    table_test::Options before = o;
+    EXPECT_THROW(parameters::apply_override(o, table_test::table(), "s", bad), std::invalid_argument) << bad;
+    EXPECT_EQ(o.peers, before.peers) << bad;  // unchanged after a refused value
   }
 }
 

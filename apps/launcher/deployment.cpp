@@ -8,6 +8,7 @@
 
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/dds/dds_options.h"
 
 namespace pixyslam::launcher {
 
@@ -25,6 +26,12 @@ const HostSpec* find_host(const Deployment& d, const std::string& name) {
   return nullptr;
 }
 
+// The range of a DDS setting, as dds_parameters() declares it.
+std::int64_t dds_bound(const std::string& path, bool upper) {
+  const parameters::Parameter<dds::DdsOptions>* p = parameters::find(dds::dds_parameters(), path);
+  return static_cast<std::int64_t>(upper ? p->max : p->min);
+}
+
 }  // namespace
 
 Deployment read_deployment(const std::string& path) {
@@ -33,12 +40,15 @@ Deployment read_deployment(const std::string& path) {
   Deployment d;
   d.profile = y.choice("profile", {"loopback", "lan_multicast", "lan_peers", "discovery_client", "secure"},
                        d.profile);
-  d.domain_id = static_cast<int>(y.integer("domain_id", 0, 232, d.domain_id));
+  d.domain_id = static_cast<int>(y.integer("domain_id", dds_bound("domain_id", false), dds_bound("domain_id", true),
+                                           d.domain_id));
   if (y.has("discovery_server")) {
     config::YamlReader server = y.child("discovery_server");
     d.discovery_server_host = server.text("host");
     d.discovery_server_port = static_cast<int>(server.integer("port", 1, 65535, d.discovery_server_port));
-    d.discovery_server_id = static_cast<int>(server.integer("id", 0, 255, d.discovery_server_id));
+    d.discovery_server_id =
+        static_cast<int>(server.integer("id", dds_bound("discovery_server_id", false),
+                                        dds_bound("discovery_server_id", true), d.discovery_server_id));
     server.finish();
   }
   d.security_dir = y.text("security_dir", "");

@@ -62,9 +62,7 @@ class HealthMonitor::Listener : public fdds::DomainParticipantListener {
 };
 
 HealthMonitor::HealthMonitor(const dds::DdsOptions& options) : listener_(std::make_unique<Listener>()) {
-  dds::DdsOptions effective = options;
-  dds::apply_environment(effective, [](const char* n) { return std::getenv(n); });
-  participant_ = dds::create_participant(effective, "pixyslam_launch", listener_.get());
+  participant_ = dds::create_participant(options, "pixyslam_launch", listener_.get());
 }
 
 HealthMonitor::~HealthMonitor() {

@@ -22,8 +22,19 @@ struct ProcessSpec {
   bool optional = false;
 };
 
+// A launch argument, declared in the file (`launch.arguments:`) and given on
+// the command line as NAME:=VALUE, as in `ros2 launch`. Its value is the
+// variable ${NAME} in commands; a process's `if_given: {NAME: [words]}` adds
+// the words only when the value is not empty.
+struct LaunchArgument {
+  std::string name;
+  std::string default_value;  // "" (the default): the process's own configuration decides
+  std::string help;
+};
+
 // A run as a launch file describes it (config/launch_*.yaml).
 struct LaunchPlan {
+  std::vector<LaunchArgument> arguments;  // as declared, in file order
   double duration_s = 0.0;      // stop after this long; 0 = until Ctrl-C or ends_run
   double stop_timeout_s = 5.0;  // SIGINT, then SIGKILL after this
   std::vector<ProcessSpec> processes;
@@ -31,10 +42,21 @@ struct LaunchPlan {
 };
 
 // Reads the `launch:` mapping of a file. In every command word, ${name} is
-// replaced by variables[name] (unknown names are errors); the launcher defines
-// config_dir (the launch file's folder), bin_dir and run_dir. Unknown keys,
-// duplicate names and empty commands throw config::ConfigError naming the file and key.
-LaunchPlan read_launch_plan(const std::string& path, const std::map<std::string, std::string>& variables);
+// replaced by variables[name] or a launch argument's value (unknown names are
+// errors); the launcher defines config_dir (the launch file's folder), bin_dir
+// and run_dir. `given` are the command line's NAME:=VALUE (split_launch_arguments);
+// `duration` is built in (duration_s), any other must be declared. Unknown
+// keys, duplicate names, empty commands and undeclared arguments throw
+// config::ConfigError naming the file and key.
+LaunchPlan read_launch_plan(const std::string& path, const std::map<std::string, std::string>& variables,
+                            const std::map<std::string, std::string>& given = {});
+
+// The NAME:=VALUE words of a command line (moved out of `words`); throws
+// std::invalid_argument for an empty or repeated name.
+std::map<std::string, std::string> split_launch_arguments(std::vector<std::string>& words);
+
+// The declared arguments, one per line with default and help (--show-args).
+std::string arguments_text(const LaunchPlan& plan);
 
 // Replaces every ${name}; throws std::invalid_argument naming an unknown variable.
 std::string substitute(const std::string& text, const std::map<std::string, std::string>& variables);

@@ -125,29 +125,40 @@ bool supervise(launcher::ProcessGroup& group, Clock::time_point until, bool& fai
   return true;
 }
 
-int run(const std::string& launch_file, const app::CommandLine& args) {
+int run(const std::string& launch_file, const app::CommandLine& args, const std::map<std::string, std::string>& given,
+        bool show_args) {
   const std::string run_dir = args.get("run-dir", default_run_dir());
-  std::filesystem::create_directories(run_dir);
+  if (!show_args) std::filesystem::create_directories(run_dir);
   const std::string bin_dir = own_folder();
   std::map<std::string, std::string> variables{
       {"config_dir", std::filesystem::absolute(app::folder_of(launch_file)).string()},
       {"bin_dir", bin_dir},
       {"run_dir", std::filesystem::absolute(run_dir).string()}};
   if (args.has("input")) variables["input"] = std::filesystem::absolute(args.get("input")).string();
-  launcher::LaunchPlan plan = launcher::read_launch_plan(launch_file, variables);
+  launcher::LaunchPlan plan = launcher::read_launch_plan(launch_file, variables, given);
+  if (show_args) {
+    std::fputs(launcher::arguments_text(plan).c_str(), stdout);
+    return 0;
+  }
   if (args.has("deployment") != args.has("host")) {
     throw std::invalid_argument("--deployment and --host go together");
   }
   if (args.has("deployment")) {
     const launcher::Deployment deployment = launcher::read_deployment(args.get("deployment"));
     plan = launcher::plan_for_host(plan, deployment, args.get("host"));
-    // The launcher's own DDS participant (the health monitor) joins like its processes.
-    for (const auto& [name, value] : launcher::host_environment(deployment, args.get("host"))) {
-      setenv(name.c_str(), value.c_str(), 1);
-    }
+    // The launcher's own DDS participant (the health monitor) joins like its
+    // processes: this process's environment, then the host's deployment settings.
     dds::DdsOptions options;
     const std::string profiles = variables["config_dir"] + "/dds/profiles.xml";
     options.profiles_file = std::filesystem::exists(profiles) ? profiles : PIXYSLAM_DEFAULT_PROFILES_FILE;
+    dds::resolve_settings(options);
+    const auto host_env = launcher::host_environment(deployment, args.get("host"));
+    dds::apply_environment(options, [&](const char* name) -> const char* {
+      for (const auto& [variable, value] : host_env) {
+        if (variable == name) return value.c_str();
+      }
+      return nullptr;
+    });
     try {
       health = std::make_unique<launcher::HealthMonitor>(options);
     } catch (const std::exception& e) {
@@ -235,15 +246,26 @@ int main(int argc, char** argv) {
       const bool help = argc >= 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h");
       if (!help && argc >= 2) std::fprintf(stderr, "pixyslam_launch: unknown argument '%s'\n", argv[1]);
       std::fprintf(help ? stdout : stderr,
-                   "usage: pixyslam_launch LAUNCH.yaml [--run-dir DIR] [--duration S] [--input FILE]\n"
-                   "                       [--deployment DEPLOY.yaml --host NAME]\n");
+                   "usage: pixyslam_launch LAUNCH.yaml [NAME:=VALUE ...] [--run-dir DIR] [--duration S] [--input FILE]\n"
+                   "                       [--deployment DEPLOY.yaml --host NAME] [--show-args]\n"
+                   "  NAME:=VALUE  a launch argument of the file (e.g. particles:=300 duration:=30)\n"
+                   "  --show-args  the file's launch arguments, their defaults and help; starts nothing\n"
+                   "  --duration S the same as duration:=S\n");
       return help ? 0 : 2;
     }
-    // The launch file is positional; the rest are flags.
+    // The launch file is positional; NAME:=VALUE words are launch arguments, the rest flags.
+    std::vector<std::string> words(argv + 2, argv + argc);
+    const std::map<std::string, std::string> given = launcher::split_launch_arguments(words);
+    const auto show = std::find(words.begin(), words.end(), "--show-args");
+    const bool show_args = show != words.end();
+    if (show_args) words.erase(show);
     std::vector<char*> flags{argv[0]};
-    for (int i = 2; i < argc; ++i) flags.push_back(argv[i]);
+    for (std::string& word : words) flags.push_back(word.data());
     const app::CommandLine args(static_cast<int>(flags.size()), flags.data(), {"run-dir", "duration", "input", "deployment", "host"});
-    return run(argv[1], args);
+    if (args.has("duration") && given.count("duration") != 0) {
+      throw std::invalid_argument("--duration and duration:= given both");
+    }
+    return run(argv[1], args, given, show_args);
   } catch (const config::ConfigError& e) {
     std::fprintf(stderr, "pixyslam_launch: config error: %s\n", e.what());
     return 2;

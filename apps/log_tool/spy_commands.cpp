@@ -166,9 +166,7 @@ class DiscoveryListener : public fdds::DomainParticipantListener {
 class DiscoveryParticipant {
  public:
   DiscoveryParticipant(const dds::DdsOptions& options, DiscoveryListener& listener) {
-    dds::DdsOptions effective = options;
-    dds::apply_environment(effective, [](const char* n) { return std::getenv(n); });
-    participant_ = dds::create_participant(effective, "pixyslam_spy", &listener);
+    participant_ = dds::create_participant(options, "pixyslam_spy", &listener);
     publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
     subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
   }

@@ -88,7 +88,7 @@ double non_negative_number(const std::string& flag, const std::string& text) {
 struct Arguments {
   std::vector<std::string> positional;
   std::string dds_config;
-  int domain = -1;
+  std::vector<std::string> dds_overrides;  // --domain
   double seconds = -1.0;  // -1: the command's default
   std::size_t count = 0;
   bool json = false;
@@ -110,9 +110,7 @@ Arguments parse(const std::string& command, const std::vector<std::string>& args
     if (live && arg == "--dds-config") {
       a.dds_config = value();
     } else if (live && arg == "--domain") {
-      const double d = non_negative_number(arg, value());
-      if (d > 232 || d != static_cast<int>(d)) throw std::invalid_argument("--domain must be an integer 0..232");
-      a.domain = static_cast<int>(d);
+      a.dds_overrides.push_back(pixyslam::dds::domain_override(value()));
     } else if (live && arg == "--seconds") {
       a.seconds = non_negative_number(arg, value());
     } else if (command == "echo" && arg == "--count") {
@@ -160,7 +158,7 @@ Arguments parse(const std::string& command, const std::vector<std::string>& args
 pixyslam::dds::DdsOptions dds_options(const Arguments& a) {
   using namespace pixyslam;
   dds::DdsOptions o = dds::read_dds_options_file(a.dds_config, PIXYSLAM_DEFAULT_PROFILES_FILE);
-  if (a.domain >= 0) o.domain_id = a.domain;
+  dds::resolve_settings(o, a.dds_overrides);
   return o;
 }
 

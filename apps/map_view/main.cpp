@@ -97,8 +97,14 @@ pixyslam::map_view::MapViewOptions load_options(const Arguments& a) {
   MapViewOptions o;
   o.dds.profiles_file = PIXYSLAM_DEFAULT_PROFILES_FILE;
   if (a.has("--config")) o = read_map_view_options_file(a.values.at("--config"), PIXYSLAM_DEFAULT_PROFILES_FILE);
-  o.render.width_px = a.integer("--width", o.render.width_px, pixyslam::map_view::kMinMapSidePx, 16384);
-  o.render.height_px = a.integer("--height", o.render.height_px, pixyslam::map_view::kMinMapSidePx, 16384);
+  for (const auto& [flag, key] : {std::pair{"--width", "width_px"}, std::pair{"--height", "height_px"}}) {
+    if (!a.has(flag)) continue;
+    try {
+      pixyslam::parameters::set_from_text(o.render, render_parameters(), "map_view", key, a.values.at(flag));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string(flag) + ": " + e.what());
+    }
+  }
   if (a.switches.count("--no-truth") != 0) o.render.ground_truth = false;
   try {
     validate(o.render);
@@ -132,8 +138,12 @@ int dispatch(const std::vector<std::string>& args) {
   if (command == "live") {
     const Arguments a = parse(args, {"--out", "--config", "--period", "--domain"}, {"--no-window"}, 0);
     MapViewOptions o = load_options(a);
-    o.snapshot_period_s = a.number("--period", o.snapshot_period_s, 0.05, 3600.0);
-    o.dds.domain_id = a.integer("--domain", o.dds.domain_id, 0, 232);
+    if (a.has("--period")) {
+      pixyslam::parameters::set_from_text(o, pixyslam::map_view::map_view_parameters(), "map_view",
+                                          "snapshot_period_s", a.values.at("--period"));
+    }
+    pixyslam::dds::resolve_settings(o.dds, a.has("--domain") ? std::vector<std::string>{pixyslam::dds::domain_override(a.values.at("--domain"))}
+                                                   : std::vector<std::string>{});
     LiveRequest r;
     r.out_given = a.has("--out");
     r.out_dir = r.out_given ? a.values.at("--out") : "";

@@ -58,7 +58,7 @@ pixyslam::player::PlayerOptions parse(const std::vector<std::string>& args) {
   using namespace pixyslam;
   player::PlayerOptions o;
   std::string dds_config;
-  int domain = -1;
+  std::vector<std::string> dds_overrides;  // --domain
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
     auto value = [&]() -> const std::string& {
@@ -86,7 +86,7 @@ pixyslam::player::PlayerOptions parse(const std::vector<std::string>& args) {
     } else if (arg == "--dds-config") {
       dds_config = value();
     } else if (arg == "--domain") {
-      domain = integer(arg, value(), 0, 232);
+      dds_overrides.push_back(dds::domain_override(value()));
     } else if (arg == "--quiet") {
       o.progress_period_s = 0.0;
     } else if (arg.rfind("-", 0) == 0) {
@@ -98,7 +98,7 @@ pixyslam::player::PlayerOptions parse(const std::vector<std::string>& args) {
   if (o.files.empty()) throw std::invalid_argument("no MCAP file given");
   player::validate(o.playback);
   o.dds = dds::read_dds_options_file(dds_config, PIXYSLAM_DEFAULT_PROFILES_FILE);
-  if (domain >= 0) o.dds.domain_id = domain;
+  dds::resolve_settings(o.dds, dds_overrides);
   return o;
 }
 

@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
     c.run.arduino_link = args.get("arduino-link", c.run.arduino_link);
     c.run.pixy_link = args.get("pixy-link", c.run.pixy_link);
     c.run.camera_video = args.get("camera-video", c.run.camera_video);
+    dds::resolve_settings(c.dds);
     robot_sim::RobotSimNode node(c);
     node.run();
     return 0;

@@ -59,7 +59,8 @@ void print_topic(const dds::Reader<Message>& reader) {
 }
 
 int run(const app::CommandLine& args) {
-  const dds::DdsOptions dds_options = dds::read_dds_options_file(args.get("dds-config"), "");
+  dds::DdsOptions dds_options = dds::read_dds_options_file(args.get("dds-config"), "");
+  dds::resolve_settings(dds_options);
 
   Received r;
   dds::Participant participant(dds_options, "sim_evaluator");

@@ -57,6 +57,7 @@ int main(int argc, char** argv) {
       }
       options.topics = selection.topics;
     }
+    pixyslam::dds::resolve_settings(options.dds);
   } catch (const config::ConfigError& e) {
     std::fprintf(stderr, "logger: config error: %s\n", e.what());
     return 2;

@@ -49,8 +49,9 @@ int main(int argc, char** argv) {
           "  --out DIR      at exit, DIR/trajectory.csv (final keyframes) and DIR/landmarks.csv");
       return 0;
     }
-    const map_optimizer_node::OptimizerNodeOptions options =
+    map_optimizer_node::OptimizerNodeOptions options =
         map_optimizer_node::read_optimizer_node_options_file(args.get("config"));
+    pixyslam::dds::resolve_settings(options.dds);
     std::fprintf(stderr,
                  "map_optimizer: keyframe every %.2f s at most, window of %zu keyframes every %.1f s, whole problem "
                  "every %.1f s; DDS domain %d, profiles '%s'\n",

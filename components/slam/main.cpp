@@ -49,10 +49,9 @@ int main(int argc, char** argv) {
     const app::CommandLine args(argc, argv, {"config", "seed", "out", "checkpoint", "set"});
     if (args.help()) {
       std::puts("usage: slam_estimator --config FILE [--seed S] [--out DIR] [--checkpoint FILE] [--set KEY=VALUE,...]\n"
-                "  --set   override filter parameters of the config, e.g. --set filter.particles=300,filter.gate.enabled=false\n"
-                "  --seed  the same as --set filter.seed=S\n"
-                "filter parameters (the config's filter: section):");
-      std::fputs(parameters::help_text(slam::filter_parameters(), "filter").c_str(), stdout);
+                "  --set   override parameters of the config, e.g. --set filter.particles=300,dds.domain_id=3\n"
+                "  --seed  the same as --set filter.seed=S");
+      std::fputs(slam_node::help_text().c_str(), stdout);
       return 0;
     }
     slam_node::EstimatorOptions options = slam_node::read_estimator_options_file(args.get("config"));
@@ -62,7 +61,7 @@ int main(int argc, char** argv) {
       for (const std::string& assignment : config::split_comma_list(args.get("set"))) overrides.push_back(assignment);
     }
     try {
-      slam::apply_overrides(options.filter, overrides);
+      slam_node::apply_overrides(options, overrides);
     } catch (const std::invalid_argument& e) {
       throw app::UsageError(std::string("--seed/--set: ") + e.what());
     }

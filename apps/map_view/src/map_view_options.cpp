@@ -4,8 +4,26 @@
 #include <stdexcept>
 
 #include "pixyslam/app/command_line.h"
+#include "pixyslam/config/parameters_yaml.h"
 
 namespace pixyslam::map_view {
+
+const parameters::Table<MapViewOptions>& map_view_parameters() {
+  using O = MapViewOptions;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::real<O>("trajectory_min_step_m", 0.0, 100.0, "m", "trajectories keep a point only this far from the last",
+                 [](O& o) -> double& { return o.trajectory_min_step_m; }),
+      P::real<O>("snapshot_period_s", 0.05, 3600.0, "s", "live view redraw and snapshot period",
+                 [](O& o) -> double& { return o.snapshot_period_s; }),
+      P::text<O>("snapshot_dir", "live snapshots go to <dir>/map_latest.png", [](O& o) -> std::string& { return o.snapshot_dir; },
+                 [](const std::string& v) {
+                   if (v.empty()) throw std::invalid_argument("empty");
+                 }),
+      P::boolean<O>("window", "open a window when a display is available", [](O& o) -> bool& { return o.window; }),
+  };
+  return table;
+}
 
 MapViewOptions read_map_view_options(config::YamlReader& root, const std::string& config_dir,
                                      const std::string& default_profiles_file) {
@@ -13,24 +31,10 @@ MapViewOptions read_map_view_options(config::YamlReader& root, const std::string
   o.dds.profiles_file = default_profiles_file;
   if (root.has("map_view")) {
     config::YamlReader s = root.child("map_view");
-    RenderOptions& r = o.render;
-    r.width_px = static_cast<int>(s.integer("width_px", kMinMapSidePx, 16384, r.width_px));
-    r.height_px = static_cast<int>(s.integer("height_px", kMinMapSidePx, 16384, r.height_px));
-    r.footer_px = static_cast<int>(s.integer("footer_px", 0, 16384, r.footer_px));
-    r.sigma_scale = s.number("sigma_scale", 0.1, 10.0, r.sigma_scale);
-    r.min_span_m = s.number("min_span_m", 0.01, 1e6, r.min_span_m);
-    r.ground_truth = s.boolean("ground_truth", r.ground_truth);
-    r.landmark_ids = s.boolean("landmark_ids", r.landmark_ids);
-    r.grid = s.boolean("grid", r.grid);
-    r.legend = s.boolean("legend", r.legend);
-    r.scale_bar = s.boolean("scale_bar", r.scale_bar);
-    o.trajectory_min_step_m = s.number("trajectory_min_step_m", 0.0, 100.0, o.trajectory_min_step_m);
-    o.snapshot_period_s = s.number("snapshot_period_s", 0.05, 3600.0, o.snapshot_period_s);
-    o.snapshot_dir = s.text("snapshot_dir", o.snapshot_dir);
-    if (o.snapshot_dir.empty()) s.fail("snapshot_dir", "must not be empty");
-    o.window = s.boolean("window", o.window);
+    config::read_parameters(s, render_parameters(), o.render);
+    config::read_parameters(s, map_view_parameters(), o);
     s.finish();
-    s.check_mapping([&] { validate(r); });
+    config::check_rules(s, [&] { validate(o.render); });
   }
   if (root.has("dds")) {
     config::YamlReader dds = root.child("dds");
@@ -46,26 +50,8 @@ MapViewOptions read_map_view_options_file(const std::string& path, const std::st
 }
 
 std::string to_yaml(const MapViewOptions& o) {
-  const RenderOptions& r = o.render;
-  auto flag = [](bool b) { return b ? "true" : "false"; };
-  std::ostringstream os;
-  os << "map_view:\n"
-     << "  width_px: " << r.width_px << "\n"
-     << "  height_px: " << r.height_px << "\n"
-     << "  footer_px: " << r.footer_px << "\n"
-     << "  sigma_scale: " << r.sigma_scale << "\n"
-     << "  min_span_m: " << r.min_span_m << "\n"
-     << "  ground_truth: " << flag(r.ground_truth) << "\n"
-     << "  landmark_ids: " << flag(r.landmark_ids) << "\n"
-     << "  grid: " << flag(r.grid) << "\n"
-     << "  legend: " << flag(r.legend) << "\n"
-     << "  scale_bar: " << flag(r.scale_bar) << "\n"
-     << "  trajectory_min_step_m: " << o.trajectory_min_step_m << "\n"
-     << "  snapshot_period_s: " << o.snapshot_period_s << "\n"
-     << "  snapshot_dir: '" << o.snapshot_dir << "'\n"
-     << "  window: " << flag(o.window) << "\n"
-     << dds::to_yaml(o.dds);
-  return os.str();
+  return parameters::to_yaml(o.render, render_parameters(), "map_view") +
+         parameters::to_yaml(o, map_view_parameters(), "map_view").substr(10) + dds::to_yaml(o.dds);
 }
 
 }  // namespace pixyslam::map_view

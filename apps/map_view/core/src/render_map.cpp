@@ -274,27 +274,38 @@ void draw_footer(cv::Mat& img, const MapViewState& s, const ViewTransform& view,
 
 }  // namespace
 
+const parameters::Table<RenderOptions>& render_parameters() {
+  using O = RenderOptions;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::integer<O, int>("width_px", kMinMapSidePx, 16384, "px", "image width", [](O& o) -> int& { return o.width_px; }),
+      P::integer<O, int>("height_px", kMinMapSidePx, 16384, "px", "image height, footer included",
+                         [](O& o) -> int& { return o.height_px; }),
+      P::integer<O, int>("footer_px", 0, 16384, "px", "legend, scale bar and caption below the map (0: none)",
+                         [](O& o) -> int& { return o.footer_px; }),
+      P::real<O>("sigma_scale", 0.1, 10.0, "", "landmark ellipses at this many sigma",
+                 [](O& o) -> double& { return o.sigma_scale; }),
+      P::real<O>("min_span_m", 0.01, 1e6, "m", "the view never shows less than this",
+                 [](O& o) -> double& { return o.min_span_m; }),
+      P::boolean<O>("ground_truth", "draw the ground truth when the log has it",
+                    [](O& o) -> bool& { return o.ground_truth; }),
+      P::boolean<O>("landmark_ids", "label the landmarks", [](O& o) -> bool& { return o.landmark_ids; }),
+      P::boolean<O>("grid", "metre grid", [](O& o) -> bool& { return o.grid; }),
+      P::boolean<O>("legend", "legend in the footer", [](O& o) -> bool& { return o.legend; }),
+      P::boolean<O>("scale_bar", "scale bar in the footer", [](O& o) -> bool& { return o.scale_bar; }),
+  };
+  return table;
+}
+
 void validate(const RenderOptions& o) {
-  constexpr int kMaxSide = 16384;
-  if (o.width_px < kMinMapSidePx || o.width_px > kMaxSide) {
-    throw std::invalid_argument("width_px " + std::to_string(o.width_px) + " is out of range [" +
-                                std::to_string(kMinMapSidePx) + ", " + std::to_string(kMaxSide) + "]");
-  }
-  if (o.height_px > kMaxSide) {
-    throw std::invalid_argument("height_px " + std::to_string(o.height_px) + " is larger than " +
-                                std::to_string(kMaxSide));
-  }
-  if (o.footer_px < 0) throw std::invalid_argument("footer_px must be >= 0");
+  parameters::check_ranges(o, render_parameters(), "map_view");
   if (o.height_px - o.footer_px < kMinMapSidePx) {
-    throw std::invalid_argument("height_px " + std::to_string(o.height_px) + " leaves less than " +
-                                std::to_string(kMinMapSidePx) + " px for the map (footer " +
-                                std::to_string(o.footer_px) + " px)");
+    throw parameters::RuleError("map_view", "height_px",
+                                "value " + std::to_string(o.height_px) + " leaves less than " +
+                                    std::to_string(kMinMapSidePx) + " px for the map (footer " +
+                                    std::to_string(o.footer_px) + " px)");
   }
   if (!(o.margin_px >= 0.0) || !std::isfinite(o.margin_px)) throw std::invalid_argument("margin_px must be >= 0");
-  if (!(o.min_span_m > 0.0) || !std::isfinite(o.min_span_m)) throw std::invalid_argument("min_span_m must be > 0");
-  if (!(o.sigma_scale > 0.0) || !std::isfinite(o.sigma_scale)) {
-    throw std::invalid_argument("sigma_scale must be > 0");
-  }
 }
 
 cv::Rect2d map_area(const RenderOptions& options) {

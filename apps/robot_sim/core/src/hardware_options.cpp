@@ -5,32 +5,12 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "pixyslam/config/yaml_text.h"
+#include "pixyslam/config/parameters_yaml.h"
 
 namespace pixyslam::robot_sim {
 namespace {
 
-// Ranges shared by validate() and the YAML reader.
-constexpr double kMinArduinoHz = 1.0, kMaxArduinoHz = 1000.0;
-constexpr double kMinPixyHz = 0.1, kMaxPixyHz = 100.0;
-constexpr double kMaxVSigma = 10.0, kMaxWSigma = 10.0;
-constexpr double kMinRefHz = 0.1, kMaxRefHz = 1000.0;
-constexpr double kMaxRangeSigma = 10.0, kMaxBearingSigma = 1.0;
-constexpr double kMinPoleWidth = 0.001, kMaxPoleWidth = 10.0;
-constexpr double kMaxMinRange = 100.0;
-constexpr double kMinMaxRange = 0.01, kMaxMaxRange = 1000.0;
-constexpr std::int64_t kMaxBlockArea = 1000000;
-constexpr std::int64_t kMaxAngle = 180;
-constexpr double kMinStep = 1e-5, kMaxStep = 0.1;
 constexpr std::size_t kMaxVersionChars = 16;
-
-void check_range(const char* name, double v, double lo, double hi) {
-  if (!(v >= lo && v <= hi)) {
-    std::ostringstream os;
-    os << "hardware option " << name << " = " << v << " is out of range [" << lo << ", " << hi << "]";
-    throw std::invalid_argument(os.str());
-  }
-}
 
 // The RST line's version grammar: 1 to 16 of [0-9A-Za-z._-].
 bool valid_version(const std::string& v) {
@@ -45,85 +25,69 @@ bool valid_version(const std::string& v) {
 
 }  // namespace
 
+const parameters::Table<HardwareOptions>& hardware_parameters() {
+  using O = HardwareOptions;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::integer<O, std::uint64_t>("seed", 0, std::uint64_t{1} << 53, "", "wheel and camera noise",
+                                   [](O& o) -> std::uint64_t& { return o.seed; }),
+      P::real<O>("arduino_rate_hz", 1.0, 1000.0, "Hz", "encoder lines per second",
+                 [](O& o) -> double& { return o.arduino_rate_hz; }),
+      P::integer<O, std::uint32_t>("arduino_start_time_us", 0, std::numeric_limits<std::uint32_t>::max(), "us",
+                                   "the Arduino's micros() at power-on",
+                                   [](O& o) -> std::uint32_t& { return o.arduino_start_time_us; }),
+      P::integer<O, std::int32_t>("start_ticks", std::numeric_limits<std::int32_t>::min(),
+                                  std::numeric_limits<std::int32_t>::max(), "", "the counters at power-on",
+                                  [](O& o) -> std::int32_t& { return o.start_ticks; }),
+      P::text<O>("firmware_version", "the RST line's version", [](O& o) -> std::string& { return o.firmware_version; },
+                 [](const std::string& v) {
+                   if (!valid_version(v)) throw std::invalid_argument("not 1 to 16 of [0-9A-Za-z._-]");
+                 }),
+      P::real<O>("v_sigma_mps", 0.0, 10.0, "m/s", "wheel speed noise at the reference rate",
+                 [](O& o) -> double& { return o.v_sigma_mps; }),
+      P::real<O>("w_sigma_radps", 0.0, 10.0, "rad/s", "turn rate noise at the reference rate",
+                 [](O& o) -> double& { return o.w_sigma_radps; }),
+      P::real<O>("noise_reference_rate_hz", 0.1, 1000.0, "Hz", "the rate the two sigmas above are given at",
+                 [](O& o) -> double& { return o.noise_reference_rate_hz; }),
+      P::real<O>("pixy_rate_hz", 0.1, 100.0, "Hz", "camera frames per second",
+                 [](O& o) -> double& { return o.pixy_rate_hz; }),
+      P::real<O>("range_sigma_m", 0.0, 10.0, "m", "range noise on the true range",
+                 [](O& o) -> double& { return o.range_sigma_m; }),
+      P::real<O>("bearing_sigma_rad", 0.0, 1.0, "rad", "bearing noise on the true bearing",
+                 [](O& o) -> double& { return o.bearing_sigma_rad; }),
+      P::real<O>("pole_width_m", 0.001, 10.0, "m", "the poles' width", [](O& o) -> double& { return o.pole_width_m; }),
+      P::real<O>("min_range_m", 0.0, 100.0, "m", "poles nearer than this are not seen",
+                 [](O& o) -> double& { return o.min_range_m; }),
+      P::real<O>("max_range_m", 0.01, 1000.0, "m", "poles farther than this are not seen (> min_range_m)",
+                 [](O& o) -> double& { return o.max_range_m; }),
+      P::integer<O, int>("min_block_area_px", 0, 1000000, "px", "smaller blocks are not reported",
+                         [](O& o) -> int& { return o.min_block_area_px; }),
+      P::integer<O, int>("colour_code_angle_deg", -180, 180, "deg", "the colour code block's angle",
+                         [](O& o) -> int& { return o.colour_code_angle_deg; }),
+      P::boolean<O>("send_empty_frames", "frames without blocks too", [](O& o) -> bool& { return o.send_empty_frames; }),
+      P::real<O>("physics_step_s", 1e-5, 0.1, "s", "the simulation's time step",
+                 [](O& o) -> double& { return o.physics_step_s; }),
+  };
+  return table;
+}
+
 void validate(const HardwareOptions& o) {
-  check_range("arduino_rate_hz", o.arduino_rate_hz, kMinArduinoHz, kMaxArduinoHz);
-  if (!valid_version(o.firmware_version)) {
-    throw std::invalid_argument("hardware option firmware_version '" + o.firmware_version +
-                                "' is not 1 to 16 of [0-9A-Za-z._-]");
-  }
-  check_range("v_sigma_mps", o.v_sigma_mps, 0.0, kMaxVSigma);
-  check_range("w_sigma_radps", o.w_sigma_radps, 0.0, kMaxWSigma);
-  check_range("noise_reference_rate_hz", o.noise_reference_rate_hz, kMinRefHz, kMaxRefHz);
-  check_range("pixy_rate_hz", o.pixy_rate_hz, kMinPixyHz, kMaxPixyHz);
-  check_range("range_sigma_m", o.range_sigma_m, 0.0, kMaxRangeSigma);
-  check_range("bearing_sigma_rad", o.bearing_sigma_rad, 0.0, kMaxBearingSigma);
-  check_range("pole_width_m", o.pole_width_m, kMinPoleWidth, kMaxPoleWidth);
-  check_range("min_range_m", o.min_range_m, 0.0, kMaxMinRange);
-  check_range("max_range_m", o.max_range_m, kMinMaxRange, kMaxMaxRange);
+  parameters::check_ranges(o, hardware_parameters(), "hardware");
   if (!(o.max_range_m > o.min_range_m)) {
-    throw std::invalid_argument("hardware option max_range_m must be greater than min_range_m");
+    throw parameters::RuleError("hardware", "max_range_m",
+                                "value " + parameters::number_text(o.max_range_m) + " must be greater than min_range_m (" +
+                                    parameters::number_text(o.min_range_m) + ")");
   }
-  check_range("min_block_area_px", o.min_block_area_px, 0, static_cast<double>(kMaxBlockArea));
-  check_range("colour_code_angle_deg", o.colour_code_angle_deg, -kMaxAngle, kMaxAngle);
-  check_range("physics_step_s", o.physics_step_s, kMinStep, kMaxStep);
 }
 
 HardwareOptions read_hardware_options(config::YamlReader& r) {
   HardwareOptions o;
-  o.seed = static_cast<std::uint64_t>(
-      r.integer("seed", 0, std::numeric_limits<std::int64_t>::max(), static_cast<std::int64_t>(o.seed)));
-  o.arduino_rate_hz = r.number("arduino_rate_hz", kMinArduinoHz, kMaxArduinoHz, o.arduino_rate_hz);
-  o.arduino_start_time_us = static_cast<std::uint32_t>(
-      r.integer("arduino_start_time_us", 0, std::numeric_limits<std::uint32_t>::max(), o.arduino_start_time_us));
-  o.start_ticks = static_cast<std::int32_t>(r.integer("start_ticks", std::numeric_limits<std::int32_t>::min(),
-                                                      std::numeric_limits<std::int32_t>::max(), o.start_ticks));
-  o.firmware_version = r.text("firmware_version", o.firmware_version);
-  if (!valid_version(o.firmware_version)) {
-    r.fail("firmware_version", "value '" + o.firmware_version + "' is not 1 to 16 of [0-9A-Za-z._-]");
-  }
-  o.v_sigma_mps = r.number("v_sigma_mps", 0.0, kMaxVSigma, o.v_sigma_mps);
-  o.w_sigma_radps = r.number("w_sigma_radps", 0.0, kMaxWSigma, o.w_sigma_radps);
-  o.noise_reference_rate_hz = r.number("noise_reference_rate_hz", kMinRefHz, kMaxRefHz, o.noise_reference_rate_hz);
-  o.pixy_rate_hz = r.number("pixy_rate_hz", kMinPixyHz, kMaxPixyHz, o.pixy_rate_hz);
-  o.range_sigma_m = r.number("range_sigma_m", 0.0, kMaxRangeSigma, o.range_sigma_m);
-  o.bearing_sigma_rad = r.number("bearing_sigma_rad", 0.0, kMaxBearingSigma, o.bearing_sigma_rad);
-  o.pole_width_m = r.number("pole_width_m", kMinPoleWidth, kMaxPoleWidth, o.pole_width_m);
-  o.min_range_m = r.number("min_range_m", 0.0, kMaxMinRange, o.min_range_m);
-  o.max_range_m = r.number("max_range_m", kMinMaxRange, kMaxMaxRange, o.max_range_m);
-  if (!(o.max_range_m > o.min_range_m)) r.fail("max_range_m", "must be greater than min_range_m");
-  o.min_block_area_px = static_cast<int>(r.integer("min_block_area_px", 0, kMaxBlockArea, o.min_block_area_px));
-  o.colour_code_angle_deg =
-      static_cast<int>(r.integer("colour_code_angle_deg", -kMaxAngle, kMaxAngle, o.colour_code_angle_deg));
-  o.send_empty_frames = r.boolean("send_empty_frames", o.send_empty_frames);
-  o.physics_step_s = r.number("physics_step_s", kMinStep, kMaxStep, o.physics_step_s);
+  config::read_parameters(r, hardware_parameters(), o);
   r.finish();
-  r.check_mapping([&] { validate(o); });
+  config::check_rules(r, [&] { validate(o); });
   return o;
 }
 
-std::string to_yaml(const HardwareOptions& o) {
-  using config::yaml_number;
-  std::ostringstream os;
-  os << "hardware:\n"
-     << "  seed: " << o.seed << "\n"
-     << "  arduino_rate_hz: " << yaml_number(o.arduino_rate_hz) << "\n"
-     << "  arduino_start_time_us: " << o.arduino_start_time_us << "\n"
-     << "  start_ticks: " << o.start_ticks << "\n"
-     << "  firmware_version: \"" << o.firmware_version << "\"\n"
-     << "  v_sigma_mps: " << yaml_number(o.v_sigma_mps) << "\n"
-     << "  w_sigma_radps: " << yaml_number(o.w_sigma_radps) << "\n"
-     << "  noise_reference_rate_hz: " << yaml_number(o.noise_reference_rate_hz) << "\n"
-     << "  pixy_rate_hz: " << yaml_number(o.pixy_rate_hz) << "\n"
-     << "  range_sigma_m: " << yaml_number(o.range_sigma_m) << "\n"
-     << "  bearing_sigma_rad: " << yaml_number(o.bearing_sigma_rad) << "\n"
-     << "  pole_width_m: " << yaml_number(o.pole_width_m) << "\n"
-     << "  min_range_m: " << yaml_number(o.min_range_m) << "\n"
-     << "  max_range_m: " << yaml_number(o.max_range_m) << "\n"
-     << "  min_block_area_px: " << o.min_block_area_px << "\n"
-     << "  colour_code_angle_deg: " << o.colour_code_angle_deg << "\n"
-     << "  send_empty_frames: " << (o.send_empty_frames ? "true" : "false") << "\n"
-     << "  physics_step_s: " << yaml_number(o.physics_step_s) << "\n";
-  return os.str();
-}
+std::string to_yaml(const HardwareOptions& o) { return parameters::to_yaml(o, hardware_parameters(), "hardware"); }
 
 }  // namespace pixyslam::robot_sim

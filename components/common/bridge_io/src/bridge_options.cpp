@@ -27,7 +27,9 @@ void apply_command_line(const app::CommandLine& args, std::string& serial_device
       throw std::invalid_argument("--device '" + serial_device + "' is not an absolute path");
     }
   }
-  if (args.has("dds-config")) dds.profiles_file = args.get("dds-config");
+  // The DDS settings resolved here, once: file, environment, command line.
+  dds::resolve_settings(dds, args.has("dds-config") ? std::vector<std::string>{"dds.profiles_file=" + args.get("dds-config")}
+                                                    : std::vector<std::string>{});
   const std::string& profiles = dds.profiles_file;
   if (profiles.empty()) return;
   const std::string where =

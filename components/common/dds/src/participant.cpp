@@ -1,6 +1,5 @@
 #include "pixyslam/dds/participant.h"
 
-#include "pixyslam/config/yaml_text.h"
 #include "pixyslam/dds/topics.h"
 
 #include <arpa/inet.h>
@@ -32,160 +31,6 @@
 namespace pixyslam::dds {
 
 namespace fdds = eprosima::fastdds::dds;
-
-namespace {
-
-// "ADDR:PORT" -> (ADDR, PORT); throws naming `what`.
-std::pair<std::string, std::uint16_t> split_server(const std::string& text, const std::string& what) {
-  const auto colon = text.rfind(':');
-  const std::string port_text = colon == std::string::npos ? "" : text.substr(colon + 1);
-  if (colon == std::string::npos || port_text.empty() || port_text.size() > 5 ||
-      port_text.find_first_not_of("0123456789") != std::string::npos || std::stoul(port_text) == 0 ||
-      std::stoul(port_text) > 65535) {
-    throw std::invalid_argument(what + ": '" + text + "' is not ADDR:PORT (e.g. 10.200.0.3:11811)");
-  }
-  check_ipv4(text.substr(0, colon), what);
-  return {text.substr(0, colon), static_cast<std::uint16_t>(std::stoul(port_text))};
-}
-
-std::string resolve(const std::string& path, const std::string& dir) {
-  if (path.empty() || path.front() == '/' || dir.empty()) return path;
-  return dir + "/" + path;
-}
-
-std::string yaml_list(const std::vector<std::string>& items) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + items[i];
-  return out + "]";
-}
-
-}  // namespace
-
-void check_ipv4(const std::string& text, const std::string& what) {
-  in_addr address{};
-  if (inet_pton(AF_INET, text.c_str(), &address) != 1) {
-    throw std::invalid_argument(what + ": '" + text + "' is not an IPv4 address");
-  }
-}
-
-DdsOptions read_dds_options(config::YamlReader& reader, const std::string& config_dir) {
-  DdsOptions o;
-  o.domain_id = static_cast<int>(reader.integer("domain_id", 0, 232, o.domain_id));
-  o.profiles_file = resolve(reader.text("profiles_file", o.profiles_file), config_dir);
-  o.participant_profile = reader.text("participant_profile", o.participant_profile);
-  o.robot_id = reader.text("robot_id", o.robot_id);
-  if (o.robot_id.empty()) reader.fail("robot_id", "must not be empty");
-  o.type_information = reader.boolean("type_information", o.type_information);
-  if (reader.has("announce_identity")) {
-    const std::string announce = reader.text("announce_identity");
-    if (announce == "true") {
-      o.announce_identity = true;
-    } else if (announce == "false") {
-      o.announce_identity = false;
-    } else if (announce != "auto") {
-      reader.fail("announce_identity", "'" + announce + "' is not true, false or auto");
-    }
-  }
-  o.diagnostics_period_s = reader.number("diagnostics_period_s", 0.0, 3600.0, o.diagnostics_period_s);
-  auto addresses = [&](const char* key) {
-    std::vector<std::string> list = reader.has(key) ? reader.text_list(key) : std::vector<std::string>{};
-    for (const std::string& a : list) {
-      try {
-        check_ipv4(a, key);
-      } catch (const std::invalid_argument& e) {
-        reader.fail(key, e.what());
-      }
-    }
-    return list;
-  };
-  o.interfaces = addresses("interfaces");
-  o.initial_peers = addresses("initial_peers");
-  o.discovery_server = reader.text("discovery_server", o.discovery_server);
-  if (!o.discovery_server.empty()) {
-    try {
-      split_server(o.discovery_server, "discovery_server");
-    } catch (const std::invalid_argument& e) {
-      reader.fail("discovery_server", e.what());
-    }
-  }
-  o.discovery_server_id = static_cast<int>(reader.integer("discovery_server_id", 0, 255, o.discovery_server_id));
-  o.security_dir = resolve(reader.text("security_dir", o.security_dir), config_dir);
-  reader.finish();
-  return o;
-}
-
-DdsOptions read_dds_options_file(const std::string& yaml_path, const std::string& default_profiles_file) {
-  if (yaml_path.empty()) {
-    DdsOptions o;
-    o.profiles_file = default_profiles_file;
-    return o;
-  }
-  config::YamlReader root = config::YamlReader::from_file(yaml_path);
-  config::YamlReader dds = root.child("dds");
-  return read_dds_options(dds, std::filesystem::path(yaml_path).parent_path().string());
-}
-
-void apply_environment(DdsOptions& o, const std::function<const char*(const char*)>& getenv) {
-  auto value = [&](const char* name) -> std::string {
-    const char* v = getenv(name);
-    return v == nullptr ? std::string() : std::string(v);
-  };
-  auto integer = [&](const char* name, int min, int max, int& out) {
-    const std::string v = value(name);
-    if (v.empty()) return;
-    if (v.size() > 3 || v.find_first_not_of("0123456789") != std::string::npos || std::stoi(v) < min ||
-        std::stoi(v) > max) {
-      throw std::invalid_argument(std::string(name) + "='" + v + "': must be an integer " + std::to_string(min) +
-                                  ".." + std::to_string(max));
-    }
-    out = std::stoi(v);
-  };
-  auto addresses = [&](const char* name, std::vector<std::string>& out) {
-    const std::string v = value(name);
-    if (v.empty()) return;
-    out = config::split_comma_list(v);
-    for (const std::string& a : out) check_ipv4(a, name);
-  };
-  integer("PIXYSLAM_DDS_DOMAIN", 0, 232, o.domain_id);
-  if (!value("PIXYSLAM_DDS_PROFILES_FILE").empty()) o.profiles_file = value("PIXYSLAM_DDS_PROFILES_FILE");
-  if (!value("PIXYSLAM_DDS_PROFILE").empty()) o.participant_profile = value("PIXYSLAM_DDS_PROFILE");
-  addresses("PIXYSLAM_DDS_INTERFACES", o.interfaces);
-  addresses("PIXYSLAM_DDS_PEERS", o.initial_peers);
-  if (!value("PIXYSLAM_DDS_SERVER").empty()) {
-    split_server(value("PIXYSLAM_DDS_SERVER"), "PIXYSLAM_DDS_SERVER");
-    o.discovery_server = value("PIXYSLAM_DDS_SERVER");
-  }
-  integer("PIXYSLAM_DDS_SERVER_ID", 0, 255, o.discovery_server_id);
-  if (!value("PIXYSLAM_DDS_SECURITY_DIR").empty()) o.security_dir = value("PIXYSLAM_DDS_SECURITY_DIR");
-  const std::string type_information = value("PIXYSLAM_DDS_TYPE_INFORMATION");
-  if (type_information == "true" || type_information == "1") {
-    o.type_information = true;
-  } else if (type_information == "false" || type_information == "0") {
-    o.type_information = false;
-  } else if (!type_information.empty()) {
-    throw std::invalid_argument("PIXYSLAM_DDS_TYPE_INFORMATION='" + type_information + "': must be true or false");
-  }
-}
-
-std::string to_yaml(const DdsOptions& o) {
-  auto quoted = [](const std::string& s) { return "'" + s + "'"; };
-  return "dds:\n"
-         "  domain_id: " + std::to_string(o.domain_id) + "\n" +
-         "  profiles_file: " + quoted(o.profiles_file) + "\n" +
-         "  participant_profile: " + quoted(o.participant_profile) + "\n" +
-         "  robot_id: " + quoted(o.robot_id) + "\n" +
-         "  type_information: " + (o.type_information ? "true" : "false") + "\n" +
-         "  diagnostics_period_s: " + config::yaml_number(o.diagnostics_period_s) + "\n" +
-         "  interfaces: " + yaml_list(o.interfaces) + "\n" +
-         "  initial_peers: " + yaml_list(o.initial_peers) + "\n" +
-         "  discovery_server: " + quoted(o.discovery_server) + "\n" +
-         "  discovery_server_id: " + std::to_string(o.discovery_server_id) + "\n" +
-         "  security_dir: " + quoted(o.security_dir) + "\n" +
-         "  announce_identity: " +
-         (o.announce_identity ? (*o.announce_identity ? "true" : "false") : std::string("auto")) + "\n";
-}
-
-bool announces_identity(const DdsOptions& options, bool secure) { return options.announce_identity.value_or(!secure); }
 
 namespace {
 
@@ -327,11 +172,6 @@ fdds::DomainParticipant* create_participant(const DdsOptions& options, const std
 }
 
 Participant::Participant(const DdsOptions& options, const std::string& name) : options_(options) {
-  apply_environment(options_, [](const char* n) { return std::getenv(n); });
-  if (to_yaml(options_) != to_yaml(options)) {
-    std::fprintf(stderr, "%s: DDS settings after the PIXYSLAM_DDS_* environment:\n%s", name.c_str(),
-                 to_yaml(options_).c_str());
-  }
   participant_ = create_participant(options_, name, nullptr);
   publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);

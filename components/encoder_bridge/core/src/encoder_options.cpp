@@ -4,7 +4,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "pixyslam/config/yaml_text.h"
+#include "pixyslam/config/parameters_yaml.h"
 
 namespace pixyslam::encoder {
 namespace {
@@ -14,32 +14,10 @@ constexpr std::array<long, 30> kStandardBauds = {
     2400,   4800,   9600,   19200,   38400,   57600,   115200,  230400,  460800,  500000,
     576000, 921600, 1000000, 1152000, 1500000, 2000000, 2500000, 3000000, 3500000, 4000000};
 
-// Ranges shared by validate() and the YAML reader.
-constexpr double kMinRadiusM = 0.001, kMaxRadiusM = 1.0;
-constexpr long kMinTicks = 1, kMaxTicks = 10000000;
-constexpr double kMinBaseM = 0.01, kMaxBaseM = 5.0;
-constexpr double kMinRateHz = 0.1, kMaxRateHz = 100.0;
-constexpr double kMinSpeedMps = 0.01, kMaxSpeedMps = 20.0;
-constexpr double kMinGapS = 0.001, kMaxGapS = 60.0;
-
-void check_range(const char* name, double v, double lo, double hi) {
-  if (!(v >= lo && v <= hi)) {
-    std::ostringstream os;
-    os << name << " = " << v << " is out of range [" << lo << ", " << hi << "]";
-    throw std::invalid_argument(os.str());
-  }
-}
-
 std::string baud_list() {
   std::string s;
   for (const long b : kStandardBauds) s += (s.empty() ? "" : ", ") + std::to_string(b);
   return s;
-}
-
-int read_sign(config::YamlReader& r, const std::string& key) {
-  const auto v = r.integer(key, -1, 1);
-  if (v == 0) r.fail(key, "value 0 is not a sign (expected 1 or -1)");
-  return static_cast<int>(v);
 }
 
 }  // namespace
@@ -51,43 +29,53 @@ bool is_standard_baud(long baud) {
   return false;
 }
 
+const parameters::Table<EncoderOptions>& encoder_parameters() {
+  using O = EncoderOptions;
+  namespace P = parameters;
+  const auto absolute_path = [](const std::string& v) {
+    if (v.empty() || v.front() != '/') throw std::invalid_argument("not an absolute path (e.g. /dev/ttyACM0)");
+  };
+  static const P::Table<O> table = {
+      P::text<O>("serial_device", "the Arduino's serial device", [](O& o) -> std::string& { return o.serial_device; },
+                 absolute_path),
+      P::integer<O, int>("baud", 50, 4000000, "bit/s", "a standard serial rate (50 ... 4000000)",
+                         [](O& o) -> int& { return o.baud; }),
+      P::required(P::real<O>("wheel_radius_m", 0.001, 1.0, "m", "wheel radius",
+                             [](O& o) -> double& { return o.wheel_radius_m; })),
+      P::required(P::integer<O, int>("ticks_per_revolution", 1, 10000000, "", "counter steps per wheel turn",
+                                     [](O& o) -> int& { return o.ticks_per_revolution; })),
+      P::required(P::real<O>("wheel_base_m", 0.01, 5.0, "m", "distance between the wheels' contact points",
+                             [](O& o) -> double& { return o.wheel_base_m; })),
+      P::required(P::integer<O, int>("left_sign", -1, 1, "", "1 or -1: the left counter's direction forward",
+                                     [](O& o) -> int& { return o.left_sign; })),
+      P::required(P::integer<O, int>("right_sign", -1, 1, "", "1 or -1: the right counter's direction forward",
+                                     [](O& o) -> int& { return o.right_sign; })),
+      P::real<O>("publish_rate_hz", 0.1, 100.0, "Hz", "(v, w) outputs per second",
+                 [](O& o) -> double& { return o.publish_rate_hz; }),
+      P::real<O>("max_wheel_speed_mps", 0.01, 20.0, "m/s", "faster wheel travel between two samples is rejected",
+                 [](O& o) -> double& { return o.max_wheel_speed_mps; }),
+      P::real<O>("max_sample_gap_s", 0.001, 60.0, "s", "longer Arduino intervals give no velocity",
+                 [](O& o) -> double& { return o.max_sample_gap_s; }),
+  };
+  return table;
+}
+
 void validate(const EncoderOptions& o) {
-  if (o.serial_device.empty() || o.serial_device.front() != '/') {
-    throw std::invalid_argument("serial_device '" + o.serial_device + "' is not an absolute path");
-  }
+  parameters::check_ranges(o, encoder_parameters(), "encoder_bridge");
   if (!is_standard_baud(o.baud)) {
-    throw std::invalid_argument("baud " + std::to_string(o.baud) + " is not a standard rate");
+    throw parameters::RuleError("encoder_bridge", "baud", "value " + std::to_string(o.baud) +
+                                                              " is not a standard serial rate (" + baud_list() + ")");
   }
-  check_range("wheel_radius_m", o.wheel_radius_m, kMinRadiusM, kMaxRadiusM);
-  check_range("ticks_per_revolution", o.ticks_per_revolution, kMinTicks, kMaxTicks);
-  check_range("wheel_base_m", o.wheel_base_m, kMinBaseM, kMaxBaseM);
-  if (o.left_sign != 1 && o.left_sign != -1) throw std::invalid_argument("left_sign must be 1 or -1");
-  if (o.right_sign != 1 && o.right_sign != -1) throw std::invalid_argument("right_sign must be 1 or -1");
-  check_range("publish_rate_hz", o.publish_rate_hz, kMinRateHz, kMaxRateHz);
-  check_range("max_wheel_speed_mps", o.max_wheel_speed_mps, kMinSpeedMps, kMaxSpeedMps);
-  check_range("max_sample_gap_s", o.max_sample_gap_s, kMinGapS, kMaxGapS);
+  for (const auto& [name, sign] : {std::pair{"left_sign", o.left_sign}, std::pair{"right_sign", o.right_sign}}) {
+    if (sign == 0) throw parameters::RuleError("encoder_bridge", name, "value 0 is not a sign (expected 1 or -1)");
+  }
 }
 
 EncoderOptions read_encoder_options(config::YamlReader& r) {
   EncoderOptions o;
-  o.serial_device = r.text("serial_device", o.serial_device);
-  if (o.serial_device.empty() || o.serial_device.front() != '/') {
-    r.fail("serial_device", "value '" + o.serial_device + "' is not an absolute path (e.g. /dev/ttyACM0)");
-  }
-  o.baud = static_cast<int>(r.integer("baud", 1, 4000000, o.baud));
-  if (!is_standard_baud(o.baud)) {
-    r.fail("baud", "value " + std::to_string(o.baud) + " is not a standard serial rate (" + baud_list() + ")");
-  }
-  o.wheel_radius_m = r.number("wheel_radius_m", kMinRadiusM, kMaxRadiusM);
-  o.ticks_per_revolution = static_cast<int>(r.integer("ticks_per_revolution", kMinTicks, kMaxTicks));
-  o.wheel_base_m = r.number("wheel_base_m", kMinBaseM, kMaxBaseM);
-  o.left_sign = read_sign(r, "left_sign");
-  o.right_sign = read_sign(r, "right_sign");
-  o.publish_rate_hz = r.number("publish_rate_hz", kMinRateHz, kMaxRateHz, o.publish_rate_hz);
-  o.max_wheel_speed_mps = r.number("max_wheel_speed_mps", kMinSpeedMps, kMaxSpeedMps, o.max_wheel_speed_mps);
-  o.max_sample_gap_s = r.number("max_sample_gap_s", kMinGapS, kMaxGapS, o.max_sample_gap_s);
+  config::read_parameters(r, encoder_parameters(), o);
   r.finish();
-  r.check_mapping([&] { validate(o); });
+  config::check_rules(r, [&] { validate(o); });
   return o;
 }
 
@@ -103,21 +91,6 @@ EncoderOptions read_encoder_options_file(const std::string& path) {
   return o;
 }
 
-std::string to_yaml(const EncoderOptions& o) {
-  using config::yaml_number;
-  std::ostringstream os;
-  os << "encoder_bridge:\n"
-     << "  serial_device: " << config::yaml_quoted(o.serial_device) << "\n"
-     << "  baud: " << o.baud << "\n"
-     << "  wheel_radius_m: " << yaml_number(o.wheel_radius_m) << "\n"
-     << "  ticks_per_revolution: " << o.ticks_per_revolution << "\n"
-     << "  wheel_base_m: " << yaml_number(o.wheel_base_m) << "\n"
-     << "  left_sign: " << o.left_sign << "\n"
-     << "  right_sign: " << o.right_sign << "\n"
-     << "  publish_rate_hz: " << yaml_number(o.publish_rate_hz) << "\n"
-     << "  max_wheel_speed_mps: " << yaml_number(o.max_wheel_speed_mps) << "\n"
-     << "  max_sample_gap_s: " << yaml_number(o.max_sample_gap_s) << "\n";
-  return os.str();
-}
+std::string to_yaml(const EncoderOptions& o) { return parameters::to_yaml(o, encoder_parameters(), "encoder_bridge"); }
 
 }  // namespace pixyslam::encoder

@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "pixyslam/app/command_line.h"
+#include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/logger_node/cdr_payload.h"
 #include "pixyslam/logger_node/topic_selection.h"
 
@@ -23,18 +24,8 @@ std::vector<std::string> all_topics() {
 
 constexpr std::uint64_t kMinRotateSizeBytes = 65536;
 
-logger::McapCompression read_compression(config::YamlReader& reader, logger::McapCompression fallback) {
-  const std::string fallback_name =
-      fallback == logger::McapCompression::kNone ? "none" : logger::mcap_compression_name(fallback);
-  const std::string name = reader.choice("compression", {"none", "zstd", "lz4"}, fallback_name);
-  const logger::McapCompression c = name == "zstd"  ? logger::McapCompression::kZstd
-                                    : name == "lz4" ? logger::McapCompression::kLz4
-                                                    : logger::McapCompression::kNone;
-  if (!logger::mcap_compression_available(c)) {
-    reader.fail("compression", "'" + name + "' is not available in this build (install lib" + name +
-                                   "-dev and rebuild, or use none)");
-  }
-  return c;
+std::string compression_name(logger::McapCompression c) {
+  return c == logger::McapCompression::kNone ? "none" : logger::mcap_compression_name(c);
 }
 
 }  // namespace
@@ -43,11 +34,64 @@ bool rotation_enabled(const LoggerOptions& options) {
   return options.rotate_size_bytes > 0 || options.rotate_period_s > 0.0;
 }
 
+const parameters::Table<LoggerOptions>& logger_parameters() {
+  using O = LoggerOptions;
+  using C = logger::McapCompression;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::text<O>("output_file", "the MCAP file (kept if it holds data: the next free indexed name is used)",
+                 [](O& o) -> std::string& { return o.output_file; },
+                 [](const std::string& v) {
+                   if (v.empty()) throw std::invalid_argument("empty");
+                 }),
+      P::integer<O, std::uint64_t>("rotate_size_bytes", 0, std::uint64_t{1} << 40, "B",
+                                   "a new file once this one holds this many bytes (0: never, else >= 65536)",
+                                   [](O& o) -> std::uint64_t& { return o.rotate_size_bytes; }),
+      P::real<O>("rotate_period_s", 0.0, 7 * 86400.0, "s", "a new file after this long (0: never, else >= 1)",
+                 [](O& o) -> double& { return o.rotate_period_s; }),
+      P::integer<O, std::size_t>("chunk_size_bytes", 4096, std::size_t{1} << 28, "B",
+                                 "uncompressed bytes per MCAP chunk",
+                                 [](O& o) -> std::size_t& { return o.chunk_size_bytes; }),
+      P::choice<O, C>("compression", {{"none", C::kNone}, {"zstd", C::kZstd}, {"lz4", C::kLz4}},
+                      "chunk compression (zstd and lz4 when built with them)",
+                      [](O& o) -> C& { return o.compression; }),
+      P::real<O>("flush_period_s", 0.0, 3600.0, "s", "the open chunk written at least this often (0: when full)",
+                 [](O& o) -> double& { return o.flush_period_s; }),
+      P::boolean<O>("fsync", "fsync(2) after every chunk (survives a power cut)", [](O& o) -> bool& { return o.fsync; }),
+      P::integer<O, std::size_t>("queue_max_bytes", std::size_t{1} << 20, std::size_t{1} << 32, "B",
+                                 "payload bytes waiting for the writer; beyond: dropped and counted",
+                                 [](O& o) -> std::size_t& { return o.queue_max_bytes; }),
+      P::real<O>("retry_period_s", 0.1, 3600.0, "s", "after a write failure, a new file tried this often",
+                 [](O& o) -> double& { return o.retry_period_s; }),
+      P::text<O>("fallback_dir", "folder tried in turn with the output file's after a failure ('': none)",
+                 [](O& o) -> std::string& { return o.fallback_dir; }),
+  };
+  return table;
+}
+
+void validate(const LoggerOptions& o) {
+  parameters::check_ranges(o, logger_parameters(), "logger");
+  if (o.rotate_size_bytes != 0 && o.rotate_size_bytes < kMinRotateSizeBytes) {
+    throw parameters::RuleError("logger", "rotate_size_bytes",
+                                "value " + std::to_string(o.rotate_size_bytes) + " is too small: 0 (off) or at least " +
+                                    std::to_string(kMinRotateSizeBytes));
+  }
+  if (o.rotate_period_s != 0.0 && o.rotate_period_s < 1.0) {
+    throw parameters::RuleError("logger", "rotate_period_s",
+                                "value " + parameters::number_text(o.rotate_period_s) +
+                                    " is too small: 0 (off) or at least 1");
+  }
+  if (!logger::mcap_compression_available(o.compression)) {
+    const std::string name = compression_name(o.compression);
+    throw parameters::RuleError("logger", "compression",
+                                "'" + name + "' is not available in this build (install lib" + name +
+                                    "-dev and rebuild, or use none)");
+  }
+}
+
 LoggerOptions read_logger_options(config::YamlReader& root, const std::string& config_dir) {
   LoggerOptions o;
   config::YamlReader section = root.child("logger");
-  o.output_file = section.text("output_file", o.output_file);
-  if (o.output_file.empty()) section.fail("output_file", "must not be empty");
   if (section.has("topics")) {
     const std::vector<std::string> patterns = section.text_list("topics");
     if (patterns.empty()) section.fail("topics", "empty list (leave the key out to record every topic)");
@@ -59,25 +103,8 @@ LoggerOptions read_logger_options(config::YamlReader& root, const std::string& c
   } else {
     o.topics = all_topics();
   }
-  o.rotate_size_bytes = static_cast<std::uint64_t>(
-      section.integer("rotate_size_bytes", 0, std::int64_t{1} << 40, static_cast<std::int64_t>(o.rotate_size_bytes)));
-  if (o.rotate_size_bytes != 0 && o.rotate_size_bytes < kMinRotateSizeBytes) {
-    section.fail("rotate_size_bytes", "value " + std::to_string(o.rotate_size_bytes) + " is too small: 0 (off) or at least " +
-                                          std::to_string(kMinRotateSizeBytes));
-  }
-  o.rotate_period_s = section.number("rotate_period_s", 0.0, 7 * 86400.0, o.rotate_period_s);
-  if (o.rotate_period_s != 0.0 && o.rotate_period_s < 1.0) {
-    section.fail("rotate_period_s", "value " + std::to_string(o.rotate_period_s) + " is too small: 0 (off) or at least 1");
-  }
-  o.chunk_size_bytes = static_cast<std::size_t>(
-      section.integer("chunk_size_bytes", 4096, std::int64_t{1} << 28, static_cast<std::int64_t>(o.chunk_size_bytes)));
-  o.compression = read_compression(section, o.compression);
-  o.flush_period_s = section.number("flush_period_s", 0.0, 3600.0, o.flush_period_s);
-  o.fsync = section.boolean("fsync", o.fsync);
-  o.queue_max_bytes = static_cast<std::size_t>(section.integer(
-      "queue_max_bytes", std::int64_t{1} << 20, std::int64_t{1} << 32, static_cast<std::int64_t>(o.queue_max_bytes)));
-  o.retry_period_s = section.number("retry_period_s", 0.1, 3600.0, o.retry_period_s);
-  o.fallback_dir = section.text("fallback_dir", o.fallback_dir);
+  config::read_parameters(section, logger_parameters(), o);
+  config::check_rules(section, [&] { validate(o); });
   section.finish();
 
   if (root.has("dds")) {
@@ -94,25 +121,9 @@ LoggerOptions read_logger_options_file(const std::string& path) {
 }
 
 std::string to_yaml(const LoggerOptions& o) {
-  std::ostringstream os;
-  os << "logger:\n"
-     << "  output_file: '" << o.output_file << "'\n"
-     << "  topics: [";
-  for (std::size_t i = 0; i < o.topics.size(); ++i) os << (i ? ", " : "") << o.topics[i];
-  os << "]\n"
-     << "  rotate_size_bytes: " << o.rotate_size_bytes << "\n"
-     << "  rotate_period_s: " << o.rotate_period_s << "\n"
-     << "  chunk_size_bytes: " << o.chunk_size_bytes << "\n"
-     << "  compression: "
-     << (o.compression == logger::McapCompression::kNone ? "none" : logger::mcap_compression_name(o.compression))
-     << "\n"
-     << "  flush_period_s: " << o.flush_period_s << "\n"
-     << "  fsync: " << (o.fsync ? "true" : "false") << "\n"
-     << "  queue_max_bytes: " << o.queue_max_bytes << "\n"
-     << "  retry_period_s: " << o.retry_period_s << "\n"
-     << "  fallback_dir: '" << o.fallback_dir << "'\n"
-     << dds::to_yaml(o.dds);
-  return os.str();
+  std::string topics;
+  for (const std::string& t : o.topics) topics += (topics.empty() ? "" : ", ") + t;
+  return parameters::to_yaml(o, logger_parameters(), "logger") + "  topics: [" + topics + "]\n" + dds::to_yaml(o.dds);
 }
 
 }  // namespace pixyslam::logger_node

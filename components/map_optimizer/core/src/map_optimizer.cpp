@@ -81,7 +81,22 @@ MapOptimizerOptions MapOptimizerOptions::from_filter(const slam::FilterOptions& 
   return o;
 }
 
+const parameters::Table<MapOptimizerOptions>& map_optimizer_parameters() {
+  using O = MapOptimizerOptions;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::real<O>("keyframe_interval_s", 0.01, 3600.0, "s", "a keyframe at most this often (and at each observation)",
+                 [](O& o) -> double& { return o.keyframe_interval_s; }),
+      P::real<O>("huber_threshold", 1e-3, 1e6, "", "Huber threshold on the whitened residual norm",
+                 [](O& o) -> double& { return o.huber_threshold; }),
+      P::integer<O, int>("max_iterations", 1, 10000, "", "Ceres iterations per solve at most",
+                         [](O& o) -> int& { return o.max_iterations; }),
+  };
+  return table;
+}
+
 void validate(const MapOptimizerOptions& o) {
+  parameters::check_ranges(o, map_optimizer_parameters(), "optimizer");
   auto require = [](bool ok, const char* field, const char* what) {
     if (!ok) throw std::invalid_argument(std::string("map optimiser option ") + field + ": " + what);
   };
@@ -91,9 +106,6 @@ void validate(const MapOptimizerOptions& o) {
   require(std::isfinite(o.bearing_sigma_rad) && o.bearing_sigma_rad > 0.0, "bearing_sigma_rad", "must be > 0");
   require(std::isfinite(o.min_range_m) && o.min_range_m >= 0.0, "min_range_m", "must be >= 0");
   require(std::isfinite(o.max_range_m) && o.max_range_m > o.min_range_m, "max_range_m", "must be > min_range_m");
-  require(std::isfinite(o.keyframe_interval_s) && o.keyframe_interval_s > 0.0, "keyframe_interval_s", "must be > 0");
-  require(std::isfinite(o.huber_threshold) && o.huber_threshold > 0.0, "huber_threshold", "must be > 0");
-  require(o.max_iterations >= 1, "max_iterations", "must be >= 1");
   require(std::isfinite(o.function_tolerance) && o.function_tolerance > 0.0, "function_tolerance", "must be > 0");
 }
 

@@ -1,11 +1,30 @@
 #include <cmath>
 
 #include "pixyslam/app/command_line.h"
+#include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/map_optimizer_node/optimizer_node.h"
 #include "pixyslam/slam_node/estimator_options.h"
 
 namespace pixyslam::map_optimizer_node {
+
+const parameters::Table<OptimizerNodeOptions>& optimizer_node_parameters() {
+  using O = OptimizerNodeOptions;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::integer<O, std::size_t>("window_keyframes", 1, 1000000, "", "the newest keyframes a window solve frees",
+                                 [](O& o) -> std::size_t& { return o.schedule.window_keyframes; }),
+      P::real<O>("window_period_s", 0.01, 3600.0, "s", "data time between window solves",
+                 [](O& o) -> double& { return o.schedule.window_period_s; }),
+      P::real<O>("whole_period_s", 0.01, 86400.0, "s", "data time between whole-problem solves",
+                 [](O& o) -> double& { return o.schedule.whole_period_s; }),
+      P::integer<O, int>("published_keyframes", 2, 8192, "", "OptimisedMap keyframes at most",
+                         [](O& o) -> int& { return o.published_keyframes; }),
+      P::real<O>("status_period_s", 0.0, 3600.0, "s", "counters to the log every so often (0: never)",
+                 [](O& o) -> double& { return o.status_period_s; }),
+  };
+  return table;
+}
 
 OptimizerNodeOptions read_optimizer_node_options_file(const std::string& path) {
   config::YamlReader root = config::YamlReader::from_file(path);
@@ -20,16 +39,8 @@ OptimizerNodeOptions read_optimizer_node_options_file(const std::string& path) {
   o.use_detection_sigmas = estimator.use_detection_sigmas;
 
   config::YamlReader y = root.child("optimizer");
-  map_optimizer::MapOptimizerOptions& m = o.optimizer;
-  m.keyframe_interval_s = y.number("keyframe_interval_s", 0.01, 3600.0, m.keyframe_interval_s);
-  m.huber_threshold = y.number("huber_threshold", 1e-3, 1e6, m.huber_threshold);
-  m.max_iterations = static_cast<int>(y.integer("max_iterations", 1, 10000, m.max_iterations));
-  o.schedule.window_keyframes = static_cast<std::size_t>(
-      y.integer("window_keyframes", 1, 1000000, static_cast<std::int64_t>(o.schedule.window_keyframes)));
-  o.schedule.window_period_s = y.number("window_period_s", 0.01, 3600.0, o.schedule.window_period_s);
-  o.schedule.whole_period_s = y.number("whole_period_s", 0.01, 86400.0, o.schedule.whole_period_s);
-  o.published_keyframes = static_cast<int>(y.integer("published_keyframes", 2, 8192, o.published_keyframes));
-  o.status_period_s = y.number("status_period_s", 0.0, 3600.0, o.status_period_s);
+  config::read_parameters(y, map_optimizer::map_optimizer_parameters(), o.optimizer);
+  config::read_parameters(y, optimizer_node_parameters(), o);
   y.finish();
   map_optimizer::validate(o.optimizer);
 

@@ -9,29 +9,36 @@ namespace {
 
 constexpr std::uint64_t kWindowNs = 1000000000ull;  // rates are measured over 1 s of frame time
 
-void require_in(double value, double min, double max, const char* what) {
-  if (!(value >= min && value <= max)) {  // also NaN
-    char text[160];
-    std::snprintf(text, sizeof text, "%s must be in [%g, %g] (is %g)", what, min, max, value);
-    throw std::invalid_argument(text);
-  }
-}
-
 std::uint64_t to_ns(double seconds) { return static_cast<std::uint64_t>(std::llround(seconds * 1e9)); }
 
 }  // namespace
 
+const parameters::Table<FrameRateOptions>& frame_rate_parameters() {
+  using O = FrameRateOptions;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::real<O>("frame_rate_hz", 0.1, 1000.0, "Hz", "the camera's frame rate: the most frames without blocks per second",
+                 [](O& o) -> double& { return o.frame_rate_hz; }),
+      P::real<O>("max_frame_rate_hz", 0.1, 10000.0, "Hz", "the most frames per second (default 1.2 * frame_rate_hz)",
+                 [](O& o) -> double& { return o.max_frame_rate_hz; }),
+      P::real<O>("frame_rate_tolerance_s", 0.0, 10.0, "s", "how early (bunched up) a frame may come and still pass",
+                 [](O& o) -> double& { return o.tolerance_s; }),
+  };
+  return table;
+}
+
 void validate(const FrameRateOptions& o) {
-  require_in(o.frame_rate_hz, 0.1, 1000.0, "frame_rate_hz");
+  parameters::check_ranges(o, frame_rate_parameters(), "pixy");
   if (!(o.max_frame_rate_hz >= o.frame_rate_hz)) {
-    char text[160];
-    std::snprintf(text, sizeof text, "max_frame_rate_hz must be >= frame_rate_hz (%g; is %g)", o.frame_rate_hz,
-                  o.max_frame_rate_hz);
-    throw std::invalid_argument(text);
+    throw parameters::RuleError("pixy", "max_frame_rate_hz",
+                                "value " + parameters::number_text(o.max_frame_rate_hz) + " is below frame_rate_hz (" +
+                                    parameters::number_text(o.frame_rate_hz) +
+                                    "): frames without blocks may come at the camera's rate");
   }
-  require_in(o.max_frame_rate_hz, 0.1, 10000.0, "max_frame_rate_hz");
-  require_in(o.tolerance_s, 0.0, 10.0, "tolerance_s");
-  require_in(o.warn_period_s, 0.1, 3600.0, "warn_period_s");
+  if (!(o.warn_period_s >= 0.1 && o.warn_period_s <= 3600.0)) {
+    throw std::invalid_argument("warn_period_s = " + parameters::number_text(o.warn_period_s) +
+                                ": must be in [0.1, 3600] s");
+  }
 }
 
 std::string FrameRateWarning::text() const {

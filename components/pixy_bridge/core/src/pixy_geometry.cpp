@@ -9,30 +9,47 @@ namespace {
 
 constexpr int kMaxTags = 5;
 
-void require(bool ok, const char* what) {
-  if (!ok) throw std::invalid_argument(std::string("CameraModel: ") + what);
-}
-
 }  // namespace
 
+const parameters::Table<CameraModel>& camera_parameters() {
+  using O = CameraModel;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::real<O>("focal_length_mm", 0.1, 100.0, "mm", "f, the lens's focal length",
+                 [](O& o) -> double& { return o.focal_length_mm; }),
+      P::real<O>("sensor_height_mm", 0.1, 100.0, "mm", "S_h, the sensor's height",
+                 [](O& o) -> double& { return o.sensor_height_mm; }),
+      P::real<O>("sensor_width_mm", 0.1, 100.0, "mm", "S_w, the sensor's width (default: square pixels)",
+                 [](O& o) -> double& { return o.sensor_width_mm; }),
+      P::integer<O, int>("image_width_px", 1, 10000, "px", "I_w", [](O& o) -> int& { return o.image_width_px; }),
+      P::integer<O, int>("image_height_px", 1, 10000, "px", "I_h", [](O& o) -> int& { return o.image_height_px; }),
+      P::required(P::real<O>("landmark_height_m", 1e-3, 100.0, "m", "h_r, the poles' height",
+                             [](O& o) -> double& { return o.landmark_height_m; })),
+      P::real<O>("min_height_to_width", 0.01, 100.0, "", "smallest block height/width ratio accepted",
+                 [](O& o) -> double& { return o.min_height_to_width; }),
+      P::real<O>("max_height_to_width", 0.01, 100.0, "", "largest block height/width ratio accepted (>= min)",
+                 [](O& o) -> double& { return o.max_height_to_width; }),
+      P::integer<O, int>("aspect_tolerance_px", 0, 10, "px", "pixels of rounding the ratio check forgives",
+                         [](O& o) -> int& { return o.aspect_tolerance_px; }),
+      P::real<O>("range_sigma_fraction", 1e-6, 1.0, "", "range sd as a fraction of the range",
+                 [](O& o) -> double& { return o.range_sigma_fraction; }),
+      P::real<O>("bearing_sigma_rad", 1e-6, 1.0, "rad", "bearing sd", [](O& o) -> double& { return o.bearing_sigma_rad; }),
+      P::real<O>("range_sigma_floor_m", 0.0, 10.0, "m", "range sd floor",
+                 [](O& o) -> double& { return o.range_sigma_floor_m; }),
+      P::real<O>("block_height_sigma_px", 0.0, 100.0, "px", "block height error, through Eq. 5 into the range sd",
+                 [](O& o) -> double& { return o.block_height_sigma_px; }),
+  };
+  return table;
+}
+
 void validate(const CameraModel& c) {
-  require(std::isfinite(c.focal_length_mm) && c.focal_length_mm > 0.0, "focal_length_mm must be > 0");
-  require(std::isfinite(c.sensor_width_mm) && c.sensor_width_mm > 0.0, "sensor_width_mm must be > 0");
-  require(std::isfinite(c.sensor_height_mm) && c.sensor_height_mm > 0.0, "sensor_height_mm must be > 0");
-  require(c.image_width_px > 0, "image_width_px must be > 0");
-  require(c.image_height_px > 0, "image_height_px must be > 0");
-  require(std::isfinite(c.landmark_height_m) && c.landmark_height_m > 0.0, "landmark_height_m must be > 0");
-  require(std::isfinite(c.min_height_to_width) && c.min_height_to_width > 0.0,
-          "min_height_to_width must be > 0");
-  require(std::isfinite(c.max_height_to_width) && c.max_height_to_width >= c.min_height_to_width,
-          "max_height_to_width must be >= min_height_to_width");
-  require(c.aspect_tolerance_px >= 0 && c.aspect_tolerance_px <= 10, "aspect_tolerance_px must be in [0, 10]");
-  require(std::isfinite(c.range_sigma_fraction) && c.range_sigma_fraction > 0.0,
-          "range_sigma_fraction must be > 0");
-  require(std::isfinite(c.bearing_sigma_rad) && c.bearing_sigma_rad > 0.0, "bearing_sigma_rad must be > 0");
-  require(std::isfinite(c.range_sigma_floor_m) && c.range_sigma_floor_m >= 0.0, "range_sigma_floor_m must be >= 0");
-  require(std::isfinite(c.block_height_sigma_px) && c.block_height_sigma_px >= 0.0,
-          "block_height_sigma_px must be >= 0");
+  parameters::check_ranges(c, camera_parameters(), "pixy");
+  if (!(c.max_height_to_width >= c.min_height_to_width)) {
+    throw parameters::RuleError("pixy", "max_height_to_width",
+                                "value " + parameters::number_text(c.max_height_to_width) +
+                                    " must be >= min_height_to_width (" + parameters::number_text(c.min_height_to_width) +
+                                    ")");
+  }
 }
 
 double range_sigma_m(const CameraModel& c, double range, double block_height_px) {

@@ -61,7 +61,6 @@ PixyNodeOptions read_pixy_node_options_file(const std::string& path, const Camer
 
 std::string to_yaml(const PixyNodeOptions& o) {
   using bridge::yaml_number;
-  const pixy::CameraModel& c = o.pixy.camera;
   std::ostringstream os;
   os << "node:\n"
      << "  serial_device: " << bridge::yaml_quoted(o.serial_device) << "\n"
@@ -69,23 +68,8 @@ std::string to_yaml(const PixyNodeOptions& o) {
      << "  camera_latency_s: " << yaml_number(o.camera_latency_s) << "\n"
      << "  frame_timeout_s: " << yaml_number(o.frame_timeout_s) << "\n"
      << bridge::to_yaml_lines(o.process)
-     << "pixy:\n"
-     << "  focal_length_mm: " << yaml_number(c.focal_length_mm) << "\n"
-     << "  sensor_height_mm: " << yaml_number(c.sensor_height_mm) << "\n"
-     << "  sensor_width_mm: " << yaml_number(c.sensor_width_mm) << "\n"
-     << "  image_width_px: " << c.image_width_px << "\n"
-     << "  image_height_px: " << c.image_height_px << "\n"
-     << "  landmark_height_m: " << yaml_number(c.landmark_height_m) << "\n"
-     << "  min_height_to_width: " << yaml_number(c.min_height_to_width) << "\n"
-     << "  max_height_to_width: " << yaml_number(c.max_height_to_width) << "\n"
-     << "  aspect_tolerance_px: " << c.aspect_tolerance_px << "\n"
-     << "  range_sigma_fraction: " << yaml_number(c.range_sigma_fraction) << "\n"
-     << "  range_sigma_floor_m: " << yaml_number(c.range_sigma_floor_m) << "\n"
-     << "  block_height_sigma_px: " << yaml_number(c.block_height_sigma_px) << "\n"
-     << "  bearing_sigma_rad: " << yaml_number(c.bearing_sigma_rad) << "\n"
-     << "  frame_rate_hz: " << yaml_number(o.pixy.rate.frame_rate_hz) << "\n"
-     << "  max_frame_rate_hz: " << yaml_number(o.pixy.rate.max_frame_rate_hz) << "\n"
-     << "  frame_rate_tolerance_s: " << yaml_number(o.pixy.rate.tolerance_s) << "\n"
+     << parameters::to_yaml(o.pixy.camera, pixy::camera_parameters(), "pixy")
+     << parameters::to_yaml(o.pixy.rate, pixy::frame_rate_parameters(), "pixy").substr(6)  // the same mapping
      << "  landmarks:" << (o.pixy.signatures.size() == 0 ? " {}" : "") << "\n";
   for (const auto& [signature, id] : o.pixy.signatures.entries()) {
     os << "    \"" << pixy::signature_tags(signature) << "\": " << id << "\n";

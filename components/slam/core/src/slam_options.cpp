@@ -106,22 +106,20 @@ const parameters::Table<FilterOptions>& filter_parameters() {
 void validate(const FilterOptions& o) {
   parameters::check_ranges(o, filter_parameters(), "filter");
   // Rules between parameters.
-  const auto require = [](bool ok, const std::string& what) {
-    if (!ok) throw std::invalid_argument(what);
+  const auto require = [](bool ok, const std::string& path, double value, const std::string& why) {
+    if (!ok) throw parameters::RuleError("filter", path, "value " + parameters::number_text(value) + " " + why);
   };
-  require(o.max_range_m > o.min_range_m, "filter.observation.max_range_m = " + parameters::number_text(o.max_range_m) +
-                                             ": must be greater than min_range_m (" +
-                                             parameters::number_text(o.min_range_m) + ")");
-  require(o.error_correlation_s == 0.0 || o.association == Association::kKnownId,
-          "filter.observation.error_correlation_s = " + parameters::number_text(o.error_correlation_s) +
-              ": needs association known_id (a landmark's last sighting is tracked by its id)");
+  require(o.max_range_m > o.min_range_m, "observation.max_range_m", o.max_range_m,
+          "must be greater than min_range_m (" + parameters::number_text(o.min_range_m) + ")");
+  require(o.error_correlation_s == 0.0 || o.association == Association::kKnownId, "observation.error_correlation_s",
+          o.error_correlation_s, "needs association known_id (a landmark's last sighting is tracked by its id)");
   const DelayedSamplingOptions& d = o.delayed_sampling;
-  require(d.exit_heading_sigma_rad <= d.enter_heading_sigma_rad,
-          "filter.delayed_sampling.exit_heading_sigma_rad = " + parameters::number_text(d.exit_heading_sigma_rad) +
-              ": must be <= enter_heading_sigma_rad (" + parameters::number_text(d.enter_heading_sigma_rad) + ")");
-  require(d.exit_position_sigma_m <= d.enter_position_sigma_m,
-          "filter.delayed_sampling.exit_position_sigma_m = " + parameters::number_text(d.exit_position_sigma_m) +
-              ": must be <= enter_position_sigma_m (" + parameters::number_text(d.enter_position_sigma_m) + ")");
+  require(d.exit_heading_sigma_rad <= d.enter_heading_sigma_rad, "delayed_sampling.exit_heading_sigma_rad",
+          d.exit_heading_sigma_rad,
+          "must be <= enter_heading_sigma_rad (" + parameters::number_text(d.enter_heading_sigma_rad) + ")");
+  require(d.exit_position_sigma_m <= d.enter_position_sigma_m, "delayed_sampling.exit_position_sigma_m",
+          d.exit_position_sigma_m,
+          "must be <= enter_position_sigma_m (" + parameters::number_text(d.enter_position_sigma_m) + ")");
 }
 
 void apply_overrides(FilterOptions& options, const std::vector<std::string>& assignments) {

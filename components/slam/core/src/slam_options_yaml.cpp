@@ -10,11 +10,7 @@ FilterOptions read_filter_options(config::YamlReader& f) {
   FilterOptions o;
   config::read_parameters(f, filter_parameters(), o);
   f.finish();
-  try {
-    validate(o);
-  } catch (const std::invalid_argument& e) {
-    throw config::ConfigError(f.origin() + ": " + e.what());
-  }
+  config::check_rules(f, [&] { validate(o); });
   return o;
 }
 

@@ -3,10 +3,75 @@
 #include <cmath>
 
 #include "pixyslam/app/command_line.h"
+#include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/slam/slam_options_yaml.h"
 
 namespace pixyslam::slam_node {
+
+const parameters::Table<EstimatorOptions>& estimator_parameters() {
+  using O = EstimatorOptions;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::real<O>("initial_pose.x_m", -1e6, 1e6, "m", "start pose x (the map frame's origin)",
+                 [](O& o) -> double& { return o.initial_pose.x(); }),
+      P::real<O>("initial_pose.y_m", -1e6, 1e6, "m", "start pose y", [](O& o) -> double& { return o.initial_pose.y(); }),
+      P::real<O>("initial_pose.theta_rad", -2.0 * M_PI, 2.0 * M_PI, "rad", "start heading",
+                 [](O& o) -> double& { return o.initial_pose.z(); }),
+      P::real<O>("odometry_max_delay_s", 0.0, 10.0, "s", "how long odometry may lag behind the newest input",
+                 [](O& o) -> double& { return o.queue.odometry_max_delay_s; }),
+      P::real<O>("observation_max_delay_s", 0.0, 10.0, "s", "how long observations may lag behind the newest input",
+                 [](O& o) -> double& { return o.queue.observation_max_delay_s; }),
+      P::boolean<O>("use_detection_sigmas", "the camera's per-detection sigmas (else the filter's)",
+                    [](O& o) -> bool& { return o.use_detection_sigmas; }),
+      P::integer<O, int>("published_particle_poses", 0, 512, "", "particle poses in each MapState (a subsample)",
+                         [](O& o) -> int& { return o.published_particle_poses; }),
+      P::choice<O, std::string>("landmarks", {{"best", "best"}, {"mixture", "mixture"}},
+                                "MapState landmarks: the best particle's, or the mixture over particles",
+                                [](O& o) -> std::string& { return o.landmarks; }),
+      P::real<O>("status_period_s", 0.0, 3600.0, "s", "counters to the log every so often (0: never)",
+                 [](O& o) -> double& { return o.status_period_s; }),
+      P::text<O>("checkpoint.file", "pose and map saved here every period (relative: to the config's folder; '': none)",
+                 [](O& o) -> std::string& { return o.checkpoint.file; }),
+      P::real<O>("checkpoint.period_s", 0.01, 3600.0, "s", "filter time between writes",
+                 [](O& o) -> double& { return o.checkpoint.period_s; }),
+      P::boolean<O>("checkpoint.resume", "start from the file when it is fresh enough",
+                    [](O& o) -> bool& { return o.checkpoint.resume; }),
+      P::real<O>("checkpoint.max_age_s", 0.0, 1e9, "s", "older than this at the first input: start from scratch",
+                 [](O& o) -> double& { return o.checkpoint.max_age_s; }),
+      P::real<O>("checkpoint.max_speed_mps", 0.0, 100.0, "m/s", "how fast the robot may have moved while no estimator ran",
+                 [](O& o) -> double& { return o.checkpoint.max_speed_mps; }),
+      P::real<O>("checkpoint.max_turn_rate_radps", 0.0, 100.0, "rad/s", "how fast it may have turned",
+                 [](O& o) -> double& { return o.checkpoint.max_turn_rate_radps; }),
+  };
+  return table;
+}
+
+void apply_overrides(EstimatorOptions& o, const std::vector<std::string>& assignments) {
+  std::vector<std::string> filter, dds;
+  for (const std::string& a : assignments) {
+    if (a.rfind("filter.", 0) == 0) {
+      filter.push_back(a);
+    } else if (a.rfind("dds.", 0) == 0) {
+      dds.push_back(a);
+    } else if (a.rfind("estimator.", 0) == 0) {
+      parameters::apply_override(o, estimator_parameters(), "estimator", a);
+    } else {
+      throw std::invalid_argument("'" + a + "': not a filter., estimator. or dds. parameter");
+    }
+  }
+  slam::apply_overrides(o.filter, filter);
+  dds::resolve_settings(o.dds, dds);
+}
+
+std::string help_text() {
+  const EstimatorOptions defaults;
+  return "filter parameters (the config's filter: section):\n" +
+         parameters::help_text(slam::filter_parameters(), "filter") +
+         "estimator parameters (estimator:):\n" + parameters::help_text(estimator_parameters(), "estimator") +
+         "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
+         parameters::help_text(dds::dds_parameters(), "dds");
+}
 
 EstimatorOptions read_estimator_options_file(const std::string& path) {
   config::YamlReader root = config::YamlReader::from_file(path);
@@ -15,34 +80,9 @@ EstimatorOptions read_estimator_options_file(const std::string& path) {
   o.filter = slam::read_filter_options(filter);
 
   config::YamlReader estimator = root.child("estimator");
-  if (estimator.has("initial_pose")) {
-    config::YamlReader pose = estimator.child("initial_pose");
-    o.initial_pose.x() = pose.number("x_m", -1e6, 1e6, 0.0);
-    o.initial_pose.y() = pose.number("y_m", -1e6, 1e6, 0.0);
-    o.initial_pose.z() = pose.number("theta_rad", -2.0 * M_PI, 2.0 * M_PI, 0.0);
-    pose.finish();
-  }
-  o.queue.odometry_max_delay_s =
-      estimator.number("odometry_max_delay_s", 0.0, 10.0, o.queue.odometry_max_delay_s);
-  o.queue.observation_max_delay_s =
-      estimator.number("observation_max_delay_s", 0.0, 10.0, o.queue.observation_max_delay_s);
-  o.use_detection_sigmas = estimator.boolean("use_detection_sigmas", o.use_detection_sigmas);
-  o.published_particle_poses = static_cast<int>(
-      estimator.integer("published_particle_poses", 0, 512, o.published_particle_poses));
-  o.landmarks = estimator.choice("landmarks", {"best", "mixture"}, o.landmarks);
-  o.status_period_s = estimator.number("status_period_s", 0.0, 3600.0, o.status_period_s);
-  if (estimator.has("checkpoint")) {
-    config::YamlReader c = estimator.child("checkpoint");
-    CheckpointOptions& k = o.checkpoint;
-    k.file = c.text("file", k.file);
-    if (!k.file.empty() && k.file.front() != '/') k.file = app::folder_of(path) + "/" + k.file;
-    k.period_s = c.number("period_s", 0.01, 3600.0, k.period_s);
-    k.resume = c.boolean("resume", k.resume);
-    k.max_age_s = c.number("max_age_s", 0.0, 1e9, k.max_age_s);
-    k.max_speed_mps = c.number("max_speed_mps", 0.0, 100.0, k.max_speed_mps);
-    k.max_turn_rate_radps = c.number("max_turn_rate_radps", 0.0, 100.0, k.max_turn_rate_radps);
-    c.finish();
-  }
+  config::read_parameters(estimator, estimator_parameters(), o);
+  CheckpointOptions& k = o.checkpoint;
+  if (!k.file.empty() && k.file.front() != '/') k.file = app::folder_of(path) + "/" + k.file;
   estimator.finish();
 
   if (root.has("dds")) {

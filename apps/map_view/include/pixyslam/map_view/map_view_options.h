@@ -27,6 +27,9 @@ struct MapViewOptions {
   dds::DdsOptions dds;  // `dds:` (live only)
 };
 
+// The viewer's own `map_view:` keys (the drawing's: render_parameters()).
+const parameters::Table<MapViewOptions>& map_view_parameters();
+
 // Reads `map_view:` and `dds:` (both optional) from the top level and calls
 // root.finish(). `config_dir` resolves a relative dds.profiles_file; without
 // a `dds:` mapping, dds.profiles_file is `default_profiles_file`. Throws

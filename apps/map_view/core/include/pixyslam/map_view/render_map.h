@@ -4,6 +4,7 @@
 
 #include <opencv2/core/mat.hpp>
 
+#include "pixyslam/parameters/parameters.h"
 #include "pixyslam/map_view/map_view_state.h"
 #include "pixyslam/map_view/view_transform.h"
 
@@ -46,8 +47,11 @@ struct RenderOptions {
 // Smallest image render_map accepts (the map area, footer not counted).
 inline constexpr int kMinMapSidePx = 64;
 
-// Throws std::invalid_argument naming the bad field (size, footer, margin,
-// min_span_m, sigma_scale).
+// The `map_view:` keys of the drawing: range, unit, default, help.
+const parameters::Table<RenderOptions>& render_parameters();
+
+// Throws std::invalid_argument naming the bad field (a range of
+// render_parameters(), a footer leaving too little map, the margin).
 void validate(const RenderOptions& options);
 
 // The rectangle of the image that shows the map (the image minus the footer).

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/parameters/parameters.h"
 
 namespace pixyslam::robot_sim {
 
@@ -71,6 +72,9 @@ struct HardwareOptions {
   // where the path's command switches).
   double physics_step_s = 0.001;
 };
+
+// One declaration per key of `hardware:`: range, unit, default, help.
+const parameters::Table<HardwareOptions>& hardware_parameters();
 
 // Throws std::invalid_argument naming the first field out of its range.
 void validate(const HardwareOptions& options);

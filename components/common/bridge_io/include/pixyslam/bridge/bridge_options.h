@@ -25,7 +25,8 @@ DeviceReaderOptions device_reader_options(const BridgeProcessOptions& options);
 
 // The bridges' command-line overrides of what args.get("config") set:
 // --device PATH replaces `serial_device` (std::invalid_argument unless it is an
-// absolute path), --dds-config FILE replaces dds.profiles_file. The profiles
+// absolute path), --dds-config FILE replaces dds.profiles_file; the DDS
+// settings resolved (dds::resolve_settings: the environment). The profiles
 // file must be readable: config::ConfigError naming --dds-config or the config
 // file's key dds.profiles_file otherwise.
 void apply_command_line(const app::CommandLine& args, std::string& serial_device, dds::DdsOptions& dds);

@@ -2,7 +2,8 @@
 
 // Reading an options struct's YAML section with its parameter table
 // (pixyslam/parameters/parameters.h): every key read with the table's range,
-// nested mappings by the paths' prefixes, unknown keys refused (finish()).
+// nested mappings by the paths' prefixes, unknown keys refused (finish()),
+// required keys demanded.
 #include <string>
 #include <vector>
 
@@ -29,6 +30,7 @@ void read_parameters(YamlReader& section, const parameters::Table<Options>& tabl
       if (!seen) groups.push_back(group);
       continue;
     }
+    if (p.required && !section.has(key)) section.fail(key, "missing (required: " + p.help + ")");
     switch (p.kind) {
       case parameters::Kind::kReal: p.set(o, section.number(key, p.min, p.max, p.get(o))); break;
       case parameters::Kind::kInteger:
@@ -38,6 +40,25 @@ void read_parameters(YamlReader& section, const parameters::Table<Options>& tabl
         break;
       case parameters::Kind::kBoolean: p.set(o, section.boolean(key, p.get(o) != 0.0) ? 1.0 : 0.0); break;
       case parameters::Kind::kChoice: p.set_choice(o, section.choice(key, p.choices, p.get_choice(o))); break;
+      case parameters::Kind::kText:
+      case parameters::Kind::kList:
+        if (!section.has(key)) break;
+        if (p.kind == parameters::Kind::kText) {
+          p.set_choice(o, section.text(key));
+        } else {
+          std::string joined;
+          for (const std::string& item : section.text_list(key)) {
+            if (item.find(',') != std::string::npos) section.fail(key, "'" + item + "' contains a comma");
+            joined += (joined.empty() ? "" : ",") + item;
+          }
+          p.set_choice(o, joined);
+        }
+        try {
+          parameters::check_text(p, o);
+        } catch (const std::invalid_argument& e) {
+          section.fail(key, "value " + parameters::value_text(p, o) + " is " + e.what());
+        }
+        break;
     }
   }
   for (const std::string& group : groups) {
@@ -45,6 +66,20 @@ void read_parameters(YamlReader& section, const parameters::Table<Options>& tabl
     YamlReader child = section.child(group);
     read_parameters(child, table, o, prefix + group + ".");
     child.finish();
+  }
+}
+
+// Runs `validate` (the rules between a section's keys): a
+// parameters::RuleError becomes the error on its key, any other
+// std::invalid_argument an error on the section. Throws ConfigError.
+template <class Validate>
+void check_rules(const YamlReader& section, const Validate& validate) {
+  try {
+    validate();
+  } catch (const parameters::RuleError& e) {
+    section.fail(e.path(), e.reason());
+  } catch (const std::invalid_argument& e) {
+    section.check_mapping([&] { throw e; });
   }
 }
 

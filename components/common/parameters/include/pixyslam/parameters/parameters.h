@@ -19,7 +19,22 @@
 
 namespace pixyslam::parameters {
 
-enum class Kind { kReal, kInteger, kBoolean, kChoice };
+// A value a range or a rule between parameters refuses, naming the parameter
+// to blame: `path` below `section`, `reason` as "value V is ...". what() is
+// "<section>.<path>: <reason>"; a YAML reader reports it on the key.
+class RuleError : public std::invalid_argument {
+ public:
+  RuleError(const std::string& section, std::string path, std::string reason)
+      : std::invalid_argument(section + "." + path + ": " + reason), path_(std::move(path)), reason_(std::move(reason)) {}
+  const std::string& path() const { return path_; }
+  const std::string& reason() const { return reason_; }
+
+ private:
+  std::string path_;
+  std::string reason_;
+};
+
+enum class Kind { kReal, kInteger, kBoolean, kChoice, kText, kList };
 
 template <class Options>
 struct Parameter {
@@ -32,8 +47,13 @@ struct Parameter {
   // The member, as a number (kReal, kInteger, kBoolean: 0 / 1) or a choice's name.
   std::function<double(const Options&)> get;
   std::function<void(Options&, double)> set;
+  // kChoice, kText: the text; kList: the items joined by ','.
   std::function<std::string(const Options&)> get_choice;
   std::function<void(Options&, const std::string&)> set_choice;
+  // kText, kList: throws std::invalid_argument saying why a value (each item
+  // of a list) is not allowed; empty: any text.
+  std::function<void(const std::string&)> check;
+  bool required = false;  // the YAML must give it (required())
 };
 
 template <class Options>
@@ -44,7 +64,7 @@ using Table = std::vector<Parameter<Options>>;
 template <class Options>
 Parameter<Options> real(std::string path, double min, double max, std::string unit, std::string help,
                         std::function<double&(Options&)> member) {
-  Parameter<Options> p{std::move(path), Kind::kReal, min, max, {}, std::move(unit), std::move(help), {}, {}, {}, {}};
+  Parameter<Options> p{std::move(path), Kind::kReal, min, max, {}, std::move(unit), std::move(help), {}, {}, {}, {}, {}, false};
   p.get = [member](const Options& o) { return member(const_cast<Options&>(o)); };
   p.set = [member](Options& o, double v) { member(o) = v; };
   return p;
@@ -55,7 +75,7 @@ template <class Options, class Int>
 Parameter<Options> integer(std::string path, Int min, Int max, std::string unit, std::string help,
                            std::function<Int&(Options&)> member) {
   Parameter<Options> p{std::move(path), Kind::kInteger, static_cast<double>(min), static_cast<double>(max), {},
-                       std::move(unit), std::move(help), {}, {}, {}, {}};
+                       std::move(unit), std::move(help), {}, {}, {}, {}, {}, false};
   p.get = [member](const Options& o) { return static_cast<double>(member(const_cast<Options&>(o))); };
   p.set = [member](Options& o, double v) { member(o) = static_cast<Int>(v); };
   return p;
@@ -63,7 +83,7 @@ Parameter<Options> integer(std::string path, Int min, Int max, std::string unit,
 
 template <class Options>
 Parameter<Options> boolean(std::string path, std::string help, std::function<bool&(Options&)> member) {
-  Parameter<Options> p{std::move(path), Kind::kBoolean, 0.0, 1.0, {}, "", std::move(help), {}, {}, {}, {}};
+  Parameter<Options> p{std::move(path), Kind::kBoolean, 0.0, 1.0, {}, "", std::move(help), {}, {}, {}, {}, {}, false};
   p.get = [member](const Options& o) { return member(const_cast<Options&>(o)) ? 1.0 : 0.0; };
   p.set = [member](Options& o, double v) { member(o) = v != 0.0; };
   return p;
@@ -73,7 +93,7 @@ Parameter<Options> boolean(std::string path, std::string help, std::function<boo
 template <class Options, class Enum>
 Parameter<Options> choice(std::string path, std::vector<std::pair<std::string, Enum>> names, std::string help,
                           std::function<Enum&(Options&)> member) {
-  Parameter<Options> p{std::move(path), Kind::kChoice, 0.0, 0.0, {}, "", std::move(help), {}, {}, {}, {}};
+  Parameter<Options> p{std::move(path), Kind::kChoice, 0.0, 0.0, {}, "", std::move(help), {}, {}, {}, {}, {}, false};
   for (const auto& n : names) p.choices.push_back(n.first);
   p.get_choice = [member, names](const Options& o) {
     for (const auto& n : names) {
@@ -90,6 +110,50 @@ Parameter<Options> choice(std::string path, std::vector<std::pair<std::string, E
     }
     throw std::invalid_argument("not one of the choices");
   };
+  return p;
+}
+
+// Free text (a name, a file); `check` (may be empty) refuses bad values.
+template <class Options>
+Parameter<Options> text(std::string path, std::string help, std::function<std::string&(Options&)> member,
+                        std::function<void(const std::string&)> check = {}) {
+  Parameter<Options> p{std::move(path), Kind::kText, 0.0, 0.0, {}, "", std::move(help), {}, {}, {}, {}, std::move(check), false};
+  p.get_choice = [member](const Options& o) { return member(const_cast<Options&>(o)); };
+  p.set_choice = [member](Options& o, const std::string& v) { member(o) = v; };
+  return p;
+}
+
+// A list of texts: a YAML sequence, or comma-separated on a command line or
+// in the environment; `check` (may be empty) refuses a bad item.
+template <class Options>
+Parameter<Options> list(std::string path, std::string help, std::function<std::vector<std::string>&(Options&)> member,
+                        std::function<void(const std::string&)> check = {}) {
+  Parameter<Options> p{std::move(path), Kind::kList, 0.0, 0.0, {}, "", std::move(help), {}, {}, {}, {}, std::move(check), false};
+  p.get_choice = [member](const Options& o) {
+    std::string joined;
+    for (const std::string& item : member(const_cast<Options&>(o))) joined += (joined.empty() ? "" : ",") + item;
+    return joined;
+  };
+  p.set_choice = [member](Options& o, const std::string& v) {
+    std::vector<std::string>& out = member(o);
+    out.clear();
+    std::string rest = v;
+    while (!rest.empty()) {
+      const auto comma = rest.find(',');
+      std::string item = rest.substr(0, comma);
+      const auto first = item.find_first_not_of(" \t");
+      const auto last = item.find_last_not_of(" \t");
+      if (first != std::string::npos) out.push_back(item.substr(first, last - first + 1));
+      rest = comma == std::string::npos ? std::string() : rest.substr(comma + 1);
+    }
+  };
+  return p;
+}
+
+// The same parameter, to be given in every YAML file.
+template <class Options>
+Parameter<Options> required(Parameter<Options> p) {
+  p.required = true;
   return p;
 }
 
@@ -126,6 +190,8 @@ std::string range_text(const Parameter<Options>& p) {
     return list;
   }
   if (p.kind == Kind::kBoolean) return "true | false";
+  if (p.kind == Kind::kText) return "text";
+  if (p.kind == Kind::kList) return "list";
   return "[" + number_text(p.min) + ", " + number_text(p.max) + "]";
 }
 
@@ -134,21 +200,53 @@ template <class Options>
 std::string value_text(const Parameter<Options>& p, const Options& o) {
   switch (p.kind) {
     case Kind::kChoice: return p.get_choice(o);
+    case Kind::kText: {
+      std::string quoted = "'";  // YAML single quotes: a quote doubled
+      for (const char c : p.get_choice(o)) quoted += c == '\'' ? std::string("''") : std::string(1, c);
+      return quoted + "'";
+    }
+    case Kind::kList: return "[" + p.get_choice(o) + "]";
     case Kind::kBoolean: return p.get(o) != 0.0 ? "true" : "false";
     default: return number_text(p.get(o));
   }
 }
 
-// Every number within its range (and an integer's value whole); throws
-// std::invalid_argument "<section>.<path> = <value>: must be in [min, max] <unit>".
+// A kText / kList member through its check (each item of a list).
+template <class Options>
+void check_text(const Parameter<Options>& p, const Options& o) {
+  if (!p.check) return;
+  if (p.kind == Kind::kText) {
+    p.check(p.get_choice(o));
+    return;
+  }
+  const std::string joined = p.get_choice(o);
+  std::string rest = joined;
+  while (!rest.empty()) {
+    const auto comma = rest.find(',');
+    p.check(rest.substr(0, comma));
+    rest = comma == std::string::npos ? std::string() : rest.substr(comma + 1);
+  }
+}
+
+// Every number within its range, every text through its check; throws
+// RuleError "<section>.<path>: value V is out of range [min, max] <unit>"
+// (or "value 'T' is <the check's reason>").
 template <class Options>
 void check_ranges(const Options& o, const Table<Options>& table, const std::string& section) {
   for (const Parameter<Options>& p : table) {
+    if (p.kind == Kind::kText || p.kind == Kind::kList) {
+      try {
+        check_text(p, o);
+      } catch (const std::invalid_argument& e) {
+        throw RuleError(section, p.path, "value " + value_text(p, o) + " is " + e.what());
+      }
+      continue;
+    }
     if (p.kind != Kind::kReal && p.kind != Kind::kInteger) continue;
     const double v = p.get(o);
     if (std::isfinite(v) && v >= p.min && v <= p.max) continue;
-    throw std::invalid_argument(section + "." + p.path + " = " + number_text(v) + ": must be in " + range_text(p) +
-                                (p.unit.empty() ? "" : " " + p.unit));
+    throw RuleError(section, p.path,
+                    "value " + number_text(v) + " is out of range " + range_text(p) + (p.unit.empty() ? "" : " " + p.unit));
   }
 }
 
@@ -180,6 +278,20 @@ void set_from_text(Options& o, const Table<Options>& table, const std::string& s
         fail("not one of the choices");
       }
       return;
+    case Kind::kText:
+    case Kind::kList: {
+      Options trial = o;
+      p->set_choice(trial, text);
+      if (p->check) {
+        try {
+          check_text(*p, trial);
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument(name + " = '" + text + "': " + e.what());
+        }
+      }
+      o = std::move(trial);
+      return;
+    }
     case Kind::kBoolean:
       if (text != "true" && text != "false") fail("not true or false");
       p->set(o, text == "true" ? 1.0 : 0.0);
@@ -243,7 +355,8 @@ std::string help_text(const Table<Options>& table, const std::string& section, c
   std::ostringstream os;
   for (const Parameter<Options>& p : table) {
     os << "  " << section << "." << p.path << "  " << range_text(p) << (p.unit.empty() ? "" : " " + p.unit)
-       << ", default " << value_text(p, defaults) << "\n      " << p.help << "\n";
+       << (p.required ? std::string(", required") : ", default " + value_text(p, defaults)) << "\n      " << p.help
+       << "\n";
   }
   return os.str();
 }

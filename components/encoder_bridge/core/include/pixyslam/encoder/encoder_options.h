@@ -3,6 +3,7 @@
 #include <string>
 
 #include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/parameters/parameters.h"
 
 namespace pixyslam::encoder {
 
@@ -26,6 +27,9 @@ struct EncoderOptions {
 
 // True for the rates Linux termios names (B50 ... B4000000).
 bool is_standard_baud(long baud);
+
+// One declaration per field: key, range, unit, help.
+const parameters::Table<EncoderOptions>& encoder_parameters();
 
 // Throws std::invalid_argument naming the first field out of its range.
 void validate(const EncoderOptions& options);

@@ -59,6 +59,12 @@ struct LoggerOptions {
 // True when rotate_size_bytes or rotate_period_s is set.
 bool rotation_enabled(const LoggerOptions& options);
 
+// The `logger:` keys but topics (patterns, read apart): range, unit, help.
+const parameters::Table<LoggerOptions>& logger_parameters();
+
+// Ranges and the rules between keys; throws std::invalid_argument naming the key.
+void validate(const LoggerOptions& options);
+
 // Reads `logger:` (required) and `dds:` (optional) from the top level and calls
 // root.finish(). `config_dir` resolves a relative dds.profiles_file. Throws
 // config::ConfigError naming the file and key path.

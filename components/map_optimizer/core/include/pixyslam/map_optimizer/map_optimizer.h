@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "pixyslam/parameters/parameters.h"
 #include "pixyslam/slam/motion_model.h"
 #include "pixyslam/slam/slam_options.h"
 #include "pixyslam/slam/types.h"
@@ -66,6 +67,10 @@ struct MapOptimizerOptions {
   // Motion and observation model exactly as the filter's.
   static MapOptimizerOptions from_filter(const slam::FilterOptions& filter);
 };
+// The optimiser's own keys (`optimizer:` of config/map_optimizer.yaml); the
+// models' values come from the filter's (from_filter).
+const parameters::Table<MapOptimizerOptions>& map_optimizer_parameters();
+
 // Throws std::invalid_argument naming the field.
 void validate(const MapOptimizerOptions& options);
 

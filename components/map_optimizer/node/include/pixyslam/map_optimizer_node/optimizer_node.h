@@ -33,6 +33,9 @@ struct OptimizerNodeOptions {
   dds::DdsOptions dds;
 };
 
+// The node's own `optimizer:` keys (beside map_optimizer_parameters()).
+const parameters::Table<OptimizerNodeOptions>& optimizer_node_parameters();
+
 // Reads the file: `filter_config` (the estimator's config, relative to this
 // file: its `filter:` noise and limits, `estimator.initial_pose`, delays and
 // detection sigmas, so both solve the same models), `optimizer:` and `dds:`.

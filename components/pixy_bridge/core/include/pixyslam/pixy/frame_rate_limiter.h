@@ -4,6 +4,8 @@
 #include <optional>
 #include <string>
 
+#include "pixyslam/parameters/parameters.h"
+
 namespace pixyslam::pixy {
 
 // How fast the pixy bridge publishes camera frames (`pixy:` keys of
@@ -24,6 +26,9 @@ struct FrameRateOptions {
   // A warning at most this often while frames are dropped.
   double warn_period_s = 5.0;
 };
+
+// The `pixy:` keys of the frame rates (warn_period_s is not a key).
+const parameters::Table<FrameRateOptions>& frame_rate_parameters();
 
 // Throws std::invalid_argument naming the first field out of its range:
 // frame_rate_hz in [0.1, 1000], max_frame_rate_hz in [frame_rate_hz, 10000],

@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include "pixyslam/parameters/parameters.h"
 #include "pixyslam/pixy/pixy_block_parser.h"
 
 namespace pixyslam::pixy {
@@ -42,7 +43,11 @@ struct CameraModel {
   double bearing_sigma_rad = 0.027;
 };
 
-// Throws std::invalid_argument naming the first field out of its range.
+// One declaration per field: its `pixy:` key, range, unit and help.
+const parameters::Table<CameraModel>& camera_parameters();
+
+// Throws std::invalid_argument naming the first field out of its range
+// (camera_parameters()) or max_height_to_width < min_height_to_width.
 void validate(const CameraModel& camera);
 
 // Range to a pole whose block is `block_height_px` tall, seed paper Eq. 5:

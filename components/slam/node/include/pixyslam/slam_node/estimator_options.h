@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "pixyslam/slam/sensor_queue.h"
 #include "pixyslam/slam/slam_options.h"
@@ -32,6 +33,17 @@ struct EstimatorOptions {
   CheckpointOptions checkpoint;          // `estimator.checkpoint`
   dds::DdsOptions dds;                   // `dds:`
 };
+
+// The `estimator:` keys: range, unit, default, help.
+const parameters::Table<EstimatorOptions>& estimator_parameters();
+
+// `--set` assignments "filter.KEY=V", "estimator.KEY=V", "dds.KEY=V" applied
+// and validated; the DDS settings resolved (the environment, then these: dds::resolve_settings).
+// Throws std::invalid_argument / config::ConfigError naming the assignment.
+void apply_overrides(EstimatorOptions& options, const std::vector<std::string>& assignments);
+
+// Every parameter of the three sections, for --help.
+std::string help_text();
 
 // Reads `filter:`, `estimator:` and `dds:` from one file; unknown keys, wrong
 // types and out-of-range values throw config::ConfigError naming file and key.
