@@ -39,7 +39,7 @@ if ((${#missing[@]})); then
 fi
 
 # The sysroot: the armhf -dev packages and everything they need, unpacked.
-packages=libfastrtps-dev,libfastcdr-dev,libyaml-cpp-dev,libeigen3-dev,libgtest-dev,libzstd-dev,liblz4-dev,libssl-dev
+packages=libfastrtps-dev,libfastcdr-dev,libyaml-cpp-dev,libcli11-dev,libeigen3-dev,libgtest-dev,libzstd-dev,liblz4-dev,libssl-dev
 extra_cmake=(-DPIXYSLAM_BUILD_BENCHMARKS=OFF -DPIXYSLAM_BUILD_MAP_OPTIMIZER=OFF)
 if ((map_optimizer)); then
   packages+=,libceres-dev,libbenchmark-dev

@@ -5,7 +5,7 @@ set -euo pipefail
 
 PACKAGES=(
   cmake g++ ninja-build pkg-config
-  libeigen3-dev libyaml-cpp-dev
+  libeigen3-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libbenchmark-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools default-jre-headless
   libzstd-dev liblz4-dev

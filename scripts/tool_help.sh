@@ -12,9 +12,12 @@ cat <<'TEXT'
 
 What each program prints for `--help` (exit 0, nothing started: ctest `help_all_executables` checks
 that for every executable of the build, and that an unknown flag exits 2). Exit codes everywhere:
-0 ok, 1 runtime failure, 2 usage or configuration error; `sim_evaluator` exits 3 when its check
-fails; the evaluations and benchmarks on the MRCLAM data set (`mrclam_eval`, `bench_mrclam_frame`,
+0 ok, 1 runtime failure (for `sim_evaluator`: its check failed), 2 usage or configuration error;
+the evaluations and benchmarks on the MRCLAM data set (`mrclam_eval`, `bench_mrclam_frame`,
 `bench_map_optimizer`) exit 77 when it is absent (skipped), `slam_offline mrclam` 1.
+Flags mean the same everywhere: `--config FILE` (the process's YAML; for the inspection tools one
+with a `dds:` mapping), `--domain N`, `--set KEY=VALUE` (a parameter of the config, listed under
+`--help`), `--out FILE`, `--out-dir DIR`, `--duration S`, `--json`, `--verbose`.
 `pixyslam_log` is `pixyslam_spy` under its old name. Regenerate with
 `scripts/tool_help.sh > docs/tools.md`.
 TEXT

@@ -53,9 +53,9 @@ start() {  # start NAME: the process NAME in the background, output appended to 
     logger_full) mkdir -p "$work/full"
             set -- bash -c "trap '' XFSZ; ulimit -f $full_kb; exec \"\$@\"" logger_full \
               "$bin/logger" --config "$cfg/logger_full.yaml" --out "$work/full/run.mcap" ;;
-    slam_estimator) set -- "$bin/slam_estimator" --config "$cfg/slam_estimator.yaml" --out "$work/estimator" \
+    slam_estimator) set -- "$bin/slam_estimator" --config "$cfg/slam_estimator.yaml" --out-dir "$work/estimator" \
                       --checkpoint "$work/checkpoint.yaml" ;;
-    evaluator) set -- "$bin/sim_evaluator" --dds-config "$cfg/slam_estimator.yaml" --out "$work/evaluator" \
+    evaluator) set -- "$bin/sim_evaluator" --config "$cfg/slam_estimator.yaml" --out-dir "$work/evaluator" \
                  --max-ate "$max_ate" ;;
     encoder_bridge) set -- "$bin/encoder_bridge" --config "$cfg/encoder_bridge.yaml" --device "$dev/arduino" ;;
     pixy_bridge) set -- "$bin/pixy_bridge" --config "$cfg/pixy_bridge.yaml" --device "$dev/pixy" ;;

@@ -9,7 +9,7 @@ set(extra --write-dataset "${OUT}/dataset")
 if(OPTIMISE)
   set(extra --optimise)
 endif()
-execute_process(COMMAND "${RUNNER}" sim --config "${CONFIG}" --out "${OUT}" ${extra}
+execute_process(COMMAND "${RUNNER}" sim --config "${CONFIG}" --out-dir "${OUT}" ${extra}
   OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
 message("${out}${err}")
 if(NOT rc EQUAL 0)
@@ -50,7 +50,7 @@ if(NOT OPTIMISE)
   string(SUBSTRING "${config_text}" 0 ${world_at} filter_text)
   file(WRITE "${OUT}/filter_only.yaml" "${filter_text}\n")
   execute_process(COMMAND "${RUNNER}" mrclam --dataset "${OUT}/dataset" --robot 1 --config "${OUT}/filter_only.yaml"
-    --out "${OUT}/from_dataset" OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+    --out-dir "${OUT}/from_dataset" OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
   message("${out}${err}")
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "slam_offline mrclam on the written data set exited with ${rc}")

@@ -34,7 +34,7 @@ sleep 8
 echoes=()
 for t in "${topics[@]}"; do
   "$bin/pixyslam_spy" echo "pixyslam/$t" --json --count 20 --seconds 20 \
-    --dds-config "$work/config/slam_estimator.yaml" > "$work/echo_$t.jsonl" 2> "$work/echo_$t.err" &
+    --config "$work/config/slam_estimator.yaml" > "$work/echo_$t.jsonl" 2> "$work/echo_$t.err" &
   echoes+=($!)
 done
 for pid in "${echoes[@]}"; do wait "$pid" || { echo "FAIL: pixyslam_spy echo failed"; cat "$work"/echo_*.err; exit 1; }; done

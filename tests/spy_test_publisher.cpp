@@ -18,13 +18,13 @@ namespace pixyslam {
 namespace {
 
 int run(int argc, char** argv) {
-    const app::CommandLine args(argc, argv, {"dds-config", "rate-hz", "map-states"});
+    const app::CommandLine args(argc, argv, {"config", "rate-hz", "map-states"});
     if (args.help()) {
-      std::printf("usage: spy_test_publisher --dds-config FILE [--rate-hz HZ] [--map-states N]\n"
+      std::printf("usage: spy_test_publisher --config FILE [--rate-hz HZ] [--map-states N]\n"
                   "  --map-states N  first publish N MapStates (seq 1..N, transient local: kept for late readers)\n");
       return 0;
     }
-    const std::string file = args.get("dds-config");
+    const std::string file = args.get("config");
     config::YamlReader root = config::YamlReader::from_file(file);
     config::YamlReader dds_yaml = root.child("dds");
     dds::DdsOptions options = dds::read_dds_options(dds_yaml, app::folder_of(file));

@@ -34,7 +34,7 @@ TEST(MapViewLive, DrawsReceivedMapStatesAndStopsOnSigint) {
   if (child == 0) {
     unsetenv("DISPLAY");
     unsetenv("WAYLAND_DISPLAY");
-    execl(PIXYSLAM_MAP_VIEW_EXE, "map_view", "live", "--domain", domain_text.c_str(), "--out", out_text.c_str(),
+    execl(PIXYSLAM_MAP_VIEW_EXE, "map_view", "live", "--domain", domain_text.c_str(), "--out-dir", out_text.c_str(),
           "--period", "0.2", static_cast<char*>(nullptr));
     _exit(127);
   }

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/parameters/parameters.h"
 
 namespace pixyslam::launcher {
 
@@ -113,17 +114,11 @@ LaunchPlan read_launch_plan(const std::string& path, const std::map<std::string,
   }
   for (const auto& [name, value] : given) {
     if (name == kDurationArgument) {
-      std::size_t used = 0;
-      double seconds = -1.0;
-      try {
-        seconds = std::stod(value, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != value.size() || !(seconds >= 0.0 && seconds <= 1e6)) {
+      const std::optional<double> seconds = parameters::parse_number(value);
+      if (!seconds || !(*seconds >= 0.0 && *seconds <= 1e6)) {
         throw config::ConfigError("duration:=" + value + ": must be seconds in [0, 1e6] (0: no limit)");
       }
-      plan.duration_s = seconds;
+      plan.duration_s = *seconds;
     } else if (values.count(name) == 0 || variables.count(name) != 0) {
       std::string known = kDurationArgument;
       for (const LaunchArgument& a : plan.arguments) known += ", " + a.name;

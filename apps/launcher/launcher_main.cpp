@@ -1,8 +1,9 @@
 // pixyslam_launch: starts the processes of a launch file, forwards their output
 // with a prefix, stops them all on Ctrl-C, after duration_s or when a process
 // marked ends_run finishes, then runs the after_run commands (evaluation).
-//   pixyslam_launch config/launch_sim.yaml [--run-dir DIR] [--duration S] [--input FILE]
-//                   [--deployment DEPLOY.yaml --host NAME]
+//   pixyslam_launch config/launch_sim.yaml [NAME:=VALUE ...] [--run-dir DIR] [--duration S] [--input FILE]
+//                   [--deployment DEPLOY.yaml --host NAME] [--show-args]
+// NAME:=VALUE: launch arguments (duration, and those the file declares).
 // --input defines ${input} for the launch file (e.g. the log launch_replay.yaml plays).
 // With a deployment, only the host's share of the processes runs, with the
 // deployment's DDS settings, and DDS liveliness of every process on the
@@ -22,6 +23,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <map>
 #include <string>
 #include <thread>
@@ -30,6 +32,7 @@
 #include "deployment.h"
 #include "health_monitor.h"
 #include "launch_plan.h"
+#include "pixyslam/app/cli.h"
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
@@ -125,34 +128,40 @@ bool supervise(launcher::ProcessGroup& group, Clock::time_point until, bool& fai
   return true;
 }
 
-int run(const std::string& launch_file, const app::CommandLine& args, const std::map<std::string, std::string>& given,
-        bool show_args) {
-  const std::string run_dir = args.get("run-dir", default_run_dir());
+struct LaunchCommandLine {
+  std::string launch_file;
+  std::vector<std::string> arguments;  // NAME:=VALUE
+  std::string run_dir, input, deployment, host;
+  double duration_s = -1.0;  // -1: the file's
+  bool show_args = false;
+};
+
+int run(const LaunchCommandLine& args, const std::map<std::string, std::string>& given) {
+  const std::string& launch_file = args.launch_file;
+  const bool show_args = args.show_args;
+  const std::string run_dir = args.run_dir.empty() ? default_run_dir() : args.run_dir;
   if (!show_args) std::filesystem::create_directories(run_dir);
   const std::string bin_dir = own_folder();
   std::map<std::string, std::string> variables{
       {"config_dir", std::filesystem::absolute(app::folder_of(launch_file)).string()},
       {"bin_dir", bin_dir},
       {"run_dir", std::filesystem::absolute(run_dir).string()}};
-  if (args.has("input")) variables["input"] = std::filesystem::absolute(args.get("input")).string();
+  if (!args.input.empty()) variables["input"] = std::filesystem::absolute(args.input).string();
   launcher::LaunchPlan plan = launcher::read_launch_plan(launch_file, variables, given);
   if (show_args) {
     std::fputs(launcher::arguments_text(plan).c_str(), stdout);
     return 0;
   }
-  if (args.has("deployment") != args.has("host")) {
-    throw std::invalid_argument("--deployment and --host go together");
-  }
-  if (args.has("deployment")) {
-    const launcher::Deployment deployment = launcher::read_deployment(args.get("deployment"));
-    plan = launcher::plan_for_host(plan, deployment, args.get("host"));
+  if (!args.deployment.empty()) {
+    const launcher::Deployment deployment = launcher::read_deployment(args.deployment);
+    plan = launcher::plan_for_host(plan, deployment, args.host);
     // The launcher's own DDS participant (the health monitor) joins like its
     // processes: this process's environment, then the host's deployment settings.
     dds::DdsOptions options;
     const std::string profiles = variables["config_dir"] + "/dds/profiles.xml";
     options.profiles_file = std::filesystem::exists(profiles) ? profiles : PIXYSLAM_DEFAULT_PROFILES_FILE;
     dds::resolve_settings(options);
-    const auto host_env = launcher::host_environment(deployment, args.get("host"));
+    const auto host_env = launcher::host_environment(deployment, args.host);
     dds::apply_environment(options, [&](const char* name) -> const char* {
       for (const auto& [variable, value] : host_env) {
         if (variable == name) return value.c_str();
@@ -164,10 +173,10 @@ int run(const std::string& launch_file, const app::CommandLine& args, const std:
     } catch (const std::exception& e) {
       std::printf("[launch] warning: no health monitor: %s\n", e.what());
     }
-    std::printf("[launch] host '%s' of %s: %zu processes, %zu after the run\n", args.get("host").c_str(),
-                args.get("deployment").c_str(), plan.processes.size(), plan.after_run.size());
+    std::printf("[launch] host '%s' of %s: %zu processes, %zu after the run\n", args.host.c_str(),
+                args.deployment.c_str(), plan.processes.size(), plan.after_run.size());
   }
-  plan.duration_s = args.number("duration", plan.duration_s);
+  if (args.duration_s >= 0.0) plan.duration_s = args.duration_s;
   char duration[48] = "";
   if (plan.duration_s > 0) std::snprintf(duration, sizeof(duration), ", for %.1f s", plan.duration_s);
   std::printf("[launch] %zu processes from %s, run folder %s%s\n", plan.processes.size(), launch_file.c_str(),
@@ -240,32 +249,41 @@ int main(int argc, char** argv) {
   // Output to a closed terminal or SSH pipe must not kill the launcher before
   // it has stopped its children (they get the default back).
   signal(SIGPIPE, SIG_IGN);
+  LaunchCommandLine args;
+  CLI::App cli{"Starts the processes of a launch file, forwards their output with a prefix, stops them all on "
+               "Ctrl-C, after the duration or when a process marked ends_run finishes, then runs the after_run "
+               "steps. Exit code 0 only if every process ended cleanly.",
+               "pixyslam_launch"};
+  cli.add_option("launch_file", args.launch_file, "e.g. config/launch_sim.yaml")->required()->check(CLI::ExistingFile)
+      ->type_name("LAUNCH.yaml");
+  cli.add_option("arguments", args.arguments, "launch arguments, e.g. particles:=300 duration:=30 (--show-args)")
+      ->type_name("NAME:=VALUE");
+  cli.add_option("--run-dir", args.run_dir, "the run's folder (${run_dir}; default ./pixyslam_runs/<time>)")
+      ->type_name("DIR");
+  cli.add_option("--duration", args.duration_s, "the same as duration:=S")->type_name("S")->check(CLI::Range(0.0, 1e6));
+  cli.add_option("--input", args.input, "defines ${input} (e.g. the log launch_replay.yaml plays)")->type_name("FILE");
+  auto* deployment = cli.add_option("--deployment", args.deployment,
+                                    "a deployment file: run one host's share with its DDS settings "
+                                    "(docs/deployment.md)")
+                         ->type_name("DEPLOY.yaml")
+                         ->check(CLI::ExistingFile);
+  auto* host = cli.add_option("--host", args.host, "the host of the deployment this is")->type_name("NAME");
+  deployment->needs(host);
+  host->needs(deployment);
+  cli.add_flag("--show-args", args.show_args, "the file's launch arguments, their defaults and help; starts nothing");
+  if (const auto done = app::parse(cli, argc, argv)) return *done;
   try {
-    if (argc < 2 || argv[1][0] == '-') {
-      // --help: the usage on stdout, exit 0; no launch file or an unknown flag first: stderr, 2.
-      const bool help = argc >= 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h");
-      if (!help && argc >= 2) std::fprintf(stderr, "pixyslam_launch: unknown argument '%s'\n", argv[1]);
-      std::fprintf(help ? stdout : stderr,
-                   "usage: pixyslam_launch LAUNCH.yaml [NAME:=VALUE ...] [--run-dir DIR] [--duration S] [--input FILE]\n"
-                   "                       [--deployment DEPLOY.yaml --host NAME] [--show-args]\n"
-                   "  NAME:=VALUE  a launch argument of the file (e.g. particles:=300 duration:=30)\n"
-                   "  --show-args  the file's launch arguments, their defaults and help; starts nothing\n"
-                   "  --duration S the same as duration:=S\n");
-      return help ? 0 : 2;
+    for (const std::string& word : args.arguments) {
+      if (word.find(":=") == std::string::npos) {
+        throw std::invalid_argument("'" + word + "' is not a launch argument NAME:=VALUE (see --help)");
+      }
     }
-    // The launch file is positional; NAME:=VALUE words are launch arguments, the rest flags.
-    std::vector<std::string> words(argv + 2, argv + argc);
+    std::vector<std::string> words = args.arguments;
     const std::map<std::string, std::string> given = launcher::split_launch_arguments(words);
-    const auto show = std::find(words.begin(), words.end(), "--show-args");
-    const bool show_args = show != words.end();
-    if (show_args) words.erase(show);
-    std::vector<char*> flags{argv[0]};
-    for (std::string& word : words) flags.push_back(word.data());
-    const app::CommandLine args(static_cast<int>(flags.size()), flags.data(), {"run-dir", "duration", "input", "deployment", "host"});
-    if (args.has("duration") && given.count("duration") != 0) {
+    if (args.duration_s >= 0.0 && given.count("duration") != 0) {
       throw std::invalid_argument("--duration and duration:= given both");
     }
-    return run(argv[1], args, given, show_args);
+    return run(args, given);
   } catch (const config::ConfigError& e) {
     std::fprintf(stderr, "pixyslam_launch: config error: %s\n", e.what());
     return 2;

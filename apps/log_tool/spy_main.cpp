@@ -8,7 +8,7 @@
 //   pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]
 //   pixyslam_spy print FILE.mcap [--topic T] [--json]
 //   pixyslam_spy compare A.mcap B.mcap --topic T [--ignore F,...] [--tolerance X]
-// DDS options: --dds-config FILE (a YAML with a `dds:` mapping, e.g.
+// DDS options: --config FILE (a YAML with a `dds:` mapping, e.g.
 // config/slam_estimator.yaml; default: config/dds/profiles.xml on domain 0),
 // --domain N. The same program is also built as pixyslam_log (info/check).
 // Exit status: 0 ok, 1 check failed / too few samples / file unreadable or
@@ -51,7 +51,7 @@ constexpr const char* kUsage =
     "       " PIXYSLAM_TOOL_NAME " check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]\n"
     "       " PIXYSLAM_TOOL_NAME " print FILE.mcap [--topic TOPIC] [--json]\n"
     "       " PIXYSLAM_TOOL_NAME " compare A.mcap B.mcap --topic TOPIC [--ignore FIELD,...] [--tolerance X]\n"
-    "DDS options: --dds-config FILE (YAML with a dds: mapping; default " PIXYSLAM_DEFAULT_PROFILES_FILE
+    "DDS options: --config FILE (YAML with a dds: mapping; default " PIXYSLAM_DEFAULT_PROFILES_FILE
     ", domain 0)\n"
     "             --domain N (overrides the file's domain_id)\n"
     "TOPIC: pixyslam/odometry, pixyslam/landmark_observation, pixyslam/map_state, pixyslam/ground_truth,\n"
@@ -107,7 +107,7 @@ Arguments parse(const std::string& command, const std::vector<std::string>& args
       if (i + 1 >= args.size()) throw std::invalid_argument(arg + " needs a value");
       return args[++i];
     };
-    if (live && arg == "--dds-config") {
+    if (live && arg == "--config") {
       a.dds_config = value();
     } else if (live && arg == "--domain") {
       a.dds_overrides.push_back(pixyslam::dds::domain_override(value()));

@@ -2,7 +2,7 @@
 // Table 1) and a loop-closure world, simulated with the paper's noise and 100
 // particles, three runs each; writes OUT/report.md (Table 1 form, detection
 // rate, time per step) and OUT/<experiment>.png (map of run 1).
-//   paper_experiments --config-dir config --out DIR [--check]
+//   paper_experiments --config-dir config --out-dir DIR [--check]
 // --check: exit 3 unless, in the corner and corridor experiments, every
 // landmark the paper lists is mapped with a mean error at most the paper's
 // error for it (Table 1), and the mean pose ATE is at most 5 cm (the paper's
@@ -198,13 +198,13 @@ bool report_experiment(const Experiment& e, const slam::FilterOptions& filter, c
 
 int main(int argc, char** argv) {
   return app::run_main("paper_experiments", [&] {
-    const app::CommandLine args(argc, argv, {"config-dir", "out", "check"});
+    const app::CommandLine args(argc, argv, {"config-dir", "out-dir", "check"});
     if (args.help()) {
-      std::puts("usage: paper_experiments --config-dir CONFIG --out DIR [--check 1]");
+      std::puts("usage: paper_experiments --config-dir CONFIG --out-dir DIR [--check 1]");
       return 0;
     }
     const std::string config_dir = args.get("config-dir");
-    const std::string out_dir = args.get("out");
+    const std::string out_dir = args.get("out-dir");
     std::filesystem::create_directories(out_dir);
     config::YamlReader sim_root = config::YamlReader::from_file(config_dir + "/slam_sim.yaml");
     config::YamlReader filter_yaml = sim_root.child("filter");
@@ -216,7 +216,7 @@ int main(int argc, char** argv) {
     };
     std::ostringstream md;
     md << "# The seed paper's experiments, simulated\n\n"
-       << "Written by `paper_experiments --config-dir config --out DIR` (`scripts/paper_experiments.sh`). "
+       << "Written by `paper_experiments --config-dir config --out-dir DIR` (`scripts/paper_experiments.sh`). "
        << "Θ is the landmark's bearing from the map origin (atan2(Y, X)), as in the paper's Table 1. Error: distance of the "
        << "estimate from the truth, mean over the runs that mapped the landmark. The paper's error is that of its "
        << "own Table 1 estimate (L04 of the corner and L06 of the corridor were not detected there).\n\n";

@@ -1,7 +1,7 @@
 // pixyslam_play: replays MCAP logs written by the logger onto DDS.
 //   pixyslam_play LOG.mcap [LOG_001.mcap ...] [--rate R] [--start S] [--duration S]
 //                 [--loop] [--topics LIST] [--restamp] [--wait-readers N]
-//                 [--wait-timeout S] [--dds-config FILE] [--domain N] [--quiet]
+//                 [--wait-timeout S] [--config FILE] [--domain N] [--quiet]
 // Exit status: 0 played, 1 a file could not be read / nothing to play,
 // 2 command-line or config error.
 #include <cstdio>
@@ -35,7 +35,7 @@ constexpr const char* kUsage =
     "  --restamp         shift header stamps onto the current clock (for a live estimator)\n"
     "  --wait-readers N  wait for N readers per topic before playing (default 1; 0: do not wait)\n"
     "  --wait-timeout S  then play anyway (default 10)\n"
-    "  --dds-config FILE YAML with a dds: mapping (default " PIXYSLAM_DEFAULT_PROFILES_FILE ", domain 0)\n"
+    "  --config FILE YAML with a dds: mapping (default " PIXYSLAM_DEFAULT_PROFILES_FILE ", domain 0)\n"
     "  --domain N        overrides the domain id\n"
     "  --quiet           no progress lines\n";
 
@@ -83,7 +83,7 @@ pixyslam::player::PlayerOptions parse(const std::vector<std::string>& args) {
     } else if (arg == "--wait-timeout") {
       o.wait_timeout_s = number(arg, value());
       if (!(o.wait_timeout_s >= 0)) throw std::invalid_argument("--wait-timeout must be >= 0");
-    } else if (arg == "--dds-config") {
+    } else if (arg == "--config") {
       dds_config = value();
     } else if (arg == "--domain") {
       dds_overrides.push_back(dds::domain_override(value()));

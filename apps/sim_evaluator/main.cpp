@@ -2,11 +2,12 @@
 // Subscribes to every topic, counts messages and sequence gaps per topic, and
 // when stopped (SIGINT/SIGTERM, e.g. by the launcher) prints the pose ATE RMSE
 // (estimate interpolated at the ground-truth times), heading RMSE, landmark
-// RMSE raw and aligned, and writes the trajectories to --out. When the map
+// RMSE raw and aligned, and writes the trajectories to --out-dir. When the map
 // optimiser runs (pixyslam/optimised_map), the same for its newest solution
 // (keyframes against the truth, its landmarks) and its CPU time.
-//   sim_evaluator --dds-config config/slam_estimator.yaml [--out DIR] [--max-ate M] [--max-optimised-ratio R]
-// Exit code 3 if the ATE exceeds --max-ate or nothing was estimated; with
+//   sim_evaluator [--config config/slam_estimator.yaml] [--domain N] [--out-dir DIR] [--max-ate M]
+//                 [--max-optimised-ratio R]
+// Exit code 1 if the ATE exceeds --max-ate or nothing was estimated; with
 // --max-optimised-ratio also when no OptimisedMap arrived or its landmark RMSE
 // is above R times the filter's (1: at most the filter's).
 #include <cmath>
@@ -16,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/cli.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
@@ -58,9 +59,17 @@ void print_topic(const dds::Reader<Message>& reader) {
   std::printf("\n");
 }
 
-int run(const app::CommandLine& args) {
-  dds::DdsOptions dds_options = dds::read_dds_options_file(args.get("dds-config"), "");
-  dds::resolve_settings(dds_options);
+struct Arguments {
+  std::string config;
+  std::vector<std::string> dds_overrides;  // --domain
+  std::string out_dir;
+  double max_ate_m = 0.0;
+  double max_optimised_ratio = -1.0;  // < 0: not checked
+};
+
+int run(const Arguments& args) {
+  dds::DdsOptions dds_options = dds::read_dds_options_file(args.config, PIXYSLAM_DEFAULT_PROFILES_FILE);
+  dds::resolve_settings(dds_options, args.dds_overrides);
 
   Received r;
   dds::Participant participant(dds_options, "sim_evaluator");
@@ -108,7 +117,7 @@ int run(const app::CommandLine& args) {
   print_topic(optimised);
   if (r.estimate.empty() || r.truth.empty()) {
     std::printf("sim_evaluator: no %s received: nothing to evaluate\n", r.estimate.empty() ? "MapState" : "GroundTruth");
-    return 3;
+    return 1;
   }
   const eval::TrajectoryErrors pose = eval::compare_trajectory(r.estimate, r.truth);
   const eval::LandmarkErrors landmarks = eval::compare_landmarks(r.map, r.true_landmarks);
@@ -130,27 +139,26 @@ int run(const app::CommandLine& args) {
                 opt_pose.heading_rmse_rad * 180.0 / M_PI, opt_landmarks.matched, opt_landmarks.rmse_m,
                 opt_landmarks.rmse_aligned_m, r.optimiser_cpu_s);
     optimised_ok = opt_landmarks.matched > 0 &&
-                   opt_landmarks.rmse_m <= args.number("max-optimised-ratio", 1.0) * landmarks.rmse_m;
+                   opt_landmarks.rmse_m <= args.max_optimised_ratio * landmarks.rmse_m;
   } else {
     std::printf("  map optimiser        no OptimisedMap received\n");
   }
 
-  if (args.has("out")) {
-    const std::string out = args.get("out");
+  if (!args.out_dir.empty()) {
+    const std::string& out = args.out_dir;
     std::filesystem::create_directories(out);
     eval::write_trajectory_csv(out + "/trajectory.csv", r.estimate);
     eval::write_trajectory_csv(out + "/ground_truth.csv", r.truth);
     std::printf("  trajectories         %s/trajectory.csv, %s/ground_truth.csv\n", out.c_str(), out.c_str());
   }
-  const double max_ate = args.number("max-ate", 0.0);
-  if (max_ate > 0.0 && !(pose.ate_rmse_m <= max_ate)) {
-    std::printf("sim_evaluator: ATE %.3f m exceeds the limit %.3f m\n", pose.ate_rmse_m, max_ate);
-    return 3;
+  if (args.max_ate_m > 0.0 && !(pose.ate_rmse_m <= args.max_ate_m)) {
+    std::printf("sim_evaluator: ATE %.3f m exceeds the limit %.3f m\n", pose.ate_rmse_m, args.max_ate_m);
+    return 1;
   }
-  if (args.has("max-optimised-ratio") && !optimised_ok) {
+  if (args.max_optimised_ratio >= 0.0 && !optimised_ok) {
     std::printf("sim_evaluator: the map optimiser's landmarks are missing or above %.2f times the filter's RMSE\n",
-                args.number("max-optimised-ratio", 1.0));
-    return 3;
+                args.max_optimised_ratio);
+    return 1;
   }
   return 0;
 }
@@ -159,13 +167,27 @@ int run(const app::CommandLine& args) {
 }  // namespace pixyslam::sim_evaluator
 
 int main(int argc, char** argv) {
-  pixyslam::app::StopSignal::install();
-  return pixyslam::app::run_main("sim_evaluator", [&] {
-    const pixyslam::app::CommandLine args(argc, argv, {"dds-config", "out", "max-ate", "max-optimised-ratio"});
-    if (args.help()) {
-      std::puts("usage: sim_evaluator --dds-config FILE [--out DIR] [--max-ate M] [--max-optimised-ratio R]");
-      return 0;
-    }
-    return pixyslam::sim_evaluator::run(args);
-  });
+  using namespace pixyslam;
+  app::StopSignal::install();
+  sim_evaluator::Arguments args;
+  CLI::App cli{"Scores a live run against the simulator's ground truth when stopped (SIGINT/SIGTERM): pose ATE, "
+               "heading and landmark RMSE of the filter and of the map optimiser's newest solution.",
+               "sim_evaluator"};
+  cli.add_option("--config", args.config, "a YAML with a dds: mapping (e.g. config/slam_estimator.yaml)")
+      ->check(CLI::ExistingFile)
+      ->type_name("FILE");
+  cli.add_option_function<std::string>(
+         "--domain", [&](const std::string& d) { args.dds_overrides.push_back(pixyslam::dds::domain_override(d)); },
+         "DDS domain (overrides the config's and PIXYSLAM_DDS_DOMAIN)")
+      ->type_name("N");
+  cli.add_option("--out-dir", args.out_dir, "write DIR/trajectory.csv and DIR/ground_truth.csv")->type_name("DIR");
+  cli.add_option("--max-ate", args.max_ate_m, "exit 1 if the pose ATE is above M (0: no check)")
+      ->type_name("M")
+      ->check(CLI::NonNegativeNumber);
+  cli.add_option("--max-optimised-ratio", args.max_optimised_ratio,
+                 "exit 1 if no OptimisedMap arrived or its landmark RMSE is above R times the filter's")
+      ->type_name("R")
+      ->check(CLI::NonNegativeNumber);
+  if (const auto done = app::parse(cli, argc, argv)) return *done;
+  return app::run_main("sim_evaluator", [&] { return sim_evaluator::run(args); });
 }

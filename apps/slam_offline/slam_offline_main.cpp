@@ -1,6 +1,6 @@
 // slam_offline: runs the FastSLAM 2.0 core without DDS.
-//   slam_offline sim    --config FILE --out DIR [--seed S] [--write-dataset DIR]
-//   slam_offline mrclam --dataset DIR --robot N --config FILE --out DIR [--seed S] [--optimise]
+//   slam_offline sim    --config FILE --out-dir DIR [--seed S] [--write-dataset DIR]
+//   slam_offline mrclam --dataset DIR --robot N --config FILE --out-dir DIR [--seed S] [--optimise]
 // Writes DIR/trajectory.csv and DIR/landmarks.csv and prints the evaluation.
 // --optimise (any mode): the map optimiser over the whole run after the filter;
 // trajectory.csv and landmarks.csv are then its solution, the filter's go to
@@ -32,9 +32,9 @@ namespace {
 using namespace pixyslam;
 
 constexpr const char* kUsage =
-    "usage: slam_offline sim    --config FILE --out DIR [--seed S] [--set ...] [--optimise] [--write-dataset DIR]\n"
-    "       slam_offline mrclam --dataset DIR --robot N --config FILE --out DIR [--seed S] [--set ...] [--optimise]\n"
-    "       slam_offline hardware --config FILE --sim-config FILE --out DIR [--seed S] [--set ...] [--duration S]\n"
+    "usage: slam_offline sim    --config FILE --out-dir DIR [--seed S] [--set ...] [--optimise] [--write-dataset DIR]\n"
+    "       slam_offline mrclam --dataset DIR --robot N --config FILE --out-dir DIR [--seed S] [--set ...] [--optimise]\n"
+    "       slam_offline hardware --config FILE --sim-config FILE --out-dir DIR [--seed S] [--set ...] [--duration S]\n"
     "                           [--optimise]\n"
     "         (hardware: the robot_sim hardware decoded by the bridges' parsers; the\n"
     "          pixy/encoder configs are taken from beside --sim-config)\n"
@@ -73,7 +73,7 @@ Args parse_args(int argc, char** argv) {
       a.optimise = true;
       continue;
     }
-    static const char* known[] = {"--config",     "--out",      "--seed",          "--dataset", "--robot",
+    static const char* known[] = {"--config",     "--out-dir",  "--seed",          "--dataset", "--robot",
                                   "--sim-config", "--duration", "--write-dataset", "--set"};
     bool ok = false;
     for (const char* k : known) ok = ok || key == k;
@@ -200,7 +200,7 @@ int run(const Args& args) {
 #ifndef PIXYSLAM_HAVE_MAP_OPTIMIZER
   if (args.optimise) throw std::runtime_error("--optimise: this build has no map optimiser (built without Ceres)");
 #endif
-  const std::filesystem::path out = args.get("out");
+  const std::filesystem::path out = args.get("out-dir");
   const offline::RunResult result = offline::run_filter(options, input);
   std::filesystem::create_directories(out);
   const auto write = [&out](const std::string& prefix, const offline::RunResult& r) {

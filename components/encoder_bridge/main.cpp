@@ -1,15 +1,15 @@
 // encoder_bridge: the Arduino's wheel-encoder lines (serial) -> Odometry over
 // DDS at publish_rate_hz, until SIGINT/SIGTERM.
-//   encoder_bridge --config config/encoder_bridge.yaml [--device PATH] [--dds-config FILE]
-// --device overrides encoder_bridge.serial_device, --dds-config the Fast DDS XML
-// profiles file (dds.profiles_file). Prints the effective configuration to
-// stdout, logs to stderr. Exit status: 0 after a clean stop, 2 for a
+//   encoder_bridge --config config/encoder_bridge.yaml [--device PATH] [--set KEY=VALUE ...] [--verbose]
+// --device overrides encoder_bridge.serial_device; --set encoder_bridge.KEY=V
+// or dds.KEY=V a parameter. --verbose prints the effective configuration to
+// stdout; logs go to stderr. Exit status: 0 after a clean stop, 2 for a
 // configuration or command-line error, 1 for any other failure.
 #include <chrono>
 #include <cstdio>
 #include <optional>
 
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/cli.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/bridge/bridge_options.h"
@@ -18,18 +18,28 @@
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();  // first: every thread inherits the blocked signals
-  constexpr const char* kUsage =
-      "usage: encoder_bridge --config FILE [--device PATH] [--dds-config FILE]";
+  bridge::BridgeCommandLine args;
+  CLI::App cli{"The Arduino's wheel-encoder lines (serial) -> Odometry over DDS, until SIGINT/SIGTERM.",
+               "encoder_bridge"};
+  bridge::add_bridge_flags(cli, args, "config/encoder_bridge.yaml: encoder_bridge:, node:, dds:",
+                           "encoder_bridge.publish_rate_hz=20");
+  cli.footer("encoder parameters (encoder_bridge:):\n" +
+             parameters::help_text(encoder::encoder_parameters(), "encoder_bridge") +
+             "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
+             parameters::help_text(pixyslam::dds::dds_parameters(), "dds"));
+  if (const auto done = app::parse(cli, argc, argv)) return *done;
 
   encoder_node::EncoderNodeOptions options;
-  const std::optional<int> early_exit =
-      app::set_up("encoder_bridge", kUsage, argc, argv, {"config", "device", "dds-config"},
-                  [&](const app::CommandLine& args) {
-                    options = encoder_node::read_encoder_node_options_file(args.get("config"));
-                    bridge::apply_command_line(args, options.encoder.serial_device, options.dds);
-                  });
-  if (early_exit) return *early_exit;
-  app::print_effective_configuration("encoder_bridge", encoder_node::to_yaml(options));
+  const std::optional<int> bad = app::configure("encoder_bridge", [&] {
+    options = encoder_node::read_encoder_node_options_file(args.config);
+    for (const std::string& a : bridge::take_overrides(args.overrides, "encoder_bridge")) {
+      parameters::apply_override(options.encoder, encoder::encoder_parameters(), "encoder_bridge", a);
+    }
+    encoder::validate(options.encoder);
+    bridge::apply_command_line(args, options.encoder.serial_device, options.dds);
+  });
+  if (bad) return *bad;
+  if (args.verbose) app::print_effective_configuration("encoder_bridge", encoder_node::to_yaml(options));
 
   return app::run_main("encoder_bridge", [&] {
     encoder_node::EncoderNode node(options);

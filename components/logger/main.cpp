@@ -1,9 +1,9 @@
 // logger: records DDS topics to an MCAP file until SIGINT/SIGTERM.
-//   logger --config config/logger.yaml [--out FILE.mcap] [--topics LIST]
+//   logger --config config/logger.yaml [--out FILE.mcap] [--topics LIST] [--set KEY=VALUE ...] [--verbose]
 // --out overrides logger.output_file (with rotation: the base of the names,
 // run.mcap -> run_000.mcap, run_001.mcap, ...); --topics logger.topics
-// (comma-separated names or patterns, as the config's list). Prints the effective
-// configuration to stdout, logs to stderr; on a stop it drains what was
+// (comma-separated names or patterns, as the config's list). --verbose prints the
+// effective configuration to stdout; logs go to stderr; on a stop it drains what was
 // received, closes the file (summary and footer) and prints per-topic counts,
 // then one line per file: "logger: file PATH: M messages, C chunks, B bytes".
 // A write failure (disk full) does not stop it: the file so far is kept, the
@@ -19,7 +19,8 @@
 #include <string>
 #include <vector>
 
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/cli.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/yaml_text.h"
@@ -30,23 +31,30 @@
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();  // first: every thread inherits the blocked signals
-  constexpr const char* kUsage =
-      "usage: logger --config FILE [--out FILE.mcap] [--topics LIST]\n"
-      "  --out FILE.mcap  the recording (overrides logger.output_file)\n"
-      "  --topics LIST    topics to record, comma-separated names or patterns (overrides logger.topics),\n"
-      "                   e.g. pixyslam/odometry,pixyslam/map_state or 'pixyslam/*,!pixyslam/diagnostics'";
+  std::string config, out, topics;
+  std::vector<std::string> overrides;
+  bool verbose = false;
+  CLI::App cli{"Records DDS topics to an MCAP file until SIGINT/SIGTERM.", "logger"};
+  app::add_config(cli, config, "config/logger.yaml: logger:, dds:");
+  cli.add_option("--out", out, "the recording (overrides logger.output_file)")->type_name("FILE.mcap");
+  cli.add_option("--topics", topics,
+                 "topics to record, comma-separated names or patterns (overrides logger.topics), e.g. "
+                 "pixyslam/odometry,pixyslam/map_state or 'pixyslam/*,!pixyslam/diagnostics'")
+      ->type_name("LIST");
+  app::add_set(cli, overrides, "logger.compression=lz4");
+  app::add_verbose(cli, verbose);
+  cli.footer("logger parameters (logger:; topics apart):\n" +
+             parameters::help_text(logger_node::logger_parameters(), "logger") +
+             "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
+             parameters::help_text(pixyslam::dds::dds_parameters(), "dds"));
+  if (const auto done = app::parse(cli, argc, argv)) return *done;
 
   logger_node::LoggerOptions options;
-  try {
-    const app::CommandLine args(argc, argv, {"config", "out", "topics"});
-    if (args.help()) {
-      std::puts(kUsage);
-      return 0;
-    }
-    options = logger_node::read_logger_options_file(args.get("config"));
-    if (args.has("out")) options.output_file = args.get("out");
-    if (args.has("topics")) {
-      const std::vector<std::string> patterns = config::split_comma_list(args.get("topics"));
+  const std::optional<int> bad = app::configure("logger", [&] {
+    options = logger_node::read_logger_options_file(config);
+    if (!out.empty()) options.output_file = out;
+    if (cli.count("--topics") != 0) {
+      const std::vector<std::string> patterns = config::split_comma_list(topics);
       std::vector<std::string> known;
       for (const logger_node::TopicInfo& t : logger_node::known_topics()) known.push_back(t.topic);
       const logger_node::TopicSelection selection = logger_node::select_topics(patterns, known);
@@ -57,16 +65,13 @@ int main(int argc, char** argv) {
       }
       options.topics = selection.topics;
     }
-    pixyslam::dds::resolve_settings(options.dds);
-  } catch (const config::ConfigError& e) {
-    std::fprintf(stderr, "logger: config error: %s\n", e.what());
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "logger: %s\n%s\n", e.what(), kUsage);
-    return 2;
+    logger_node::apply_overrides(options, overrides);
+  });
+  if (bad) return *bad;
+  if (verbose) {
+    std::printf("# logger: effective configuration\n%s", logger_node::to_yaml(options).c_str());
+    std::fflush(stdout);
   }
-  std::printf("# logger: effective configuration\n%s", logger_node::to_yaml(options).c_str());
-  std::fflush(stdout);
 
   try {
     logger_node::LoggerNode node(options);

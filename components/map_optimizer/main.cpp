@@ -1,14 +1,15 @@
 // map_optimizer: the map optimiser over DDS (components/map_optimizer): Odometry,
 // LandmarkObservation and the estimator's MapState in, OptimisedMap out, until
 // SIGINT/SIGTERM. Optional: the robot runs without it; it can run on another host.
-//   map_optimizer --config config/map_optimizer.yaml [--out DIR]
-// --out writes DIR/trajectory.csv (the final solution's keyframes) and
+//   map_optimizer --config config/map_optimizer.yaml [--out-dir DIR] [--set KEY=VALUE ...]
+// --out-dir writes DIR/trajectory.csv (the final solution's keyframes) and
 // DIR/landmarks.csv at exit, in slam_offline's formats.
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "pixyslam/app/cli.h"
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
@@ -39,19 +40,26 @@ void write_outputs(const std::string& dir, const pixyslam::msg::OptimisedMap& ma
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
+  std::string config, out_dir;
+  std::vector<std::string> overrides;
+  CLI::App cli{"The map optimiser over DDS: Odometry, LandmarkObservation and the estimator's MapState in, "
+               "OptimisedMap out, until SIGINT/SIGTERM.",
+               "map_optimizer"};
+  app::add_config(cli, config,
+                  "config/map_optimizer.yaml: filter_config (the estimator's file: its noise, limits and start pose), "
+                  "optimizer:, dds:");
+  cli.add_option("--out-dir", out_dir, "at exit, DIR/trajectory.csv (final keyframes) and DIR/landmarks.csv")
+      ->type_name("DIR");
+  app::add_set(cli, overrides, "optimizer.window_keyframes=50");
+  cli.footer(map_optimizer_node::help_text());
+  if (const auto done = app::parse(cli, argc, argv)) return *done;
   return app::run_main("map_optimizer", [&] {
-    const app::CommandLine args(argc, argv, {"config", "out"});
-    if (args.help()) {
-      std::puts(
-          "usage: map_optimizer --config FILE [--out DIR]\n"
-          "  --config FILE  config/map_optimizer.yaml: filter_config (the estimator's file: its noise, limits and\n"
-          "                 start pose), optimizer: (keyframes, window and whole-problem solves), dds:\n"
-          "  --out DIR      at exit, DIR/trajectory.csv (final keyframes) and DIR/landmarks.csv");
-      return 0;
+    map_optimizer_node::OptimizerNodeOptions options = map_optimizer_node::read_optimizer_node_options_file(config);
+    try {
+      map_optimizer_node::apply_overrides(options, overrides);
+    } catch (const std::invalid_argument& e) {
+      throw app::UsageError(std::string("--set: ") + e.what());
     }
-    map_optimizer_node::OptimizerNodeOptions options =
-        map_optimizer_node::read_optimizer_node_options_file(args.get("config"));
-    pixyslam::dds::resolve_settings(options.dds);
     std::fprintf(stderr,
                  "map_optimizer: keyframe every %.2f s at most, window of %zu keyframes every %.1f s, whole problem "
                  "every %.1f s; DDS domain %d, profiles '%s'\n",
@@ -66,7 +74,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "map_optimizer: %llu window and %llu whole-problem solves, CPU %.3f s (Ceres %.3f s)\n",
                  static_cast<unsigned long long>(c.window_solves), static_cast<unsigned long long>(c.whole_solves),
                  c.cpu_time_s, c.solve_time_s);
-    if (args.has("out")) write_outputs(args.get("out"), node.latest_map());
+    if (!out_dir.empty()) write_outputs(out_dir, node.latest_map());
     return 0;
   });
 }

@@ -2,12 +2,12 @@
 // per camera frame over DDS, until SIGINT/SIGTERM. With a `camera:` section it
 // reads a camera, video file or y4m stream instead and detects the colour codes
 // itself (a software Pixy, components/pixy_bridge/camera; docs/camera.md).
-//   pixy_bridge --config config/pixy_bridge.yaml [--device PATH] [--camera INPUT] [--dds-config FILE]
+//   pixy_bridge --config config/pixy_bridge.yaml [--device PATH] [--camera INPUT] [--set KEY=VALUE ...]
+//               [--verbose]
 // --device overrides node.serial_device (or camera.input), --camera selects the
 // camera backend reading INPUT (with the `camera:` settings, or the defaults),
-// --dds-config the Fast DDS XML profiles
-// file (dds.profiles_file). Prints the effective configuration to stdout, logs
-// to stderr. Exit status: 0 after a clean stop, 2 for a configuration or
+// --set pixy.KEY=V or dds.KEY=V a parameter. --verbose prints the effective
+// configuration to stdout; logs go to stderr. Exit status: 0 after a clean stop, 2 for a configuration or
 // command-line error, 1 for any other failure.
 #include <chrono>
 #include <cstdio>
@@ -16,7 +16,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/cli.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/bridge/bridge_options.h"
@@ -28,8 +28,21 @@
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();  // first: every thread inherits the blocked signals
-  constexpr const char* kUsage =
-      "usage: pixy_bridge --config FILE [--device PATH] [--camera INPUT] [--dds-config FILE]";
+  bridge::BridgeCommandLine args;
+  std::string camera_input;
+  CLI::App cli{"The Pixy's UART block stream (or a camera) -> one LandmarkObservation per frame over DDS, until "
+               "SIGINT/SIGTERM.",
+               "pixy_bridge"};
+  bridge::add_bridge_flags(cli, args, "config/pixy_bridge.yaml: node:, pixy:, camera: (optional), dds:",
+                           "pixy.frame_rate_hz=30");
+  cli.add_option("--camera", camera_input, "read this camera, video file or y4m stream instead of the Pixy")
+      ->type_name("INPUT");
+  cli.footer("Pixy parameters (pixy:; landmarks apart):\n" +
+             parameters::help_text(pixy::camera_parameters(), "pixy") +
+             parameters::help_text(pixy::frame_rate_parameters(), "pixy") +
+             "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
+             parameters::help_text(pixyslam::dds::dds_parameters(), "dds"));
+  if (const auto done = app::parse(cli, argc, argv)) return *done;
 
   pixy_node::PixyNodeOptions options;
   pixy_node::CameraSectionReader read_camera;
@@ -40,34 +53,42 @@ int main(int argc, char** argv) {
                                                         so_far.pixy.camera.image_height_px);
   };
 #endif
-  const std::optional<int> early_exit =
-      app::set_up("pixy_bridge", kUsage, argc, argv, {"config", "device", "camera", "dds-config"},
-                  [&](const app::CommandLine& args) {
-                    options = pixy_node::read_pixy_node_options_file(args.get("config"), read_camera);
+  const std::optional<int> bad = app::configure("pixy_bridge", [&] {
+    options = pixy_node::read_pixy_node_options_file(args.config, read_camera);
+    for (const std::string& a : bridge::take_overrides(args.overrides, "pixy")) {
+      const std::string key = a.substr(0, a.find('=')).substr(5);
+      if (parameters::find(pixy::frame_rate_parameters(), key) != nullptr) {
+        parameters::apply_override(options.pixy.rate, pixy::frame_rate_parameters(), "pixy", a);
+      } else {
+        parameters::apply_override(options.pixy.camera, pixy::camera_parameters(), "pixy", a);
+      }
+    }
+    pixy::validate(options.pixy.camera);
+    pixy::validate(options.pixy.rate);
 #ifdef PIXYSLAM_HAS_CAMERA
-                    if (args.has("camera") && !camera_options) {
-                      camera_options = camera::CameraSourceOptions{};
-                      camera_options->image_width_px = options.pixy.camera.image_width_px;
-                      camera_options->image_height_px = options.pixy.camera.image_height_px;
-                    }
-                    if (camera_options) {
-                      if (args.has("camera")) camera_options->input = args.get("camera");
-                      bridge::apply_command_line(args, camera_options->input, options.dds);
-                      return;
-                    }
+    if (!camera_input.empty() && !camera_options) {
+      camera_options = camera::CameraSourceOptions{};
+      camera_options->image_width_px = options.pixy.camera.image_width_px;
+      camera_options->image_height_px = options.pixy.camera.image_height_px;
+    }
+    if (camera_options) {
+      if (!camera_input.empty()) camera_options->input = camera_input;
+      bridge::apply_command_line(args, camera_options->input, options.dds);
+      return;
+    }
 #else
-                    if (args.has("camera")) {
-                      throw std::invalid_argument("--camera: this pixy_bridge was built without the camera backend");
-                    }
+    if (!camera_input.empty()) {
+      throw std::invalid_argument("--camera: this pixy_bridge was built without the camera backend");
+    }
 #endif
-                    bridge::apply_command_line(args, options.serial_device, options.dds);
-                  });
-  if (early_exit) return *early_exit;
+    bridge::apply_command_line(args, options.serial_device, options.dds);
+  });
+  if (bad) return *bad;
   std::string effective = pixy_node::to_yaml(options);
 #ifdef PIXYSLAM_HAS_CAMERA
   if (camera_options) effective += camera::to_yaml(*camera_options);
 #endif
-  app::print_effective_configuration("pixy_bridge", effective);
+  if (args.verbose) app::print_effective_configuration("pixy_bridge", effective);
 
   return app::run_main("pixy_bridge", [&] {
     std::unique_ptr<bridge::ByteSource> source;

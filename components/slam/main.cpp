@@ -1,19 +1,19 @@
 // slam_estimator: FastSLAM 2.0 over DDS. Odometry + LandmarkObservation in,
 // MapState out, until SIGINT/SIGTERM.
-//   slam_estimator --config config/slam_estimator.yaml [--seed S] [--out DIR] [--checkpoint FILE]
-//                  [--set filter.KEY=VALUE,...]
+//   slam_estimator --config config/slam_estimator.yaml [--seed S] [--out-dir DIR] [--checkpoint FILE]
+//                  [--set KEY=VALUE ...] [--verbose]
 // --checkpoint (or estimator.checkpoint.file) saves the pose and map every
 // period and resumes from the file at start when it is fresh (a restart).
-// --out writes DIR/trajectory.csv (every MapState's mean pose) and DIR/landmarks.csv at exit.
+// --out-dir writes DIR/trajectory.csv (every MapState's mean pose) and DIR/landmarks.csv at exit.
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "pixyslam/app/cli.h"
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
-#include "pixyslam/config/yaml_text.h"
 #include "pixyslam/slam/slam_options.h"
 #include "pixyslam/slam_node/estimator_node.h"
 #include "pixyslam/eval/csv_io.h"
@@ -45,39 +45,42 @@ void write_outputs(const std::string& dir, const pixyslam::slam_node::EstimatorN
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
+  std::string config, out_dir, checkpoint, seed;
+  std::vector<std::string> overrides;
+  bool verbose = false;
+  CLI::App cli{"FastSLAM 2.0 over DDS: Odometry and LandmarkObservation in, MapState out, until SIGINT/SIGTERM.",
+               "slam_estimator"};
+  app::add_config(cli, config, "config/slam_estimator.yaml: filter:, estimator:, dds:");
+  cli.add_option("--seed", seed, "the same as --set filter.seed=S")->type_name("S");
+  cli.add_option("--out-dir", out_dir, "at exit, DIR/trajectory.csv (every MapState's mean pose) and DIR/landmarks.csv")
+      ->type_name("DIR");
+  cli.add_option("--checkpoint", checkpoint,
+                 "save pose and map here every period, resume from it at start when fresh (estimator.checkpoint.file)")
+      ->type_name("FILE");
+  app::add_set(cli, overrides, "filter.particles=300");
+  app::add_verbose(cli, verbose);
+  cli.footer(slam_node::help_text());
+  if (const auto done = app::parse(cli, argc, argv)) return *done;
   return app::run_main("slam_estimator", [&] {
-    const app::CommandLine args(argc, argv, {"config", "seed", "out", "checkpoint", "set"});
-    if (args.help()) {
-      std::puts("usage: slam_estimator --config FILE [--seed S] [--out DIR] [--checkpoint FILE] [--set KEY=VALUE,...]\n"
-                "  --set   override parameters of the config, e.g. --set filter.particles=300,dds.domain_id=3\n"
-                "  --seed  the same as --set filter.seed=S");
-      std::fputs(slam_node::help_text().c_str(), stdout);
-      return 0;
-    }
-    slam_node::EstimatorOptions options = slam_node::read_estimator_options_file(args.get("config"));
-    std::vector<std::string> overrides;
-    if (args.has("seed")) overrides.push_back("filter.seed=" + args.get("seed"));
-    if (args.has("set")) {
-      for (const std::string& assignment : config::split_comma_list(args.get("set"))) overrides.push_back(assignment);
-    }
+    slam_node::EstimatorOptions options = slam_node::read_estimator_options_file(config);
+    if (!seed.empty()) overrides.insert(overrides.begin(), "filter.seed=" + seed);
     try {
       slam_node::apply_overrides(options, overrides);
     } catch (const std::invalid_argument& e) {
       throw app::UsageError(std::string("--seed/--set: ") + e.what());
     }
-    if (args.has("checkpoint")) options.checkpoint.file = args.get("checkpoint");
+    if (!checkpoint.empty()) options.checkpoint.file = checkpoint;
     std::fprintf(stderr, "slam_estimator: %d particles, seed %llu, DDS domain %d, profiles '%s'\n",
                  options.filter.particles, static_cast<unsigned long long>(options.filter.seed),
                  options.dds.domain_id, options.dds.profiles_file.c_str());
+    if (verbose) app::print_effective_configuration("slam_estimator", slam_node::to_yaml(options));
 
     slam_node::EstimatorNode node(options);
     node.start();
     while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
     }
     node.stop();
-    if (args.has("out")) {
-      write_outputs(args.get("out"), node);
-    }
+    if (!out_dir.empty()) write_outputs(out_dir, node);
     return 0;
   });
 }

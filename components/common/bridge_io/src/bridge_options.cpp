@@ -20,20 +20,36 @@ DeviceReaderOptions device_reader_options(const BridgeProcessOptions& o) {
   return d;
 }
 
-void apply_command_line(const app::CommandLine& args, std::string& serial_device, dds::DdsOptions& dds) {
-  if (args.has("device")) {
-    serial_device = args.get("device");
-    if (serial_device.empty() || serial_device.front() != '/') {
+void add_bridge_flags(CLI::App& cli, BridgeCommandLine& args, const std::string& config_help,
+                      const std::string& set_example) {
+  app::add_config(cli, args.config, config_help);
+  cli.add_option("--device", args.device, "the serial device (overrides the config's)")->type_name("PATH");
+  app::add_set(cli, args.overrides, set_example + " or dds.domain_id=3");
+  app::add_verbose(cli, args.verbose);
+}
+
+std::vector<std::string> take_overrides(std::vector<std::string>& overrides, const std::string& section) {
+  std::vector<std::string> taken, rest;
+  for (std::string& a : overrides) (a.rfind(section + ".", 0) == 0 ? taken : rest).push_back(std::move(a));
+  overrides = std::move(rest);
+  return taken;
+}
+
+void apply_command_line(const BridgeCommandLine& args, std::string& serial_device, dds::DdsOptions& dds) {
+  if (!args.device.empty()) {
+    serial_device = args.device;
+    if (serial_device.front() != '/') {
       throw std::invalid_argument("--device '" + serial_device + "' is not an absolute path");
     }
   }
+  std::vector<std::string> rest = args.overrides;
+  const std::vector<std::string> dds_overrides = take_overrides(rest, "dds");
+  if (!rest.empty()) throw std::invalid_argument("--set " + rest.front() + ": not a parameter of this process");
   // The DDS settings resolved here, once: file, environment, command line.
-  dds::resolve_settings(dds, args.has("dds-config") ? std::vector<std::string>{"dds.profiles_file=" + args.get("dds-config")}
-                                                    : std::vector<std::string>{});
+  dds::resolve_settings(dds, dds_overrides);
   const std::string& profiles = dds.profiles_file;
   if (profiles.empty()) return;
-  const std::string where =
-      args.has("dds-config") ? std::string("--dds-config") : args.get("config") + ": key 'dds.profiles_file'";
+  const std::string where = args.config + ": dds.profiles_file (or --set / PIXYSLAM_DDS_PROFILES_FILE)";
   std::error_code ec;
   const std::filesystem::file_status st = std::filesystem::status(profiles, ec);
   if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) {

@@ -89,6 +89,19 @@ void validate(const LoggerOptions& o) {
   }
 }
 
+void apply_overrides(LoggerOptions& o, const std::vector<std::string>& assignments) {
+  std::vector<std::string> dds;
+  for (const std::string& a : assignments) {
+    if (a.rfind("dds.", 0) == 0) {
+      dds.push_back(a);
+    } else {
+      parameters::apply_override(o, logger_parameters(), "logger", a);
+    }
+  }
+  validate(o);
+  dds::resolve_settings(o.dds, dds);
+}
+
 LoggerOptions read_logger_options(config::YamlReader& root, const std::string& config_dir) {
   LoggerOptions o;
   config::YamlReader section = root.child("logger");

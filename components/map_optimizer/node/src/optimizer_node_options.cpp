@@ -26,6 +26,33 @@ const parameters::Table<OptimizerNodeOptions>& optimizer_node_parameters() {
   return table;
 }
 
+void apply_overrides(OptimizerNodeOptions& o, const std::vector<std::string>& assignments) {
+  std::vector<std::string> dds;
+  for (const std::string& a : assignments) {
+    const std::string key = a.substr(0, a.find('='));
+    if (a.rfind("dds.", 0) == 0) {
+      dds.push_back(a);
+    } else if (key.rfind("optimizer.", 0) == 0 &&
+               parameters::find(map_optimizer::map_optimizer_parameters(), key.substr(10)) != nullptr) {
+      parameters::apply_override(o.optimizer, map_optimizer::map_optimizer_parameters(), "optimizer", a);
+    } else if (key.rfind("optimizer.", 0) == 0) {
+      parameters::apply_override(o, optimizer_node_parameters(), "optimizer", a);
+    } else {
+      throw std::invalid_argument("'" + a + "': not an optimizer. or dds. parameter");
+    }
+  }
+  map_optimizer::validate(o.optimizer);
+  dds::resolve_settings(o.dds, dds);
+}
+
+std::string help_text() {
+  return "optimizer parameters (optimizer:; the noise models come from filter_config):\n" +
+         parameters::help_text(map_optimizer::map_optimizer_parameters(), "optimizer") +
+         parameters::help_text(optimizer_node_parameters(), "optimizer") +
+         "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
+         parameters::help_text(dds::dds_parameters(), "dds");
+}
+
 OptimizerNodeOptions read_optimizer_node_options_file(const std::string& path) {
   config::YamlReader root = config::YamlReader::from_file(path);
   OptimizerNodeOptions o;

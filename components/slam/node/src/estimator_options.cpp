@@ -64,6 +64,11 @@ void apply_overrides(EstimatorOptions& o, const std::vector<std::string>& assign
   dds::resolve_settings(o.dds, dds);
 }
 
+std::string to_yaml(const EstimatorOptions& o) {
+  return parameters::to_yaml(o.filter, slam::filter_parameters(), "filter") +
+         parameters::to_yaml(o, estimator_parameters(), "estimator") + dds::to_yaml(o.dds);
+}
+
 std::string help_text() {
   const EstimatorOptions defaults;
   return "filter parameters (the config's filter: section):\n" +

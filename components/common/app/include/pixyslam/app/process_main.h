@@ -33,6 +33,25 @@ int run_main(const char* name, const Body& body) {
   }
 }
 
+// The configuration stage of a process (reading its files, applying its
+// flags): a config::ConfigError ("<name>: config error: <what>") or a
+// std::invalid_argument ("<name>: <what> (see --help)") escaping `body` is a
+// configuration or usage error: one line on stderr, returns 2. Returns
+// nothing when the process is to go on.
+template <class Body>
+std::optional<int> configure(const char* name, const Body& body) {
+  try {
+    body();
+  } catch (const config::ConfigError& e) {
+    std::fprintf(stderr, "%s: config error: %s\n", name, e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "%s: %s (see --help)\n", name, e.what());
+    return 2;
+  }
+  return std::nullopt;
+}
+
 // The set-up of a process that runs until it is stopped: parses `argv` for
 // `--flag value` pairs of `flags`, then calls `configure(args)` to read the
 // configuration. Returns the exit status when the process is to end here:

@@ -2,7 +2,9 @@
 
 #include <string>
 
-#include "pixyslam/app/command_line.h"
+#include <vector>
+
+#include "pixyslam/app/cli.h"
 #include "pixyslam/bridge/device_reader.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/yaml_text.h"
@@ -23,13 +25,27 @@ BridgeProcessOptions read_bridge_process_options(config::YamlReader& node);
 
 DeviceReaderOptions device_reader_options(const BridgeProcessOptions& options);
 
-// The bridges' command-line overrides of what args.get("config") set:
-// --device PATH replaces `serial_device` (std::invalid_argument unless it is an
-// absolute path), --dds-config FILE replaces dds.profiles_file; the DDS
-// settings resolved (dds::resolve_settings: the environment). The profiles
-// file must be readable: config::ConfigError naming --dds-config or the config
-// file's key dds.profiles_file otherwise.
-void apply_command_line(const app::CommandLine& args, std::string& serial_device, dds::DdsOptions& dds);
+// The flags both bridges share: --config FILE, --device PATH, --set KEY=VALUE
+// (the component's section or dds.), --verbose.
+struct BridgeCommandLine {
+  std::string config;
+  std::string device;
+  std::vector<std::string> overrides;
+  bool verbose = false;
+};
+void add_bridge_flags(CLI::App& cli, BridgeCommandLine& args, const std::string& config_help,
+                      const std::string& set_example);
+
+// The overrides of `section` (its assignments, "section.KEY=V") apart from the
+// others, which stay in `overrides`.
+std::vector<std::string> take_overrides(std::vector<std::string>& overrides, const std::string& section);
+
+// The bridges' command-line overrides of what the config file set: --device
+// PATH replaces `serial_device` (std::invalid_argument unless it is an
+// absolute path); the DDS settings resolved (dds::resolve_settings: the
+// environment, then the `dds.` overrides; any other left is an error). The
+// profiles file must be readable: config::ConfigError naming it otherwise.
+void apply_command_line(const BridgeCommandLine& args, std::string& serial_device, dds::DdsOptions& dds);
 
 // The YAML scalars of the bridges' to_yaml() (config/yaml_text.h).
 using config::yaml_number;

@@ -65,6 +65,11 @@ const parameters::Table<LoggerOptions>& logger_parameters();
 // Ranges and the rules between keys; throws std::invalid_argument naming the key.
 void validate(const LoggerOptions& options);
 
+// `--set` assignments "logger.KEY=V", "dds.KEY=V" applied and validated; the
+// DDS settings resolved (the environment, then these). Throws
+// std::invalid_argument / config::ConfigError naming the assignment.
+void apply_overrides(LoggerOptions& options, const std::vector<std::string>& assignments);
+
 // Reads `logger:` (required) and `dds:` (optional) from the top level and calls
 // root.finish(). `config_dir` resolves a relative dds.profiles_file. Throws
 // config::ConfigError naming the file and key path.

@@ -36,6 +36,14 @@ struct OptimizerNodeOptions {
 // The node's own `optimizer:` keys (beside map_optimizer_parameters()).
 const parameters::Table<OptimizerNodeOptions>& optimizer_node_parameters();
 
+// `--set` assignments "optimizer.KEY=V", "dds.KEY=V" applied and validated;
+// the DDS settings resolved (the environment, then these). Throws
+// std::invalid_argument / config::ConfigError naming the assignment.
+void apply_overrides(OptimizerNodeOptions& options, const std::vector<std::string>& assignments);
+
+// The `optimizer:` and `dds:` parameters, for --help.
+std::string help_text();
+
 // Reads the file: `filter_config` (the estimator's config, relative to this
 // file: its `filter:` noise and limits, `estimator.initial_pose`, delays and
 // detection sigmas, so both solve the same models), `optimizer:` and `dds:`.

@@ -42,6 +42,9 @@ const parameters::Table<EstimatorOptions>& estimator_parameters();
 // Throws std::invalid_argument / config::ConfigError naming the assignment.
 void apply_overrides(EstimatorOptions& options, const std::vector<std::string>& assignments);
 
+// The three sections as YAML (the effective configuration).
+std::string to_yaml(const EstimatorOptions& options);
+
 // Every parameter of the three sections, for --help.
 std::string help_text();
 
