@@ -15,7 +15,8 @@ domain=$((20 + $$ % 100))
 sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/config/*.yaml
 
 status=0
-"$bin/pixyslam_launch" "$work/config/launch_replay.yaml" --input "$log" --run-dir "$work/run" \
+read -r -a launch_args <<< "${LAUNCH_ARGS:-}"  # as the recorded run had them
+"$bin/pixyslam_launch" "$work/config/launch_replay.yaml" --input "$log" "${launch_args[@]}" --run-dir "$work/run" \
   > "$work/out.log" 2>&1 || status=$?
 grep -v "status: " "$work/out.log"
 if [[ $status -ne 0 ]]; then

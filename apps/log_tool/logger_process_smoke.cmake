@@ -37,7 +37,7 @@ set(config ${WORK_DIR}/logger.yaml)
 file(WRITE ${config} "${config_text}")
 find_program(TIMEOUT timeout REQUIRED)
 set(out ${WORK_DIR}/smoke.mcap)
-execute_process(COMMAND ${TIMEOUT} --preserve-status -s INT 3 ${LOGGER} --config ${config} --out ${out}
+execute_process(COMMAND ${TIMEOUT} --preserve-status -s INT 3 ${LOGGER} --config ${config} --out ${out} --verbose
   RESULT_VARIABLE rc OUTPUT_VARIABLE stdout ERROR_VARIABLE err)
 expect_status("logger stopped by SIGINT (stderr: ${err})" "${rc}" 0)
 expect_match("logger effective configuration" "${stdout}" "output_file: '${out}'")
@@ -53,7 +53,7 @@ expect_status("pixyslam_log check on the logger's empty file:\n${check}" "${rc}"
 # 2b. --topics records only those (two channels, two schemas); a bad pattern
 #     is a usage error (exit 2) naming it.
 set(two ${WORK_DIR}/two_topics.mcap)
-execute_process(COMMAND ${TIMEOUT} --preserve-status -s INT 2 ${LOGGER} --config ${config} --out ${two}
+execute_process(COMMAND ${TIMEOUT} --preserve-status -s INT 2 ${LOGGER} --config ${config} --out ${two} --verbose
   --topics pixyslam/odometry,pixyslam/map_state RESULT_VARIABLE rc OUTPUT_VARIABLE stdout ERROR_VARIABLE err)
 expect_status("logger --topics (stderr: ${err})" "${rc}" 0)
 expect_match("logger --topics effective configuration" "${stdout}" "topics: \\[pixyslam/odometry, pixyslam/map_state\\]")

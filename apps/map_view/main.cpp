@@ -1,7 +1,7 @@
 // map_view: the estimator's map as an image (seed paper Fig. 6b): particles,
 // mean trajectory, landmarks with n-sigma ellipses and ids, ground truth, the
 // map optimiser's solution.
-//   map_view live   [--config FILE] [--out-dir DIR] [--period S] [--no-window] [--domain N]
+//   map_view live   [--config FILE] [--out-dir DIR] [--period S] [--no-window] [--domain N] [--verbose]
 //   map_view render LOG.mcap --out FILE.png [--config FILE] [--width N] [--height N] [--no-truth]
 //   map_view video  LOG.mcap --out FILE.avi|DIR [--config FILE] [--fps N] [--speed X]
 //                   [--width N] [--height N] [--no-truth]
@@ -32,7 +32,7 @@ namespace {
 using pixyslam::map_view::InputError;
 
 constexpr const char* kUsage =
-    "usage: map_view live   [--config FILE] [--out-dir DIR] [--period S] [--no-window] [--domain N]\n"
+    "usage: map_view live   [--config FILE] [--out-dir DIR] [--period S] [--no-window] [--domain N] [--verbose]\n"
     "       map_view render LOG.mcap --out FILE.png [--config FILE] [--width N] [--height N] [--no-truth]\n"
     "       map_view video  LOG.mcap --out FILE.avi|DIR [--config FILE] [--fps N] [--speed X]\n"
     "                       [--width N] [--height N] [--no-truth]\n"
@@ -136,11 +136,15 @@ int dispatch(const std::vector<std::string>& args) {
     return run_video(o, r);
   }
   if (command == "live") {
-    const Arguments a = parse(args, {"--out-dir", "--config", "--period", "--domain"}, {"--no-window"}, 0);
+    const Arguments a = parse(args, {"--out-dir", "--config", "--period", "--domain"}, {"--no-window", "--verbose"}, 0);
     MapViewOptions o = load_options(a);
     if (a.has("--period")) {
-      pixyslam::parameters::set_from_text(o, pixyslam::map_view::map_view_parameters(), "map_view",
-                                          "snapshot_period_s", a.values.at("--period"));
+      try {
+        pixyslam::parameters::set_from_text(o, pixyslam::map_view::map_view_parameters(), "map_view",
+                                            "snapshot_period_s", a.values.at("--period"));
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string("--period: ") + e.what());
+      }
     }
     pixyslam::dds::resolve_settings(o.dds, a.has("--domain") ? std::vector<std::string>{pixyslam::dds::domain_override(a.values.at("--domain"))}
                                                    : std::vector<std::string>{});
@@ -148,7 +152,7 @@ int dispatch(const std::vector<std::string>& args) {
     r.out_given = a.has("--out-dir");
     r.out_dir = r.out_given ? a.values.at("--out-dir") : "";
     r.no_window = a.switches.count("--no-window") != 0;
-    pixyslam::app::print_effective_configuration("map_view", to_yaml(o));
+    if (a.switches.count("--verbose") != 0) pixyslam::app::print_effective_configuration("map_view", to_yaml(o));
     return run_live(o, r);
   }
   throw std::invalid_argument("unknown command '" + command + "'");
