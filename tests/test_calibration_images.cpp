@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "pixyslam/calibration/pole_images.h"
-#include "pixyslam/camera/synthetic_camera.h"
+#include "pixyslam/sim/synthetic_camera.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/pixy/pixy_options.h"
 
@@ -39,7 +39,7 @@ class CalibrationImages : public ::testing::Test {
 };
 
 TEST_F(CalibrationImages, RecoversTheFocalLengthFromPhotosOfAPole) {
-  camera::SyntheticCameraOptions lens;
+  sim::SyntheticCameraOptions lens;
   lens.camera = model_;
   lens.camera.focal_length_mm = 2.95;  // the true lens
   std::mt19937_64 rng(4);
@@ -47,9 +47,9 @@ TEST_F(CalibrationImages, RecoversTheFocalLengthFromPhotosOfAPole) {
   int k = 0;
   for (const double d : {0.5, 0.7, 1.0, 1.3, 1.6}) {
     for (const double bearing : {-0.3, 0.2}) {
-      const camera::SyntheticPole pole{1, d * std::cos(bearing), d * std::sin(bearing), 1, 2};
+      const sim::SyntheticPole pole{1, d * std::cos(bearing), d * std::sin(bearing), 1, 2};
       const cv::Mat photo =
-          camera::render_camera_image(slam::Pose2::Zero(), {pole}, lens, camera::default_detector_options(), rng);
+          sim::render_camera_image(slam::Pose2::Zero(), {pole}, lens, camera::default_detector_options(), rng);
       const std::string name = "pole" + std::to_string(k++) + ".png";
       ASSERT_TRUE(cv::imwrite(folder_ + "/" + name, photo));
       list += name + "," + std::to_string(d) + "," + std::to_string(bearing) + "\n";

@@ -10,13 +10,17 @@
 
 #include "camera_eval.h"
 #include "pixyslam/camera/colour_code_detector.h"
-#include "pixyslam/camera/synthetic_camera.h"
+#include "pixyslam/sim/synthetic_camera.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/pixy/pixy_options.h"
 #include "pixyslam/slam/slam_options_yaml.h"
 
 namespace pixyslam::camera {
 namespace {
+
+using sim::SyntheticPole;
+using sim::SyntheticCameraOptions;
+using sim::render_camera_image;
 
 pixy::PixyOptions shipped_pixy_options() {
   config::YamlReader root = config::YamlReader::from_file(std::string(PIXYSLAM_CONFIG_DIR) + "/pixy_bridge.yaml");

@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "pixyslam/camera/camera_byte_source.h"
-#include "pixyslam/camera/synthetic_camera.h"
+#include "pixyslam/sim/synthetic_camera.h"
 #include "pixyslam/camera/y4m_stream.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/pixy/pixy_block_parser.h"
@@ -23,6 +23,10 @@
 
 namespace pixyslam::camera {
 namespace {
+
+using sim::SyntheticPole;
+using sim::SyntheticCameraOptions;
+using sim::render_camera_image;
 
 cv::Mat random_image(int w, int h, std::uint64_t seed) {
   cv::Mat m(h, w, CV_8UC3);

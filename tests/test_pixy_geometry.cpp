@@ -68,6 +68,22 @@ TEST(PixyGeometry, BearingFollowsEquation6WithLeftPositive) {
   EXPECT_NEAR(bearing_rad(table2, 0.0), std::atan(2.43 / 2.0 / 2.8), 1e-15);
 }
 
+// The inverse (simulator, synthetic camera, calibration) and Eq. 5/6 undo
+// each other: range -> block height -> range, bearing -> column -> bearing.
+TEST(PixyGeometry, InverseOfEquations5And6RoundTrips) {
+  CameraModel c = paper_camera(0.08);
+  c.sensor_width_mm = 4.1;  // not square pixels: S_w must be the one used for columns
+  for (const double r : {0.2, 0.5, 1.0, 2.5, 7.0}) {
+    EXPECT_NEAR(range_m(c, block_height_px(c, r)), r, 1e-12 * r) << r;
+  }
+  for (const double phi : {-0.6, -0.1, 0.0, 0.05, 0.6}) {
+    EXPECT_NEAR(bearing_rad(c, block_x_px(c, phi)), phi, 1e-12) << phi;
+  }
+  EXPECT_DOUBLE_EQ(block_x_px(c, 0.0), 0.5 * c.image_width_px);  // straight ahead: the image centre
+  EXPECT_LT(block_x_px(c, 0.3), block_x_px(c, 0.0));  // left of the axis: smaller columns
+  EXPECT_NEAR(px_per_tan(c) * std::tan(0.3), 0.5 * c.image_width_px - block_x_px(c, 0.3), 1e-9);
+}
+
 TEST(PixyGeometry, AspectBoundsAreInclusive) {
   const CameraModel c = paper_camera(0.08);  // [2.0, 2.2]
   EXPECT_TRUE(aspect_ok(c, block(1, false, 160, 100, 10, 20)));   // 2.0

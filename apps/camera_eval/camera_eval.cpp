@@ -17,7 +17,7 @@ double EvalResult::detection_rate() const {
 }
 
 EvalResult evaluate(const EvalOptions& options, const pixy::SignatureMap& signatures, const pixy::CameraModel& model) {
-  std::vector<camera::SyntheticPole> poles;
+  std::vector<sim::SyntheticPole> poles;
   for (const sim::Pole& p : sim::place_poles(options.world)) {
     const auto sig = [&]() -> std::optional<std::uint16_t> {
       for (const auto& [s, id] : signatures.entries()) {
@@ -29,7 +29,7 @@ EvalResult evaluate(const EvalOptions& options, const pixy::SignatureMap& signat
     poles.push_back({p.id, p.x_m, p.y_m, *sig / 8, *sig % 8});
   }
   const sim::WorldRun run = sim::simulate(options.world);
-  camera::SyntheticCameraOptions camera_options = options.camera;
+  sim::SyntheticCameraOptions camera_options = options.camera;
   camera_options.camera = model;
   std::mt19937_64 rng(options.seed);
   EvalResult r;
@@ -46,14 +46,14 @@ EvalResult evaluate(const EvalOptions& options, const pixy::SignatureMap& signat
     if (truth.t_s + 1e-9 < next) continue;
     next += frame_dt;
     ++r.frames;
-    std::vector<camera::RenderedPole> drawn;
-    const cv::Mat image = camera::render_camera_image(slam::Pose2(truth.x_m, truth.y_m, truth.theta_rad), poles,
+    std::vector<sim::RenderedPole> drawn;
+    const cv::Mat image = sim::render_camera_image(slam::Pose2(truth.x_m, truth.y_m, truth.theta_rad), poles,
                                                       camera_options, options.detector, rng, &drawn);
     const auto begin = std::chrono::steady_clock::now();
     const std::vector<pixy::PixyBlock> blocks = camera::detect_colour_codes(image, options.detector);
     detect_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-    std::map<int, const camera::RenderedPole*> truth_of;
-    for (const camera::RenderedPole& d : drawn) truth_of[d.id] = &d;
+    std::map<int, const sim::RenderedPole*> truth_of;
+    for (const sim::RenderedPole& d : drawn) truth_of[d.id] = &d;
     std::map<int, bool> seen;
     slam::ObservationFrame frame{truth.t_s, {}};
     // The bridge's own checks (signature known, inside the image, aspect ratio, duplicates), Eq. 5 and 6.
@@ -75,7 +75,7 @@ EvalResult evaluate(const EvalOptions& options, const pixy::SignatureMap& signat
       }
     }
     if (!frame.detections.empty()) input.frames.push_back(frame);
-    for (const camera::RenderedPole& d : drawn) {
+    for (const sim::RenderedPole& d : drawn) {
       if (!d.in_image || d.occluded || d.range_m > options.max_range_m) continue;
       PoleStats& s = r.poles[d.id];
       ++s.in_view;
@@ -90,7 +90,7 @@ EvalResult evaluate(const EvalOptions& options, const pixy::SignatureMap& signat
   for (const eval::LandmarkRow& l : slam.landmarks) {
     ++r.map_landmarks;
     bool near_its_pole = false;
-    for (const camera::SyntheticPole& p : poles) {
+    for (const sim::SyntheticPole& p : poles) {
       if (p.id == l.id && std::hypot(p.x_m - l.x_m, p.y_m - l.y_m) <= 0.5) near_its_pole = true;
     }
     if (!near_its_pole) ++r.map_wrong_ids;

@@ -3,7 +3,7 @@
 #include <map>
 #include <string>
 
-#include "pixyslam/camera/synthetic_camera.h"
+#include "pixyslam/sim/synthetic_camera.h"
 #include "pixyslam/pixy/pixy_geometry.h"
 #include "pixyslam/sim/sim_world.h"
 #include "pixyslam/slam/slam_options.h"
@@ -15,7 +15,7 @@ namespace pixyslam::camera_eval {
 // ids and ranges the way the pixy bridge does (SignatureMap, Eq. 5 and 6).
 struct EvalOptions {
   sim::WorldOptions world;
-  camera::SyntheticCameraOptions camera;
+  sim::SyntheticCameraOptions camera;
   camera::DetectorOptions detector = camera::default_detector_options();
   double max_range_m = 2.0;  // poles beyond are too small to count as "in view" (a band under 5 px)
   std::uint64_t seed = 1;

@@ -15,7 +15,7 @@
 #include <csignal>
 
 #include "camera_video_fifo.h"
-#include "pixyslam/camera/synthetic_camera.h"
+#include "pixyslam/sim/synthetic_camera.h"
 #endif
 
 namespace pixyslam::robot_sim {
@@ -95,14 +95,14 @@ struct RobotSimNode::Impl {
   void render_frames(const HardwareOutput& out) {
     if (!video) return;
     for (const PixyFrameRecord& f : out.frames) {
-      const cv::Mat image = camera::render_camera_image(slam::Pose2(f.pose.x_m, f.pose.y_m, f.pose.theta_rad),
+      const cv::Mat image = sim::render_camera_image(slam::Pose2(f.pose.x_m, f.pose.y_m, f.pose.theta_rad),
                                                         camera_poles, camera_options, detector, camera_rng);
       video->write_frame(image);
     }
   }
-  camera::SyntheticCameraOptions camera_options;
+  sim::SyntheticCameraOptions camera_options;
   camera::DetectorOptions detector = camera::default_detector_options();
-  std::vector<camera::SyntheticPole> camera_poles;
+  std::vector<sim::SyntheticPole> camera_poles;
   std::mt19937_64 camera_rng{7};
   std::unique_ptr<CameraVideoFifo> video;
 #endif

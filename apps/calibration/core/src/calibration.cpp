@@ -114,7 +114,10 @@ CameraFit fit_camera(const std::vector<PoleSample>& samples, const pixy::CameraM
   }
   const double k = num / den;
   CameraFit fit;
-  fit.focal_length_mm = k * camera.sensor_height_mm / (camera.landmark_height_m * camera.image_height_px);
+  // Eq. 5 (h = block_height_px at 1 m / d) is linear in f: f = K / (its value for f = 1 mm).
+  pixy::CameraModel unit_focus = camera;
+  unit_focus.focal_length_mm = 1.0;
+  fit.focal_length_mm = k / pixy::block_height_px(unit_focus, 1.0);
   pixy::CameraModel fitted = camera;
   fitted.focal_length_mm = fit.focal_length_mm;
   // tan(phi_i) = c u_i, u_i = I_w/2 - x_i, c = S_w / (f I_w): least squares over samples off the axis.

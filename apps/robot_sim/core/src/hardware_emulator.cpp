@@ -186,10 +186,7 @@ void HardwareEmulator::emit_pixy_frame(HardwareOutput& out) {
   const pixy::CameraModel& cam = camera_;
   const double iw = cam.image_width_px;
   const double ih = cam.image_height_px;
-  // Pixels per unit of tan(bearing), and block sizes times range (px m).
-  const double px_per_tan = cam.focal_length_mm * iw / cam.sensor_width_mm;
-  const double height_px_m = cam.focal_length_mm * cam.landmark_height_m / cam.sensor_height_mm * ih;
-  const double width_px_m = cam.focal_length_mm * hw_.pole_width_m / cam.sensor_width_mm * iw;
+  const double width_px_m = hw_.pole_width_m * pixy::px_per_tan(cam);  // block width times range
   const double cos_t = std::cos(pose_.z());
   const double sin_t = std::sin(pose_.z());
 
@@ -219,9 +216,9 @@ void HardwareEmulator::emit_pixy_frame(HardwareOutput& out) {
       continue;
     }
     // The pole's image (Eq. 5 and 6 inverted), cut to the image.
-    const double h = height_px_m / s.noisy_range_m;
+    const double h = pixy::block_height_px(cam, s.noisy_range_m);
     const double w = width_px_m / s.noisy_range_m;
-    const double xc = 0.5 * iw - std::tan(s.noisy_bearing_rad) * px_per_tan;
+    const double xc = pixy::block_x_px(cam, s.noisy_bearing_rad);
     const double left_px = xc - 0.5 * w, right_px = xc + 0.5 * w;
     const double top_px = 0.5 * ih - 0.5 * h, bottom_px = 0.5 * ih + 0.5 * h;
     const double x0 = std::max(left_px, 0.0);

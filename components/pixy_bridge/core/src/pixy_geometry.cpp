@@ -52,6 +52,14 @@ void validate(const CameraModel& c) {
   }
 }
 
+double block_height_px(const CameraModel& c, double range) {
+  return c.focal_length_mm * c.landmark_height_m * c.image_height_px / (c.sensor_height_mm * range);
+}
+
+double px_per_tan(const CameraModel& c) { return c.focal_length_mm * c.image_width_px / c.sensor_width_mm; }
+
+double block_x_px(const CameraModel& c, double bearing) { return 0.5 * c.image_width_px - std::tan(bearing) * px_per_tan(c); }
+
 double range_sigma_m(const CameraModel& c, double range, double block_height_px) {
   const double proportional = c.range_sigma_fraction * range;
   const double pixel = block_height_px > 0.0 ? range * c.block_height_sigma_px / block_height_px : 0.0;

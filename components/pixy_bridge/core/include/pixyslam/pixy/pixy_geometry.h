@@ -67,6 +67,15 @@ double range_sigma_m(const CameraModel& camera, double range, double block_heigh
 // bearing, x = 0 gives +atan(S_w / (2 f)), the left edge of the field of view.
 double bearing_rad(const CameraModel& camera, double block_x_px);
 
+// The inverse of Eq. 5 and 6 (rendering a pole, simulating a camera):
+// Eq. 5 solved for the block height at `range_m`, h_s = f h_r I_h / (S_h r);
+double block_height_px(const CameraModel& camera, double range_m);
+// Eq. 6 solved for the column of a block at `bearing_rad`, x = I_w / 2 - tan(phi) f I_w / S_w;
+double block_x_px(const CameraModel& camera, double bearing_rad);
+// f I_w / S_w: pixels per unit of tan(bearing); an object w m wide at range r
+// spans w / r times this many columns.
+double px_per_tan(const CameraModel& camera);
+
 // Height/width ratio within [min_height_to_width, max_height_to_width]
 // (inclusive). False for a zero width or height.
 bool aspect_ok(const CameraModel& camera, const PixyBlock& block);

@@ -1,5 +1,8 @@
 #pragma once
 
+// The simulator's camera: renders the landmark poles as a camera at a pose
+// sees them (images for the camera backend's tests and robot_sim's video).
+
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -10,7 +13,7 @@
 #include "pixyslam/pixy/pixy_geometry.h"
 #include "pixyslam/slam/types.h"
 
-namespace pixyslam::camera {
+namespace pixyslam::sim {
 
 // A landmark pole for the synthetic camera: two colour bands, top and bottom
 // (signatures 1..7 of the detector's options), at (x, y) in the map frame.
@@ -46,7 +49,7 @@ struct RenderedPole {
 // band in its signature's hue with shading and noise. `detector` gives the
 // hues. Deterministic for a given rng state.
 cv::Mat render_camera_image(const slam::Pose2& pose, const std::vector<SyntheticPole>& poles,
-                            const SyntheticCameraOptions& options, const DetectorOptions& detector,
+                            const SyntheticCameraOptions& options, const camera::DetectorOptions& detector,
                             std::mt19937_64& rng, std::vector<RenderedPole>* drawn = nullptr);
 
-}  // namespace pixyslam::camera
+}  // namespace pixyslam::sim

@@ -1,15 +1,15 @@
-#include "pixyslam/camera/synthetic_camera.h"
+#include "pixyslam/sim/synthetic_camera.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include <opencv2/imgproc.hpp>
 
-namespace pixyslam::camera {
+namespace pixyslam::sim {
 namespace {
 
 // The middle of a signature's HSV box as a BGR colour, value scaled by `shade`.
-cv::Scalar signature_colour(const HsvRange& r, double shade) {
+cv::Scalar signature_colour(const camera::HsvRange& r, double shade) {
   const int h = r.h_min <= r.h_max ? (r.h_min + r.h_max) / 2 : ((r.h_min + r.h_max + 180) / 2) % 180;
   const int s = std::clamp((std::max(r.s_min, 100) + r.s_max) / 2 + 20, 0, 255);
   const int v = std::clamp(static_cast<int>(210 * shade), 0, 255);
@@ -22,7 +22,7 @@ cv::Scalar signature_colour(const HsvRange& r, double shade) {
 }  // namespace
 
 cv::Mat render_camera_image(const slam::Pose2& pose, const std::vector<SyntheticPole>& poles,
-                            const SyntheticCameraOptions& options, const DetectorOptions& detector,
+                            const SyntheticCameraOptions& options, const camera::DetectorOptions& detector,
                             std::mt19937_64& rng, std::vector<RenderedPole>* drawn) {
   const pixy::CameraModel& c = options.camera;
   const int w = c.image_width_px, h = c.image_height_px;
@@ -42,7 +42,7 @@ cv::Mat render_camera_image(const slam::Pose2& pose, const std::vector<Synthetic
     // Specks (removed by the detector's opening) and a few larger patches of
     // pole colours (blobs of their own; a pair stacked by chance is a false code).
     for (int k = 0; k < 44; ++k) {
-      const HsvRange& r = detector.signatures[static_cast<std::size_t>(byte(rng) % 6)];
+      const camera::HsvRange& r = detector.signatures[static_cast<std::size_t>(byte(rng) % 6)];
       const int side = k < 40 ? 2 : 5;
       cv::rectangle(image, cv::Rect(byte(rng) * w / 256, h / 2 + byte(rng) * (h / 2) / 256, side, side),
                     signature_colour(r, 1.0), cv::FILLED);
@@ -64,10 +64,9 @@ cv::Mat render_camera_image(const slam::Pose2& pose, const std::vector<Synthetic
     q.info.range_m = std::hypot(fwd, left);
     q.info.bearing_rad = std::atan2(left, fwd);
     // Eq. 6 solved for the column, Eq. 5 for the height; width by the same horizontal scale.
-    const double px_per_tan = c.focal_length_mm * c.image_width_px / c.sensor_width_mm;
-    const double cx = 0.5 * w - std::tan(q.info.bearing_rad) * px_per_tan;
-    const double height = c.focal_length_mm * c.landmark_height_m * c.image_height_px / (c.sensor_height_mm * q.info.range_m);
-    const double width = options.pole_width_m / q.info.range_m * px_per_tan;
+    const double cx = pixy::block_x_px(c, q.info.bearing_rad);
+    const double height = pixy::block_height_px(c, q.info.range_m);
+    const double width = options.pole_width_m / q.info.range_m * pixy::px_per_tan(c);
     const int top = static_cast<int>(std::lround(0.5 * h - 0.5 * height));
     const int bottom = static_cast<int>(std::lround(0.5 * h + 0.5 * height));
     const int x0 = static_cast<int>(std::lround(cx - 0.5 * width));
@@ -109,4 +108,4 @@ cv::Mat render_camera_image(const slam::Pose2& pose, const std::vector<Synthetic
   return image;
 }
 
-}  // namespace pixyslam::camera
+}  // namespace pixyslam::sim
