@@ -179,6 +179,9 @@ int main(int argc, char** argv) {
       throw std::invalid_argument("unknown command '" + command + "'");
     }
     a = parse(command, args);
+    if (command == "info" || command == "check" || command == "compare" || command == "print") {
+      app::require_files(a.positional);
+    }
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, PIXYSLAM_TOOL_NAME ": %s\n%s", e.what(), kUsage);
     return 2;

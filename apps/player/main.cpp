@@ -35,7 +35,7 @@ constexpr const char* kUsage =
     "  --restamp         shift header stamps onto the current clock (for a live estimator)\n"
     "  --wait-readers N  wait for N readers per topic before playing (default 1; 0: do not wait)\n"
     "  --wait-timeout S  then play anyway (default 10)\n"
-    "  --config FILE YAML with a dds: mapping (default " PIXYSLAM_DEFAULT_PROFILES_FILE ", domain 0)\n"
+    "  --config FILE     YAML with a dds: mapping (default " PIXYSLAM_DEFAULT_PROFILES_FILE ", domain 0)\n"
     "  --domain N        overrides the domain id\n"
     "  --quiet           no progress lines\n";
 
@@ -96,6 +96,7 @@ pixyslam::player::PlayerOptions parse(const std::vector<std::string>& args) {
     }
   }
   if (o.files.empty()) throw std::invalid_argument("no MCAP file given");
+  app::require_files(o.files);
   player::validate(o.playback);
   o.dds = dds::read_dds_options_file(dds_config, PIXYSLAM_DEFAULT_PROFILES_FILE);
   dds::resolve_settings(o.dds, dds_overrides);

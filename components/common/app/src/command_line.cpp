@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <stdexcept>
 
 namespace pixyslam::app {
@@ -43,6 +44,13 @@ double CommandLine::number(const std::string& flag, double fallback) const {
     throw UsageError("--" + flag + ": not a number: '" + it->second + "'");
   }
   return v;
+}
+
+void require_files(const std::vector<std::string>& files) {
+  for (const std::string& f : files) {
+    std::error_code ec;
+    if (!std::filesystem::exists(f, ec)) throw UsageError(f + ": no such file");
+  }
 }
 
 std::string folder_of(const std::string& path) {

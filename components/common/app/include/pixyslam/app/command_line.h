@@ -40,6 +40,10 @@ class CommandLine {
 // returns 0; otherwise returns nullopt (go on).
 std::optional<int> usage_exit(const std::vector<std::string>& args, const char* usage);
 
+// Throws UsageError "<file>: no such file" for the first of `files` that does
+// not exist (an input named on the command line: exit 2, as any usage error).
+void require_files(const std::vector<std::string>& files);
+
 // Folder of a file path ("." for a bare file name), for resolving paths that a
 // config file gives relative to itself.
 std::string folder_of(const std::string& path);
