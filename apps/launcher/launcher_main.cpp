@@ -56,77 +56,150 @@ std::string default_run_dir() {
   return (std::filesystem::current_path() / "pixyslam_runs" / stamp).string();
 }
 
-// Forwards output until `until` or a stop; returns false if the run must end
-// early (stop requested, or a process ended: `failed` tells whether badly).
-std::unique_ptr<launcher::HealthMonitor> health;
-
-void print_health() {
-  if (!health) return;
-  for (const std::string& event : health->take_events()) std::printf("[health] %s\n", event.c_str());
-  std::fflush(stdout);
-}
-
-// Optional processes that failed, waiting for their restart.
-struct Restart {
-  launcher::ProcessSpec spec;
-  Clock::time_point at;
-};
-std::vector<Restart> restarts;
-std::map<std::string, int> failures;  // per optional process name
-
 // Back-off before restart n (1, 2, ...): 1, 2, 4, ... 30 s.
 double restart_delay_s(int n) { return std::min(30.0, static_cast<double>(1 << std::min(n - 1, 5))); }
 
-void start_due_restarts(launcher::ProcessGroup& group) {
-  for (auto it = restarts.begin(); it != restarts.end();) {
-    if (Clock::now() < it->at) {
-      ++it;
-      continue;
-    }
-    std::printf("[launch] restarting %s (restart %d)\n", it->spec.name.c_str(), failures[it->spec.name]);
-    try {
-      group.start(it->spec);
-    } catch (const std::exception& e) {
-      std::printf("[launch] %s: %s\n", it->spec.name.c_str(), e.what());
-    }
-    it = restarts.erase(it);
-  }
+Clock::duration seconds(double s) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
 }
 
-bool supervise(launcher::ProcessGroup& group, Clock::time_point until, bool& failed, bool& finished) {
-  while (Clock::now() < until) {
-    print_health();
-    for (std::size_t i : group.poll(std::chrono::milliseconds(100))) {
-      const launcher::ExitStatus& status = group.status(i);
-      const launcher::ProcessSpec& spec = group.spec(i);
-      std::printf("[launch] %s ended: %s\n", spec.name.c_str(), status.describe().c_str());
-      if (!status.ok() && spec.optional && status.exited && status.code == 2) {
-        std::printf("[launch] %s is optional: the run goes on; not restarted (exit code 2: a usage or "
-                    "configuration error)\n", spec.name.c_str());
-        continue;
+// One run of a launch plan: starts its processes (each after its delay),
+// supervises them (an optional one that fails is restarted with back-off, an
+// essential one's failure stops the run, as does an ends_run process's exit,
+// the duration or a signal), stops them all, runs the after-run steps and
+// prints the summary. Single-threaded; run() once.
+class LaunchSession {
+ public:
+  LaunchSession(launcher::LaunchPlan plan, const std::string& bin_dir,
+                std::unique_ptr<launcher::HealthMonitor> health)
+      : plan_(std::move(plan)), group_(bin_dir, stdout), health_(std::move(health)) {}
+
+  // The exit status: 0 only if every process ended cleanly.
+  int run(const std::string& run_dir) {
+    bool running = true;
+    for (const launcher::ProcessSpec& spec : plan_.processes) {
+      if (spec.delay_s > 0) {
+        running = supervise(Clock::now() + seconds(spec.delay_s));
+        if (!running) break;
       }
-      if (!status.ok() && spec.optional && !app::StopSignal::requested()) {
-        const int n = ++failures[spec.name];
-        const double delay = restart_delay_s(n);
-        std::printf("[launch] %s is optional: the run goes on; restart in %.0f s\n", spec.name.c_str(), delay);
-        restarts.push_back({spec, Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                     std::chrono::duration<double>(delay))});
-        continue;
-      }
-      if (!status.ok()) {
-        failed = true;
-        return false;
-      }
-      if (spec.ends_run) {
-        finished = true;
-        return false;
-      }
+      group_.start(spec);
     }
-    if (app::StopSignal::requested()) return false;
-    start_due_restarts(group);
+    const auto started = Clock::now();
+    if (running) supervise(plan_.duration_s > 0 ? started + seconds(plan_.duration_s) : Clock::time_point::max());
+    std::printf("[launch] stopping after %.1f s%s\n", std::chrono::duration<double>(Clock::now() - started).count(),
+                app::StopSignal::requested() ? " (signal)" : failed_ ? " (a process failed)" : "");
+    std::fflush(stdout);
+    group_.stop_all(std::chrono::milliseconds(static_cast<long>(plan_.stop_timeout_s * 1000)));
+    run_after_steps();
+    return summary(run_dir);
   }
-  return true;
-}
+
+ private:
+  // Forwards output until `until` or a stop; returns false if the run must end
+  // early (stop requested, or a process ended: failed_ tells whether badly).
+  bool supervise(Clock::time_point until) {
+    while (Clock::now() < until) {
+      print_health();
+      for (std::size_t i : group_.poll(std::chrono::milliseconds(100))) {
+        if (!on_exit(group_.status(i), group_.spec(i))) return false;
+      }
+      if (app::StopSignal::requested()) return false;
+      start_due_restarts();
+    }
+    return true;
+  }
+
+  // A process ended; false if the run ends with it.
+  bool on_exit(const launcher::ExitStatus& status, const launcher::ProcessSpec& spec) {
+    std::printf("[launch] %s ended: %s\n", spec.name.c_str(), status.describe().c_str());
+    if (!status.ok() && spec.optional && status.exited && status.code == 2) {
+      std::printf("[launch] %s is optional: the run goes on; not restarted (exit code 2: a usage or "
+                  "configuration error)\n", spec.name.c_str());
+      return true;
+    }
+    if (!status.ok() && spec.optional && !app::StopSignal::requested()) {
+      const double delay = restart_delay_s(++failures_[spec.name]);
+      std::printf("[launch] %s is optional: the run goes on; restart in %.0f s\n", spec.name.c_str(), delay);
+      restarts_.push_back({spec, Clock::now() + seconds(delay)});
+      return true;
+    }
+    if (!status.ok()) {
+      failed_ = true;
+      return false;
+    }
+    return !spec.ends_run;
+  }
+
+  void start_due_restarts() {
+    for (auto it = restarts_.begin(); it != restarts_.end();) {
+      if (Clock::now() < it->at) {
+        ++it;
+        continue;
+      }
+      std::printf("[launch] restarting %s (restart %d)\n", it->spec.name.c_str(), failures_[it->spec.name]);
+      try {
+        group_.start(it->spec);
+      } catch (const std::exception& e) {
+        std::printf("[launch] %s: %s\n", it->spec.name.c_str(), e.what());
+      }
+      it = restarts_.erase(it);
+    }
+  }
+
+  // Evaluation and the like, one after another, also after a Ctrl-C (a run on
+  // a host without an ends_run process ends that way); a second one skips them.
+  void run_after_steps() {
+    const int signals_before = app::StopSignal::signal_count();
+    auto skipped = [&] { return signals_before > 1 || app::StopSignal::signal_count() > signals_before; };
+    if (signals_before == 1 && !plan_.after_run.empty()) {
+      std::printf("[launch] after-run steps (Ctrl-C again to skip them)\n");
+      std::fflush(stdout);
+    }
+    for (const launcher::ProcessSpec& spec : plan_.after_run) {
+      if (skipped()) break;
+      group_.start(spec);
+      while (group_.running(group_.size() - 1) && !skipped()) group_.poll(std::chrono::milliseconds(100));
+      if (group_.running(group_.size() - 1)) group_.stop_all(std::chrono::seconds(5));
+    }
+  }
+
+  int summary(const std::string& run_dir) {
+    int bad = 0;
+    std::printf("[launch] summary:\n");
+    for (std::size_t i = 0; i < group_.size(); ++i) {
+      const launcher::ExitStatus& status = group_.status(i);
+      const launcher::ProcessSpec& spec = group_.spec(i);
+      std::printf("[launch]   %-16s %s%s%s\n", spec.name.c_str(), status.describe().c_str(),
+                  status.ok() ? "" : "  <- FAILED", spec.optional && !status.ok() ? " (optional)" : "");
+      if (!status.ok()) ++bad;
+    }
+    print_health();
+    if (health_) std::printf("[launch] health: %d process(es) lost on the domain during the run\n", health_->lost());
+    health_.reset();
+    std::printf("[launch] run folder: %s\n", run_dir.c_str());
+    std::fflush(stdout);
+    return bad == 0 && !failed_ ? 0 : 1;
+  }
+
+  void print_health() {
+    if (!health_) return;
+    for (const std::string& event : health_->take_events()) std::printf("[health] %s\n", event.c_str());
+    std::fflush(stdout);
+  }
+
+  // An optional process that failed, waiting for its restart.
+  struct Restart {
+    launcher::ProcessSpec spec;
+    Clock::time_point at;
+  };
+
+  launcher::LaunchPlan plan_;
+  launcher::ProcessGroup group_;
+  std::unique_ptr<launcher::HealthMonitor> health_;
+  std::vector<Restart> restarts_;
+  std::map<std::string, int> failures_;  // per optional process name
+  bool failed_ = false;
+};
 
 struct LaunchCommandLine {
   std::string launch_file;
@@ -148,6 +221,7 @@ int run(const LaunchCommandLine& args, const std::map<std::string, std::string>&
       {"run_dir", std::filesystem::absolute(run_dir).string()}};
   if (!args.input.empty()) variables["input"] = std::filesystem::absolute(args.input).string();
   launcher::LaunchPlan plan = launcher::read_launch_plan(launch_file, variables, given);
+  std::unique_ptr<launcher::HealthMonitor> health;
   if (show_args) {
     std::fputs(launcher::arguments_text(plan).c_str(), stdout);
     return 0;
@@ -183,63 +257,7 @@ int run(const LaunchCommandLine& args, const std::map<std::string, std::string>&
               run_dir.c_str(), duration);
   std::fflush(stdout);
 
-  launcher::ProcessGroup group(bin_dir, stdout);
-  bool failed = false;
-  bool finished = false;
-  bool running = true;
-  for (const launcher::ProcessSpec& spec : plan.processes) {
-    if (spec.delay_s > 0) {
-      running = supervise(group, Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                    std::chrono::duration<double>(spec.delay_s)),
-                          failed, finished);
-      if (!running) break;
-    }
-    group.start(spec);
-  }
-  const auto started = Clock::now();
-  if (running) {
-    const auto until = plan.duration_s > 0
-                           ? started + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(plan.duration_s))
-                           : Clock::time_point::max();
-    supervise(group, until, failed, finished);
-  }
-  std::printf("[launch] stopping after %.1f s%s\n",
-              std::chrono::duration<double>(Clock::now() - started).count(),
-              app::StopSignal::requested() ? " (signal)" : failed ? " (a process failed)" : "");
-  std::fflush(stdout);
-  group.stop_all(std::chrono::milliseconds(static_cast<long>(plan.stop_timeout_s * 1000)));
-
-  // Evaluation and the like, one after another, also after a Ctrl-C (a run on
-  // a host without an ends_run process ends that way); a second one skips them.
-  const int signals_before = app::StopSignal::signal_count();
-  auto skipped = [&] { return signals_before > 1 || app::StopSignal::signal_count() > signals_before; };
-  if (signals_before == 1 && !plan.after_run.empty()) {
-    std::printf("[launch] after-run steps (Ctrl-C again to skip them)\n");
-    std::fflush(stdout);
-  }
-  for (const launcher::ProcessSpec& spec : plan.after_run) {
-    if (skipped()) break;
-    group.start(spec);
-    while (group.running(group.size() - 1) && !skipped()) group.poll(std::chrono::milliseconds(100));
-    if (group.running(group.size() - 1)) group.stop_all(std::chrono::seconds(5));
-  }
-
-  int bad = 0;
-  std::printf("[launch] summary:\n");
-  for (std::size_t i = 0; i < group.size(); ++i) {
-    const launcher::ExitStatus& status = group.status(i);
-    const launcher::ProcessSpec& spec = group.spec(i);
-    std::printf("[launch]   %-16s %s%s%s\n", spec.name.c_str(), status.describe().c_str(),
-                status.ok() ? "" : "  <- FAILED", spec.optional && !status.ok() ? " (optional)" : "");
-    if (!status.ok()) ++bad;
-  }
-  print_health();
-  if (health) std::printf("[launch] health: %d process(es) lost on the domain during the run\n", health->lost());
-  health.reset();
-  std::printf("[launch] run folder: %s\n", run_dir.c_str());
-  std::fflush(stdout);
-  return bad == 0 && !failed ? 0 : 1;
+  return LaunchSession(std::move(plan), bin_dir, std::move(health)).run(run_dir);
 }
 
 }  // namespace
