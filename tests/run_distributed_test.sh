@@ -156,11 +156,11 @@ if [[ $profile == secure ]]; then
   sleep 4
   ip netns exec "${tag}_$log_host" env PIXYSLAM_DDS_PROFILE=lan_peers PIXYSLAM_DDS_INTERFACES=$log_addr \
     PIXYSLAM_DDS_PEERS=10.200.$net.1,$log_addr \
-    "$bin/pixyslam_spy" echo pixyslam/odometry --count 1 --seconds 5 > "$work/intruder_plain.txt" 2>&1 &
+    "$bin/pixyslam_spy" echo pixyslam/odometry --count 1 --duration 5 > "$work/intruder_plain.txt" 2>&1 &
   plain=$!
   ip netns exec "${tag}_$log_host" env PIXYSLAM_DDS_PROFILE=secure PIXYSLAM_DDS_SECURITY_DIR="$work/intruder" \
     PIXYSLAM_DDS_INTERFACES=$log_addr PIXYSLAM_DDS_PEERS=10.200.$net.1,$log_addr \
-    "$bin/pixyslam_spy" echo pixyslam/odometry --count 1 --seconds 5 > "$work/intruder_ca.txt" 2>&1 &
+    "$bin/pixyslam_spy" echo pixyslam/odometry --count 1 --duration 5 > "$work/intruder_ca.txt" 2>&1 &
   other_ca=$!
   plain_status=0; wait "$plain" || plain_status=$?
   ca_status=0; wait "$other_ca" || ca_status=$?
@@ -174,7 +174,7 @@ if [[ $profile == discovery_client ]]; then
   robot_env+=(PIXYSLAM_DDS_SERVER=10.200.$net.3:11811 PIXYSLAM_DDS_TYPE_INFORMATION=false)
 fi
 if [[ $profile == secure ]]; then robot_env+=(PIXYSLAM_DDS_SECURITY_DIR=$work/security); fi
-ip netns exec "${tag}_robot" env "${robot_env[@]}" "$bin/pixyslam_spy" hz pixyslam/odometry --seconds 60 \
+ip netns exec "${tag}_robot" env "${robot_env[@]}" "$bin/pixyslam_spy" hz pixyslam/odometry --duration 60 \
   > "$work/doomed.log" 2>&1 &
 doomed=$!
 pids+=($doomed)

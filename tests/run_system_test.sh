@@ -33,7 +33,7 @@ topics=(odometry landmark_observation map_state ground_truth)
 sleep 8
 echoes=()
 for t in "${topics[@]}"; do
-  "$bin/pixyslam_spy" echo "pixyslam/$t" --json --count 20 --seconds 20 \
+  "$bin/pixyslam_spy" echo "pixyslam/$t" --json --count 20 --duration 20 \
     --config "$work/config/slam_estimator.yaml" > "$work/echo_$t.jsonl" 2> "$work/echo_$t.err" &
   echoes+=($!)
 done

@@ -35,12 +35,12 @@ done
 grep -q "publishing on domain" "$work/publisher.log" || { cat "$work/publisher.log"; fail "publisher did not start"; }
 
 echo "== participants"
-"$spy" participants --config "$cfg" --seconds 4 | tee "$work/participants.txt"
+"$spy" participants --config "$cfg" --duration 4 | tee "$work/participants.txt"
 grep -Eq "^spy_test_publisher +[0-9a-f.]+ +$(hostname | cut -c1-15)[^ ]* +$pub_pid +spy_test_publis" \
   "$work/participants.txt" || fail "participants does not show spy_test_publisher with pid $pub_pid"
 
 echo "== echo --json --count 3"
-"$spy" echo pixyslam/odometry --config "$cfg" --json --count 3 --seconds 20 | tee "$work/echo.json"
+"$spy" echo pixyslam/odometry --config "$cfg" --json --count 3 --duration 20 | tee "$work/echo.json"
 [[ $(wc -l < "$work/echo.json") -eq 3 ]] || fail "expected 3 JSON lines"
 previous=0
 while IFS= read -r line; do
@@ -55,7 +55,7 @@ expected
 done < "$work/echo.json"
 
 echo "== echo (YAML) --count 1"
-"$spy" echo pixyslam/odometry --domain "$domain" --count 1 --seconds 20 | tee "$work/echo.yaml"
+"$spy" echo pixyslam/odometry --domain "$domain" --count 1 --duration 20 | tee "$work/echo.yaml"
 seq=$(grep -oE '^  seq: [0-9]+' "$work/echo.yaml" | grep -oE '[0-9]+')
 [[ -n "$seq" ]] || fail "no header.seq in the YAML document"
 grep -qx -- "---" "$work/echo.yaml" || fail "no YAML document start"
@@ -63,23 +63,23 @@ grep -qx "v_mps: $seq.5" "$work/echo.yaml" || fail "v_mps of seq $seq"
 grep -qx "encoder_samples: $((seq + 3))" "$work/echo.yaml" || fail "encoder_samples of seq $seq"
 
 echo "== echo of a kept history (30 MapStates, transient local) --count 1: the newest"
-"$spy" echo pixyslam/map_state --domain "$domain" --json --count 1 --seconds 20 | tee "$work/map.json"
+"$spy" echo pixyslam/map_state --domain "$domain" --json --count 1 --duration 20 | tee "$work/map.json"
 grep -q '"seq":30,' "$work/map.json" || fail "echo printed another MapState than the newest (seq 30)"
 
 echo "== topics"
-"$spy" topics --config "$cfg" --seconds 4 | tee "$work/topics.txt"
+"$spy" topics --config "$cfg" --duration 4 | tee "$work/topics.txt"
 grep -q "^pixyslam/odometry  \[pixyslam::msg::Odometry\]" "$work/topics.txt" || fail "topics: no odometry topic"
 grep -Eq "^  writer +spy_test_publisher \(pid $pub_pid\) +reliable +volatile +history keep_all" "$work/topics.txt" \
   || fail "topics: no writer line of the publisher"
 
 echo "== hz"
-"$spy" hz pixyslam/odometry --config "$cfg" --seconds 2 | tee "$work/hz.txt"
+"$spy" hz pixyslam/odometry --config "$cfg" --duration 2 | tee "$work/hz.txt"
 rate=$(grep -oE 'rate [0-9.]+' "$work/hz.txt" | grep -oE '[0-9.]+' || true)
 [[ -n "$rate" ]] || fail "hz printed no rate"
 awk -v r="$rate" 'BEGIN { exit !(r > 5 && r < 40) }' || fail "hz rate $rate Hz not near 20 Hz"
 
 echo "== unknown topic"
 status=0
-"$spy" echo pixyslam/nothing --config "$cfg" --count 1 --seconds 1 2>/dev/null || status=$?
+"$spy" echo pixyslam/nothing --config "$cfg" --count 1 --duration 1 2>/dev/null || status=$?
 [[ $status -eq 2 ]] || fail "unknown topic gave exit status $status, expected 2"
 echo "PASS"

@@ -1,9 +1,9 @@
 // pixyslam_spy: one inspection tool for the live system and its recordings,
 // decoding with the project's own types (no XTypes needed).
-//   pixyslam_spy participants | topics                     [DDS options] [--seconds N]
-//   pixyslam_spy echo TOPIC [--json] [--count N] [--seconds N] [DDS options]
-//   pixyslam_spy hz TOPIC [--seconds N]                    [DDS options]
-//   pixyslam_spy diagnostics [--seconds N]                 [DDS options]
+//   pixyslam_spy participants | topics                     [DDS options] [--duration S]
+//   pixyslam_spy echo TOPIC [--json] [--count N] [--duration S] [DDS options]
+//   pixyslam_spy hz TOPIC [--duration S]                    [DDS options]
+//   pixyslam_spy diagnostics [--duration S]                 [DDS options]
 //   pixyslam_spy info FILE.mcap
 //   pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]
 //   pixyslam_spy print FILE.mcap [--topic T] [--json]
@@ -42,11 +42,11 @@
 namespace {
 
 constexpr const char* kUsage =
-    "usage: " PIXYSLAM_TOOL_NAME " participants [--seconds N] [DDS options]\n"
-    "       " PIXYSLAM_TOOL_NAME " topics [--seconds N] [DDS options]\n"
-    "       " PIXYSLAM_TOOL_NAME " echo TOPIC [--json] [--count N] [--seconds N] [DDS options]\n"
-    "       " PIXYSLAM_TOOL_NAME " hz TOPIC [--seconds N] [DDS options]\n"
-    "       " PIXYSLAM_TOOL_NAME " diagnostics [--seconds N] [DDS options]\n"
+    "usage: " PIXYSLAM_TOOL_NAME " participants [--duration S] [DDS options]\n"
+    "       " PIXYSLAM_TOOL_NAME " topics [--duration S] [DDS options]\n"
+    "       " PIXYSLAM_TOOL_NAME " echo TOPIC [--json] [--count N] [--duration S] [DDS options]\n"
+    "       " PIXYSLAM_TOOL_NAME " hz TOPIC [--duration S] [DDS options]\n"
+    "       " PIXYSLAM_TOOL_NAME " diagnostics [--duration S] [DDS options]\n"
     "       " PIXYSLAM_TOOL_NAME " info FILE.mcap\n"
     "       " PIXYSLAM_TOOL_NAME " check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]\n"
     "       " PIXYSLAM_TOOL_NAME " print FILE.mcap [--topic TOPIC] [--json]\n"
@@ -111,7 +111,7 @@ Arguments parse(const std::string& command, const std::vector<std::string>& args
       a.dds_config = value();
     } else if (live && arg == "--domain") {
       a.dds_overrides.push_back(pixyslam::dds::domain_override(value()));
-    } else if (live && arg == "--seconds") {
+    } else if (live && arg == "--duration") {
       a.seconds = non_negative_number(arg, value());
     } else if (command == "echo" && arg == "--count") {
       const double c = non_negative_number(arg, value());
