@@ -6,7 +6,7 @@
 # ends by itself after two laps (~90 s) and prints the pose and landmark errors,
 # messages per topic and where the MCAP log is. Exit code 0 only if every
 # process ended cleanly and the ATE is under 0.10 m.
-#   scripts/run_demo.sh [--run-dir DIR] [any other pixyslam_launch option, e.g. --duration S]
+#   scripts/run_demo.sh [--run-dir DIR] [any pixyslam_launch argument, e.g. particles:=300 duration:=30]
 # The run folder (default build/demo_run) is emptied first.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
