@@ -268,28 +268,27 @@ int main(int argc, char** argv) {
   // it has stopped its children (they get the default back).
   signal(SIGPIPE, SIG_IGN);
   LaunchCommandLine args;
-  CLI::App cli{"Starts the processes of a launch file, forwards their output with a prefix, stops them all on "
+  app::Cli cli{"pixyslam_launch", "Starts the processes of a launch file, forwards their output with a prefix, stops them all on "
                "Ctrl-C, after the duration or when a process marked ends_run finishes, then runs the after_run "
-               "steps. Exit code 0 only if every process ended cleanly.",
-               "pixyslam_launch"};
-  cli.add_option("launch_file", args.launch_file, "e.g. config/launch_sim.yaml")->required()->check(CLI::ExistingFile)
-      ->type_name("LAUNCH.yaml");
-  cli.add_option("arguments", args.arguments, "launch arguments, e.g. particles:=300 duration:=30 (--show-args)")
-      ->type_name("NAME:=VALUE");
-  cli.add_option("--run-dir", args.run_dir, "the run's folder (${run_dir}; default ./pixyslam_runs/<time>)")
-      ->type_name("DIR");
-  cli.add_option("--duration", args.duration_s, "the same as duration:=S")->type_name("S")->check(CLI::Range(0.0, 1e6));
-  cli.add_option("--input", args.input, "defines ${input} (e.g. the log launch_replay.yaml plays)")->type_name("FILE");
-  auto* deployment = cli.add_option("--deployment", args.deployment,
+               "steps. Exit code 0 only if every process ended cleanly."};
+  cli.option("launch_file", args.launch_file, "e.g. config/launch_sim.yaml").required().existing_file()
+      .type("LAUNCH.yaml");
+  cli.option("arguments", args.arguments, "launch arguments, e.g. particles:=300 duration:=30 (--show-args)")
+      .type("NAME:=VALUE");
+  cli.option("--run-dir", args.run_dir, "the run's folder (${run_dir}; default ./pixyslam_runs/<time>)")
+      .type("DIR");
+  cli.option("--duration", args.duration_s, "the same as duration:=S").type("S").range(0.0, 1e6);
+  cli.option("--input", args.input, "defines ${input} (e.g. the log launch_replay.yaml plays)").type("FILE");
+  app::Cli::Option& deployment = cli.option("--deployment", args.deployment,
                                     "a deployment file: run one host's share with its DDS settings "
                                     "(docs/deployment.md)")
-                         ->type_name("DEPLOY.yaml")
-                         ->check(CLI::ExistingFile);
-  auto* host = cli.add_option("--host", args.host, "the host of the deployment this is")->type_name("NAME");
-  deployment->needs(host);
-  host->needs(deployment);
-  cli.add_flag("--show-args", args.show_args, "the file's launch arguments, their defaults and help; starts nothing");
-  if (const auto done = app::parse(cli, argc, argv)) return *done;
+                         .type("DEPLOY.yaml")
+                         .existing_file();
+  app::Cli::Option& host = cli.option("--host", args.host, "the host of the deployment this is").type("NAME");
+  deployment.needs(host);
+  host.needs(deployment);
+  cli.flag("--show-args", args.show_args, "the file's launch arguments, their defaults and help; starts nothing");
+  if (const auto done = cli.parse(argc, argv)) return *done;
   try {
     for (const std::string& word : args.arguments) {
       if (word.find(":=") == std::string::npos) {

@@ -170,24 +170,23 @@ int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
   sim_evaluator::Arguments args;
-  CLI::App cli{"Scores a live run against the simulator's ground truth when stopped (SIGINT/SIGTERM): pose ATE, "
-               "heading and landmark RMSE of the filter and of the map optimiser's newest solution.",
-               "sim_evaluator"};
-  cli.add_option("--config", args.config, "a YAML with a dds: mapping (e.g. config/slam_estimator.yaml)")
-      ->check(CLI::ExistingFile)
-      ->type_name("FILE");
-  cli.add_option_function<std::string>(
+  app::Cli cli{"sim_evaluator", "Scores a live run against the simulator's ground truth when stopped (SIGINT/SIGTERM): pose ATE, "
+               "heading and landmark RMSE of the filter and of the map optimiser's newest solution."};
+  cli.option("--config", args.config, "a YAML with a dds: mapping (e.g. config/slam_estimator.yaml)")
+      .existing_file()
+      .type("FILE");
+  cli.option_each(
          "--domain", [&](const std::string& d) { args.dds_overrides.push_back(pixyslam::dds::domain_override(d)); },
          "DDS domain (overrides the config's and PIXYSLAM_DDS_DOMAIN)")
-      ->type_name("N");
-  cli.add_option("--out-dir", args.out_dir, "write DIR/trajectory.csv and DIR/ground_truth.csv")->type_name("DIR");
-  cli.add_option("--max-ate", args.max_ate_m, "exit 1 if the pose ATE is above M (0: no check)")
-      ->type_name("M")
-      ->check(CLI::NonNegativeNumber);
-  cli.add_option("--max-optimised-ratio", args.max_optimised_ratio,
+      .type("N");
+  cli.option("--out-dir", args.out_dir, "write DIR/trajectory.csv and DIR/ground_truth.csv").type("DIR");
+  cli.option("--max-ate", args.max_ate_m, "exit 1 if the pose ATE is above M (0: no check)")
+      .type("M")
+      .non_negative();
+  cli.option("--max-optimised-ratio", args.max_optimised_ratio,
                  "exit 1 if no OptimisedMap arrived or its landmark RMSE is above R times the filter's")
-      ->type_name("R")
-      ->check(CLI::NonNegativeNumber);
-  if (const auto done = app::parse(cli, argc, argv)) return *done;
+      .type("R")
+      .non_negative();
+  if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("sim_evaluator", [&] { return sim_evaluator::run(args); });
 }

@@ -19,15 +19,14 @@ int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();  // first: every thread inherits the blocked signals
   bridge::BridgeCommandLine args;
-  CLI::App cli{"The Arduino's wheel-encoder lines (serial) -> Odometry over DDS, until SIGINT/SIGTERM.",
-               "encoder_bridge"};
+  app::Cli cli{"encoder_bridge", "The Arduino's wheel-encoder lines (serial) -> Odometry over DDS, until SIGINT/SIGTERM."};
   bridge::add_bridge_flags(cli, args, "config/encoder_bridge.yaml: encoder_bridge:, node:, dds:",
                            "encoder_bridge.publish_rate_hz=20");
   cli.footer("encoder parameters (encoder_bridge:):\n" +
              parameters::help_text(encoder::encoder_parameters(), "encoder_bridge") +
              "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
              parameters::help_text(pixyslam::dds::dds_parameters(), "dds"));
-  if (const auto done = app::parse(cli, argc, argv)) return *done;
+  if (const auto done = cli.parse(argc, argv)) return *done;
 
   encoder_node::EncoderNodeOptions options;
   const std::optional<int> bad = app::configure("encoder_bridge", [&] {

@@ -34,26 +34,26 @@ int main(int argc, char** argv) {
   std::string config, out, topics;
   std::vector<std::string> overrides;
   bool verbose = false;
-  CLI::App cli{"Records DDS topics to an MCAP file until SIGINT/SIGTERM.", "logger"};
+  app::Cli cli{"logger", "Records DDS topics to an MCAP file until SIGINT/SIGTERM."};
   app::add_config(cli, config, "config/logger.yaml: logger:, dds:");
-  cli.add_option("--out", out, "the recording (overrides logger.output_file)")->type_name("FILE.mcap");
-  cli.add_option("--topics", topics,
+  cli.option("--out", out, "the recording (overrides logger.output_file)").type("FILE.mcap");
+  cli.option("--topics", topics,
                  "topics to record, comma-separated names or patterns (overrides logger.topics), e.g. "
                  "pixyslam/odometry,pixyslam/map_state or 'pixyslam/*,!pixyslam/diagnostics'")
-      ->type_name("LIST");
+      .type("LIST");
   app::add_set(cli, overrides, "logger.compression=lz4");
   app::add_verbose(cli, verbose);
   cli.footer("logger parameters (logger:; topics apart):\n" +
              parameters::help_text(logger_node::logger_parameters(), "logger") +
              "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
              parameters::help_text(pixyslam::dds::dds_parameters(), "dds"));
-  if (const auto done = app::parse(cli, argc, argv)) return *done;
+  if (const auto done = cli.parse(argc, argv)) return *done;
 
   logger_node::LoggerOptions options;
   const std::optional<int> bad = app::configure("logger", [&] {
     options = logger_node::read_logger_options_file(config);
     if (!out.empty()) options.output_file = out;
-    if (cli.count("--topics") != 0) {
+    if (cli.given("--topics")) {
       const std::vector<std::string> patterns = config::split_comma_list(topics);
       std::vector<std::string> known;
       for (const logger_node::TopicInfo& t : logger_node::known_topics()) known.push_back(t.topic);

@@ -42,17 +42,16 @@ int main(int argc, char** argv) {
   app::StopSignal::install();
   std::string config, out_dir;
   std::vector<std::string> overrides;
-  CLI::App cli{"The map optimiser over DDS: Odometry, LandmarkObservation and the estimator's MapState in, "
-               "OptimisedMap out, until SIGINT/SIGTERM.",
-               "map_optimizer"};
+  app::Cli cli{"map_optimizer", "The map optimiser over DDS: Odometry, LandmarkObservation and the estimator's MapState in, "
+               "OptimisedMap out, until SIGINT/SIGTERM."};
   app::add_config(cli, config,
                   "config/map_optimizer.yaml: filter_config (the estimator's file: its noise, limits and start pose), "
                   "optimizer:, dds:");
-  cli.add_option("--out-dir", out_dir, "at exit, DIR/trajectory.csv (final keyframes) and DIR/landmarks.csv")
-      ->type_name("DIR");
+  cli.option("--out-dir", out_dir, "at exit, DIR/trajectory.csv (final keyframes) and DIR/landmarks.csv")
+      .type("DIR");
   app::add_set(cli, overrides, "optimizer.window_keyframes=50");
   cli.footer(map_optimizer_node::help_text());
-  if (const auto done = app::parse(cli, argc, argv)) return *done;
+  if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("map_optimizer", [&] {
     map_optimizer_node::OptimizerNodeOptions options = map_optimizer_node::read_optimizer_node_options_file(config);
     try {

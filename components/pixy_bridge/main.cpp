@@ -30,19 +30,18 @@ int main(int argc, char** argv) {
   app::StopSignal::install();  // first: every thread inherits the blocked signals
   bridge::BridgeCommandLine args;
   std::string camera_input;
-  CLI::App cli{"The Pixy's UART block stream (or a camera) -> one LandmarkObservation per frame over DDS, until "
-               "SIGINT/SIGTERM.",
-               "pixy_bridge"};
+  app::Cli cli{"pixy_bridge", "The Pixy's UART block stream (or a camera) -> one LandmarkObservation per frame over DDS, until "
+               "SIGINT/SIGTERM."};
   bridge::add_bridge_flags(cli, args, "config/pixy_bridge.yaml: node:, pixy:, camera: (optional), dds:",
                            "pixy.frame_rate_hz=30");
-  cli.add_option("--camera", camera_input, "read this camera, video file or y4m stream instead of the Pixy")
-      ->type_name("INPUT");
+  cli.option("--camera", camera_input, "read this camera, video file or y4m stream instead of the Pixy")
+      .type("INPUT");
   cli.footer("Pixy parameters (pixy:; landmarks apart):\n" +
              parameters::help_text(pixy::camera_parameters(), "pixy") +
              parameters::help_text(pixy::frame_rate_parameters(), "pixy") +
              "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
              parameters::help_text(pixyslam::dds::dds_parameters(), "dds"));
-  if (const auto done = app::parse(cli, argc, argv)) return *done;
+  if (const auto done = cli.parse(argc, argv)) return *done;
 
   pixy_node::PixyNodeOptions options;
   pixy_node::CameraSectionReader read_camera;

@@ -48,19 +48,18 @@ int main(int argc, char** argv) {
   std::string config, out_dir, checkpoint, seed;
   std::vector<std::string> overrides;
   bool verbose = false;
-  CLI::App cli{"FastSLAM 2.0 over DDS: Odometry and LandmarkObservation in, MapState out, until SIGINT/SIGTERM.",
-               "slam_estimator"};
+  app::Cli cli{"slam_estimator", "FastSLAM 2.0 over DDS: Odometry and LandmarkObservation in, MapState out, until SIGINT/SIGTERM."};
   app::add_config(cli, config, "config/slam_estimator.yaml: filter:, estimator:, dds:");
-  cli.add_option("--seed", seed, "the same as --set filter.seed=S")->type_name("S");
-  cli.add_option("--out-dir", out_dir, "at exit, DIR/trajectory.csv (every MapState's mean pose) and DIR/landmarks.csv")
-      ->type_name("DIR");
-  cli.add_option("--checkpoint", checkpoint,
+  cli.option("--seed", seed, "the same as --set filter.seed=S").type("S");
+  cli.option("--out-dir", out_dir, "at exit, DIR/trajectory.csv (every MapState's mean pose) and DIR/landmarks.csv")
+      .type("DIR");
+  cli.option("--checkpoint", checkpoint,
                  "save pose and map here every period, resume from it at start when fresh (estimator.checkpoint.file)")
-      ->type_name("FILE");
+      .type("FILE");
   app::add_set(cli, overrides, "filter.particles=300");
   app::add_verbose(cli, verbose);
   cli.footer(slam_node::help_text());
-  if (const auto done = app::parse(cli, argc, argv)) return *done;
+  if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("slam_estimator", [&] {
     slam_node::EstimatorOptions options = slam_node::read_estimator_options_file(config);
     if (!seed.empty()) overrides.insert(overrides.begin(), "filter.seed=" + seed);

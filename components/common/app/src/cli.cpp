@@ -2,26 +2,108 @@
 
 #include <cstdio>
 
+#include <CLI/CLI.hpp>
+
 namespace pixyslam::app {
 
-std::optional<int> parse(CLI::App& cli, int argc, char** argv) {
+Cli::Option& Cli::Option::required() {
+  option_->required();
+  return *this;
+}
+
+Cli::Option& Cli::Option::existing_file() {
+  option_->check(CLI::ExistingFile);
+  return *this;
+}
+
+Cli::Option& Cli::Option::range(double min, double max) {
+  option_->check(CLI::Range(min, max));
+  return *this;
+}
+
+Cli::Option& Cli::Option::non_negative() {
+  option_->check(CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::size_t used = 0;
+        double v = -1.0;
+        try {
+          v = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        return used == text.size() && v >= 0.0 ? std::string() : "must be a number >= 0, got '" + text + "'";
+      },
+      ">= 0"));
+  return *this;
+}
+
+Cli::Option& Cli::Option::needs(Option& other) {
+  option_->needs(other.option_);
+  return *this;
+}
+
+Cli::Option& Cli::Option::type(const std::string& name) {
+  option_->type_name(name);
+  return *this;
+}
+
+Cli::Cli(const std::string& name, const std::string& description)
+    : app_(std::make_unique<CLI::App>(description, name)) {}
+
+Cli::~Cli() = default;
+
+Cli::Option& Cli::keep(CLI::Option* option) {
+  options_.push_back(std::make_unique<Option>(option));
+  return *options_.back();
+}
+
+Cli::Option& Cli::option(const std::string& name, std::string& value, const std::string& help) {
+  return keep(app_->add_option(name, value, help));
+}
+
+Cli::Option& Cli::option(const std::string& name, double& value, const std::string& help) {
+  return keep(app_->add_option(name, value, help));
+}
+
+Cli::Option& Cli::option(const std::string& name, std::vector<std::string>& values, const std::string& help) {
+  return keep(app_->add_option(name, values, help));
+}
+
+Cli::Option& Cli::option_each(const std::string& name, std::function<void(const std::string&)> each,
+                              const std::string& help) {
+  return keep(app_->add_option_function<std::vector<std::string>>(
+                      name,
+                      [each](const std::vector<std::string>& values) {
+                        for (const std::string& v : values) each(v);
+                      },
+                      help)
+                  ->allow_extra_args(false));
+}
+
+void Cli::flag(const std::string& name, bool& value, const std::string& help) { app_->add_flag(name, value, help); }
+
+void Cli::footer(const std::string& text) { app_->footer(text); }
+
+bool Cli::given(const std::string& name) const { return app_->count(name) != 0; }
+
+std::optional<int> Cli::parse(int argc, char** argv) {
   try {
-    cli.parse(argc, argv);
+    app_->parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
-    std::fputs(cli.help().c_str(), stdout);
+    std::fputs(app_->help().c_str(), stdout);
     return 0;
   } catch (const CLI::CallForAllHelp&) {
-    std::fputs(cli.help("", CLI::AppFormatMode::All).c_str(), stdout);
+    std::fputs(app_->help("", CLI::AppFormatMode::All).c_str(), stdout);
     return 0;
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "%s: %s (see --help)\n", cli.get_name().c_str(), e.what());
+    std::fprintf(stderr, "%s: %s (see --help)\n", app_->get_name().c_str(), e.what());
     return 2;
   }
   return std::nullopt;
 }
 
-CLI::Option* add_config(CLI::App& cli, std::string& path, const std::string& help) {
-  return cli.add_option("--config", path, help)->required()->check(CLI::ExistingFile)->type_name("FILE");
+Cli::Option& add_config(Cli& cli, std::string& path, const std::string& help) {
+  return cli.option("--config", path, help).required().existing_file().type("FILE");
 }
 
 std::vector<std::string> split_assignments(const std::string& text) {
@@ -43,22 +125,19 @@ std::vector<std::string> split_assignments(const std::string& text) {
   return out;
 }
 
-CLI::Option* add_set(CLI::App& cli, std::vector<std::string>& assignments, const std::string& example) {
+Cli::Option& add_set(Cli& cli, std::vector<std::string>& assignments, const std::string& example) {
   return cli
-      .add_option_function<std::vector<std::string>>(
+      .option_each(
           "--set",
-          [&assignments](const std::vector<std::string>& values) {
-            for (const std::string& v : values) {
-              for (std::string& a : split_assignments(v)) assignments.push_back(std::move(a));
-            }
+          [&assignments](const std::string& v) {
+            for (std::string& a : split_assignments(v)) assignments.push_back(std::move(a));
           },
           "override a parameter of the config, e.g. --set " + example + " (repeatable; the list: --help)")
-      ->type_name("KEY=VALUE")
-      ->allow_extra_args(false);
+      .type("KEY=VALUE");
 }
 
-CLI::Option* add_verbose(CLI::App& cli, bool& verbose) {
-  return cli.add_flag("--verbose", verbose, "print the whole effective configuration at start");
+void add_verbose(Cli& cli, bool& verbose) {
+  cli.flag("--verbose", verbose, "print the whole effective configuration at start");
 }
 
 }  // namespace pixyslam::app

@@ -20,10 +20,10 @@ DeviceReaderOptions device_reader_options(const BridgeProcessOptions& o) {
   return d;
 }
 
-void add_bridge_flags(CLI::App& cli, BridgeCommandLine& args, const std::string& config_help,
+void add_bridge_flags(app::Cli& cli, BridgeCommandLine& args, const std::string& config_help,
                       const std::string& set_example) {
   app::add_config(cli, args.config, config_help);
-  cli.add_option("--device", args.device, "the serial device (overrides the config's)")->type_name("PATH");
+  cli.option("--device", args.device, "the serial device (overrides the config's)").type("PATH");
   app::add_set(cli, args.overrides, set_example + " or dds.domain_id=3");
   app::add_verbose(cli, args.verbose);
 }

@@ -1,32 +1,76 @@
 #pragma once
 
-// The command line of every pixyslam executable: CLI11 (Debian libcli11-dev),
-// one flag name per meaning (docs/tools.md) and the same exit codes
-// everywhere: 0 ok (and after --help), 1 runtime failure, 2 usage or
-// configuration error.
+// The command line of every pixyslam executable: CLI11 (Debian libcli11-dev)
+// behind one small interface, compiled once (cli.cpp: CLI11 is header-only
+// and costs ~15 s per file that includes it). One flag name per meaning
+// (docs/tools.md) and the same exit codes everywhere: 0 ok (and after
+// --help), 1 runtime failure, 2 usage or configuration error.
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;
+class Option;
+}  // namespace CLI
 
 namespace pixyslam::app {
 
-// Parses argv with `cli`. Returns the exit status when the process is to end
-// here: 0 after --help (the help on stdout), 2 for a usage error
-// ("<name>: <what> (see --help)" on stderr); nothing when it is to go on.
-std::optional<int> parse(CLI::App& cli, int argc, char** argv);
+class Cli {
+ public:
+  // One declared option; its methods refine it and return it.
+  class Option {
+   public:
+    explicit Option(CLI::Option* option) : option_(option) {}
+    Option& required();
+    Option& existing_file();
+    Option& range(double min, double max);
+    Option& non_negative();
+    Option& needs(Option& other);  // given only together with `other`
+    Option& type(const std::string& name);  // the value's name in --help, e.g. "DIR"
+
+   private:
+    CLI::Option* option_;
+  };
+
+  Cli(const std::string& name, const std::string& description);
+  ~Cli();
+  Cli(const Cli&) = delete;
+  Cli& operator=(const Cli&) = delete;
+
+  // "--name" is a flag with a value; a name without dashes is positional.
+  Option& option(const std::string& name, std::string& value, const std::string& help);
+  Option& option(const std::string& name, double& value, const std::string& help);
+  Option& option(const std::string& name, std::vector<std::string>& values, const std::string& help);
+  // Calls `each` with every value given (repeatable).
+  Option& option_each(const std::string& name, std::function<void(const std::string&)> each, const std::string& help);
+  void flag(const std::string& name, bool& value, const std::string& help);
+  void footer(const std::string& text);
+  bool given(const std::string& name) const;
+
+  // Returns the exit status when the process is to end here: 0 after --help
+  // (the help on stdout), 2 for a usage error ("<name>: <what> (see --help)"
+  // on stderr); nothing when it is to go on.
+  std::optional<int> parse(int argc, char** argv);
+
+ private:
+  Option& keep(CLI::Option* option);
+  std::unique_ptr<CLI::App> app_;
+  std::vector<std::unique_ptr<Option>> options_;
+};
 
 // --config FILE: the process's YAML (must exist).
-CLI::Option* add_config(CLI::App& cli, std::string& path, const std::string& help);
+Cli::Option& add_config(Cli& cli, std::string& path, const std::string& help);
 
 // --set KEY=VALUE, repeatable, or several comma-separated ("a=1,b=2"; a comma
 // not followed by KEY= stays in the value: dds.interfaces=10.0.0.1,10.0.0.2).
 // `example` shows a key, e.g. "filter.particles=300".
-CLI::Option* add_set(CLI::App& cli, std::vector<std::string>& assignments, const std::string& example);
+Cli::Option& add_set(Cli& cli, std::vector<std::string>& assignments, const std::string& example);
 
 // --verbose: the long form of what a process prints at start (the effective configuration).
-CLI::Option* add_verbose(CLI::App& cli, bool& verbose);
+void add_verbose(Cli& cli, bool& verbose);
 
 // "a=1,b=2,c" split into assignments at commas followed by KEY=.
 std::vector<std::string> split_assignments(const std::string& text);

@@ -33,7 +33,7 @@ struct BridgeCommandLine {
   std::vector<std::string> overrides;
   bool verbose = false;
 };
-void add_bridge_flags(CLI::App& cli, BridgeCommandLine& args, const std::string& config_help,
+void add_bridge_flags(app::Cli& cli, BridgeCommandLine& args, const std::string& config_help,
                       const std::string& set_example);
 
 // The overrides of `section` (its assignments, "section.KEY=V") apart from the
