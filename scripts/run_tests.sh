@@ -11,7 +11,9 @@ if [[ ${PIXYSLAM_ARMHF:-1} != 0 ]]; then
   "$root/scripts/cross_build_armhf.sh" --no-tests --build-dir "$root/build-armhf"
 fi
 build_dir=${BUILD_DIR:-$root/build}
-# One test more than cores: the DDS tests (one at a time, RESOURCE_LOCK dds)
-# mostly wait on simulated real time, while the armhf unit tests under qemu and
-# the fuzz build (both niced) keep the cores busy beside them.
-ctest --test-dir "$build_dir" --output-on-failure --parallel "$(($(nproc) + 1))" --timeout 600 "$@"
+# Two tests more than cores: the DDS tests (one at a time, RESOURCE_LOCK dds)
+# mostly wait on simulated real time, the container image build mostly on apt,
+# while the armhf unit tests under qemu and the fuzz build (both niced) keep
+# the cores busy beside them from the start (with one more than cores, the fuzz
+# build waited ~150 s for the images and was the last test to end).
+ctest --test-dir "$build_dir" --output-on-failure --parallel "$(($(nproc) + 2))" --timeout 600 "$@"

@@ -19,7 +19,9 @@ if ! command -v clang++-14 >/dev/null || ! compgen -G "/usr/lib/llvm-14/lib/clan
   exit 77
 fi
 if [[ ! -f $build_dir/CMakeCache.txt ]]; then
+  # -O1 (libFuzzer's usual level): the build is the long part of a short run.
   cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -DNDEBUG" \
     -DPIXYSLAM_FUZZ=ON -DBUILD_TESTING=OFF -DPIXYSLAM_BUILD_BENCHMARKS=OFF -DPIXYSLAM_BUILD_MAP_VIEW=OFF >/dev/null
 fi
 cmake --build "$build_dir" --target pixyslam_fuzzers --parallel "$jobs" >/dev/null
