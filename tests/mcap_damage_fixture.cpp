@@ -23,7 +23,7 @@
 #include "pixyslam/dds/topics.h"
 #include "pixyslam/logger/mcap_reader.h"
 #include "pixyslam/logger/mcap_writer.h"
-#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/dds/cdr_payload.h"
 
 namespace pixyslam {
 namespace {
@@ -52,7 +52,7 @@ void write_log(const std::string& path, int count, std::size_t chunk_size) {
     odometry.distance_m(odometry.v_mps() * 0.01);
     odometry.rotation_rad(odometry.w_radps() * 0.01);
     odometry.encoder_samples(2);
-    writer.write_message(channel, static_cast<std::uint32_t>(i), stamp, stamp, logger_node::to_cdr(odometry));
+    writer.write_message(channel, static_cast<std::uint32_t>(i), stamp, stamp, dds::to_cdr(odometry));
   }
   writer.close();
 }

@@ -22,7 +22,7 @@
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/log_tool/sequence_check.h"
 #include "pixyslam/logger/mcap_reader.h"
-#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/logger_node/logger_node.h"
 #include "pixyslam/logger_node/logger_options.h"
 #include "pixyslam/logger_node/topic_selection.h"
@@ -33,6 +33,13 @@ namespace {
 using log_tool::analyze_sequence;
 using log_tool::describe;
 using log_tool::SequenceReport;
+using dds::decode_header;
+using dds::find_topic;
+using dds::from_cdr;
+using dds::known_topics;
+using dds::SampleHeader;
+using dds::to_cdr;
+using dds::TopicInfo;
 
 // ---------------------------------------------------------------- sequences
 

@@ -15,7 +15,7 @@
 
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/logger/mcap_writer.h"
-#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/map_view/image_output.h"
 #include "pixyslam/map_view/map_log.h"
 #include "pixyslam/map_view/map_view_options.h"
@@ -628,14 +628,14 @@ void write_log(const std::string& path, int steps, bool with_map_channel, int op
     const std::uint64_t t = t0 + static_cast<std::uint64_t>(i) * 100'000'000ULL;
     const double x = 0.05 * i;
     writer.write_message(truth_channel, static_cast<std::uint32_t>(i + 1), t, t,
-                         logger_node::to_cdr(ground_truth(t, x)));
+                         dds::to_cdr(ground_truth(t, x)));
     if (with_map_channel) {
       writer.write_message(map_channel, static_cast<std::uint32_t>(i + 1), t + 1000, t + 1000,
-                           logger_node::to_cdr(map_state(t, x, 1 + i / 10)));
+                           dds::to_cdr(map_state(t, x, 1 + i / 10)));
     }
     if (optimised_every > 0 && (i + 1) % optimised_every == 0) {
       writer.write_message(optimised_channel, static_cast<std::uint32_t>((i + 1) / optimised_every), t + 2000,
-                           t + 2000, logger_node::to_cdr(optimised_map(t, i + 1, 0.01 * i)));
+                           t + 2000, dds::to_cdr(optimised_map(t, i + 1, 0.01 * i)));
     }
   }
   writer.close();

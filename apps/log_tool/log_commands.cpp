@@ -15,7 +15,7 @@
 #include "pixyslam/log_tool/message_format.h"
 #include "pixyslam/log_tool/sequence_check.h"
 #include "pixyslam/logger/mcap_reader.h"
-#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/dds/cdr_payload.h"
 
 namespace pixyslam::log_tool {
 
@@ -255,11 +255,11 @@ int run_check(const CheckRequest& request, std::ostream& out, std::ostream& err)
     if (it == topics.end()) continue;  // the reader reports messages of unknown channels
     TopicCheck& t = it->second;
     ++t.messages;
-    logger_node::SampleHeader header;
+    dds::SampleHeader header;
     std::string error;
     if (t.channel->message_encoding != "cdr") {
       error = "message encoding '" + t.channel->message_encoding + "' is not cdr";
-    } else if (logger_node::decode_header(t.type_name, m.data.data(), m.data.size(), header, error)) {
+    } else if (dds::decode_header(t.type_name, m.data.data(), m.data.size(), header, error)) {
       // One sequence per writer: per robot, and per process on the diagnostics
       // topic, which every process writes (frame_id = the process).
       std::string writer = header.robot_id;
@@ -322,7 +322,7 @@ namespace {
 template <class Message>
 bool decode_as(const std::vector<std::uint8_t>& bytes, Value& value, std::string& error) {
   Message message;
-  if (!logger_node::from_cdr(bytes, message, error)) return false;
+  if (!dds::from_cdr(bytes, message, error)) return false;
   value = to_value(message);
   return true;
 }

@@ -11,7 +11,7 @@
 
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/dds/endpoints.h"
-#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/logger_node/topic_selection.h"
 
 namespace pixyslam::player {
@@ -43,7 +43,7 @@ class TypedChannel final : public LogPlayer::Channel {
 
   void publish(const std::vector<std::uint8_t>& payload, bool restamp, std::int64_t offset_ns) override {
     std::string error;
-    if (!logger_node::from_cdr(payload, sample_, error)) {
+    if (!dds::from_cdr(payload, sample_, error)) {
       ++report_.undecodable;
       return;
     }
@@ -102,7 +102,7 @@ LogPlayer::LogPlayer(const PlayerOptions& options, std::ostream& log) : options_
            << " messages recovered); playing what was recovered\n";
     }
     for (const logger::McapChannel& channel : reader.channels()) {
-      if (logger_node::find_topic(channel.topic) == nullptr || channel.message_encoding != "cdr") {
+      if (dds::find_topic(channel.topic) == nullptr || channel.message_encoding != "cdr") {
         log_ << "pixyslam_play: " << file << ": skipping channel '" << channel.topic << "' ("
              << channel.message_encoding << "): not a topic of this project\n";
         continue;

@@ -31,7 +31,7 @@ int main(int argc, char** argv) {
   encoder_node::EncoderNodeOptions options;
   const std::optional<int> bad = app::configure("encoder_bridge", [&] {
     options = encoder_node::read_encoder_node_options_file(args.config);
-    for (const std::string& a : bridge::take_overrides(args.overrides, "encoder_bridge")) {
+    for (const std::string& a : parameters::take_section(args.overrides, "encoder_bridge")) {
       parameters::apply_override(options.encoder, encoder::encoder_parameters(), "encoder_bridge", a);
     }
     encoder::validate(options.encoder);

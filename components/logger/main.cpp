@@ -24,7 +24,7 @@
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/yaml_text.h"
-#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/logger_node/logger_node.h"
 #include "pixyslam/logger_node/topic_selection.h"
 
@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
     if (cli.given("--topics")) {
       const std::vector<std::string> patterns = config::split_comma_list(topics);
       std::vector<std::string> known;
-      for (const logger_node::TopicInfo& t : logger_node::known_topics()) known.push_back(t.topic);
+      for (const pixyslam::dds::TopicInfo& t : pixyslam::dds::known_topics()) known.push_back(t.topic);
       const logger_node::TopicSelection selection = logger_node::select_topics(patterns, known);
       if (patterns.empty() || !selection.error.empty()) {
         throw std::invalid_argument("--topics: " + (patterns.empty() ? std::string("empty list")

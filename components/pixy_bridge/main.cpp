@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
 #endif
   const std::optional<int> bad = app::configure("pixy_bridge", [&] {
     options = pixy_node::read_pixy_node_options_file(args.config, read_camera);
-    for (const std::string& a : bridge::take_overrides(args.overrides, "pixy")) {
+    for (const std::string& a : parameters::take_section(args.overrides, "pixy")) {
       const std::string key = a.substr(0, a.find('=')).substr(5);
       if (parameters::find(pixy::frame_rate_parameters(), key) != nullptr) {
         parameters::apply_override(options.pixy.rate, pixy::frame_rate_parameters(), "pixy", a);

@@ -22,13 +22,13 @@
 
 #include "fuzz_common.h"
 #include "pixyslam/dds/guarded_type.h"
-#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/slam/fastslam2.h"
 #include "pixyslam/slam_node/map_state_conversions.h"
 
 namespace {
 
-using pixyslam::logger_node::from_cdr;
+using pixyslam::dds::from_cdr;
 
 void check_filter(const pixyslam::slam::FastSlam2& filter) {
   const pixyslam::slam::PoseEstimate e = filter.pose_estimate();
@@ -128,9 +128,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       break;
     }
   }
-  pixyslam::logger_node::SampleHeader header;
-  for (const auto& topic : pixyslam::logger_node::known_topics()) {
-    (void)pixyslam::logger_node::decode_header(topic.type_name, payload.data(), payload.size(), header, error);
+  pixyslam::dds::SampleHeader header;
+  for (const auto& topic : pixyslam::dds::known_topics()) {
+    (void)pixyslam::dds::decode_header(topic.type_name, payload.data(), payload.size(), header, error);
   }
   return 0;
 }

@@ -14,7 +14,7 @@
 #include "pixyslam/encoder/arduino_line_parser.h"
 #include "pixyslam/logger/mcap_reader.h"
 #include "pixyslam/logger/mcap_writer.h"
-#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/pixy/pixy_block_parser.h"
 
 namespace fs = std::filesystem;
@@ -123,23 +123,23 @@ int main(int argc, char** argv) {
     b.insert(b.end(), payload.begin(), payload.end());
     write(cdr, name, b);
   };
-  cdr_seed("odometry", 0, logger_node::to_cdr(odometry(1)));
-  cdr_seed("odometry_delayed", 0x10, logger_node::to_cdr(odometry(2)));
-  cdr_seed("observation", 1, logger_node::to_cdr(observation(1)));
-  cdr_seed("observation_delayed", 0x11, logger_node::to_cdr(observation(2)));
+  cdr_seed("odometry", 0, pixyslam::dds::to_cdr(odometry(1)));
+  cdr_seed("odometry_delayed", 0x10, pixyslam::dds::to_cdr(odometry(2)));
+  cdr_seed("observation", 1, pixyslam::dds::to_cdr(observation(1)));
+  cdr_seed("observation_delayed", 0x11, pixyslam::dds::to_cdr(observation(2)));
   msg::MapState map;
   map.header().seq(1);
-  cdr_seed("map_state", 2, logger_node::to_cdr(map));
+  cdr_seed("map_state", 2, pixyslam::dds::to_cdr(map));
   msg::GroundTruth truth;
   truth.header().seq(1);
-  cdr_seed("ground_truth", 3, logger_node::to_cdr(truth));
+  cdr_seed("ground_truth", 3, pixyslam::dds::to_cdr(truth));
   msg::Diagnostics diagnostics;
   diagnostics.header().seq(1);
   diagnostics.process("encoder_bridge");
   diagnostics.counters().resize(2);
   diagnostics.counters()[0].name("lines_rejected");
   diagnostics.counters()[0].value(3);
-  cdr_seed("diagnostics", 4, logger_node::to_cdr(diagnostics));
+  cdr_seed("diagnostics", 4, pixyslam::dds::to_cdr(diagnostics));
   msg::OptimisedMap optimised;
   optimised.header(header(1, 1'000'000'000ull, "map"));
   optimised.keyframe_count(2);
@@ -153,7 +153,7 @@ int main(int argc, char** argv) {
   optimised.landmarks()[0].cov_yy_m2(0.01);
   optimised.landmarks()[0].observations(4);
   optimised.converged(true);
-  cdr_seed("optimised_map", 5, logger_node::to_cdr(optimised));
+  cdr_seed("optimised_map", 5, pixyslam::dds::to_cdr(optimised));
 
   // MCAP files: chunked and unchunked, with the project's schemas.
   const fs::path mcap = root / "fuzz_mcap_reader";
@@ -166,7 +166,7 @@ int main(int argc, char** argv) {
     const std::uint16_t schema = writer.add_schema("pixyslam::msg::Odometry", "omgidl", "struct Odometry {};");
     const std::uint16_t channel = writer.add_channel("pixyslam/odometry", "cdr", schema);
     for (std::uint64_t i = 1; i <= 4; ++i) {
-      writer.write_message(channel, static_cast<std::uint32_t>(i), i * 1000, i * 1000, logger_node::to_cdr(odometry(i)));
+      writer.write_message(channel, static_cast<std::uint32_t>(i), i * 1000, i * 1000, pixyslam::dds::to_cdr(odometry(i)));
     }
     writer.close();
     (void)logger::McapReader(path.string());  // the seed must itself be clean

@@ -6,7 +6,7 @@
 
 #include "pixyslam/dds/topics.h"
 #include "pixyslam/logger/mcap_reader.h"
-#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/dds/cdr_payload.h"
 
 namespace pixyslam::map_view {
 namespace {
@@ -19,7 +19,7 @@ void decode_channel(const logger::McapReader& reader, const logger::McapChannel&
   for (const logger::McapMessage& m : reader.messages()) {
     if (m.channel_id != channel.id) continue;
     Message sample;
-    if (!logger_node::deserialize_payload(type, m.data.data(), m.data.size(), &sample, error)) {
+    if (!dds::deserialize_payload(type, m.data.data(), m.data.size(), &sample, error)) {
       ++undecodable;
       continue;
     }

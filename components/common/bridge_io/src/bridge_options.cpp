@@ -28,13 +28,6 @@ void add_bridge_flags(app::Cli& cli, BridgeCommandLine& args, const std::string&
   app::add_verbose(cli, args.verbose);
 }
 
-std::vector<std::string> take_overrides(std::vector<std::string>& overrides, const std::string& section) {
-  std::vector<std::string> taken, rest;
-  for (std::string& a : overrides) (a.rfind(section + ".", 0) == 0 ? taken : rest).push_back(std::move(a));
-  overrides = std::move(rest);
-  return taken;
-}
-
 void apply_command_line(const BridgeCommandLine& args, std::string& serial_device, dds::DdsOptions& dds) {
   if (!args.device.empty()) {
     serial_device = args.device;
@@ -43,7 +36,7 @@ void apply_command_line(const BridgeCommandLine& args, std::string& serial_devic
     }
   }
   std::vector<std::string> rest = args.overrides;
-  const std::vector<std::string> dds_overrides = take_overrides(rest, "dds");
+  const std::vector<std::string> dds_overrides = parameters::take_section(rest, "dds");
   if (!rest.empty()) throw std::invalid_argument("--set " + rest.front() + ": not a parameter of this process");
   // The DDS settings resolved here, once: file, environment, command line.
   dds::resolve_settings(dds, dds_overrides);

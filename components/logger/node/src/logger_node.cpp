@@ -11,7 +11,7 @@
 #include <utility>
 
 #include "pixyslam/dds/endpoints.h"
-#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/logger_node/topic_selection.h"
 
 namespace pixyslam::logger_node {
@@ -47,7 +47,7 @@ class TypedSubscription final : public Subscription {
     std::vector<std::uint8_t> payload;
     bool serialized = true;
     try {
-      payload = serialize_payload(type_, &message);
+      payload = dds::serialize_payload(type_, &message);
     } catch (...) {  // nothing may escape into Fast DDS
       serialized = false;
     }
@@ -64,7 +64,7 @@ class TypedSubscription final : public Subscription {
 
 LoggerNode::LoggerNode(const LoggerOptions& options) : options_(options) {
   std::vector<std::string> all;
-  for (const TopicInfo& t : known_topics()) all.push_back(t.topic);
+  for (const dds::TopicInfo& t : dds::known_topics()) all.push_back(t.topic);
   if (options_.topics.empty()) {
     options_.topics = all;
   } else {
@@ -76,7 +76,7 @@ LoggerNode::LoggerNode(const LoggerOptions& options) : options_(options) {
     options_.topics = selection.topics;
   }
   for (const std::string& name : options_.topics) {
-    const TopicInfo* info = find_topic(name);
+    const dds::TopicInfo* info = dds::find_topic(name);
     if (info == nullptr) throw std::invalid_argument("logger: unknown topic '" + name + "'");
     topic_infos_.push_back(info);
     TopicCounters counters;
@@ -167,7 +167,7 @@ void LoggerNode::open_file(std::size_t index, const std::string& path_override) 
   const std::map<std::string, std::string> metadata_base = {
       {"robot_id", options_.dds.robot_id}, {"dds_domain_id", std::to_string(options_.dds.domain_id)}};
   for (std::size_t i = 0; i < topic_infos_.size(); ++i) {
-    const TopicInfo& info = *topic_infos_[i];
+    const dds::TopicInfo& info = *topic_infos_[i];
     const std::uint16_t schema = writer_.add_schema(info.type_name, "omgidl", msg::idl_text(info.idl_stem));
     std::map<std::string, std::string> metadata = metadata_base;
     metadata["type_name"] = info.type_name;

@@ -4,7 +4,7 @@
 
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/config/parameters_yaml.h"
-#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/logger_node/topic_selection.h"
 
 namespace pixyslam::logger_node {
@@ -18,7 +18,7 @@ namespace {
 
 std::vector<std::string> all_topics() {
   std::vector<std::string> out;
-  for (const TopicInfo& t : known_topics()) out.push_back(t.topic);
+  for (const dds::TopicInfo& t : dds::known_topics()) out.push_back(t.topic);
   return out;
 }
 
@@ -90,14 +90,9 @@ void validate(const LoggerOptions& o) {
 }
 
 void apply_overrides(LoggerOptions& o, const std::vector<std::string>& assignments) {
-  std::vector<std::string> dds;
-  for (const std::string& a : assignments) {
-    if (a.rfind("dds.", 0) == 0) {
-      dds.push_back(a);
-    } else {
-      parameters::apply_override(o, logger_parameters(), "logger", a);
-    }
-  }
+  std::vector<std::string> rest = assignments;
+  const std::vector<std::string> dds = parameters::take_section(rest, "dds");
+  for (const std::string& a : rest) parameters::apply_override(o, logger_parameters(), "logger", a);
   validate(o);
   dds::resolve_settings(o.dds, dds);
 }

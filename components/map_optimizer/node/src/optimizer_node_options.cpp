@@ -27,18 +27,16 @@ const parameters::Table<OptimizerNodeOptions>& optimizer_node_parameters() {
 }
 
 void apply_overrides(OptimizerNodeOptions& o, const std::vector<std::string>& assignments) {
-  std::vector<std::string> dds;
-  for (const std::string& a : assignments) {
-    const std::string key = a.substr(0, a.find('='));
-    if (a.rfind("dds.", 0) == 0) {
-      dds.push_back(a);
-    } else if (key.rfind("optimizer.", 0) == 0 &&
-               parameters::find(map_optimizer::map_optimizer_parameters(), key.substr(10)) != nullptr) {
+  std::vector<std::string> rest = assignments;
+  const std::vector<std::string> dds = parameters::take_section(rest, "dds");
+  const std::vector<std::string> optimizer = parameters::take_section(rest, "optimizer");
+  if (!rest.empty()) throw std::invalid_argument("'" + rest.front() + "': not an optimizer. or dds. parameter");
+  for (const std::string& a : optimizer) {
+    const std::string key = a.substr(0, a.find('=')).substr(10);  // below "optimizer."
+    if (parameters::find(map_optimizer::map_optimizer_parameters(), key) != nullptr) {
       parameters::apply_override(o.optimizer, map_optimizer::map_optimizer_parameters(), "optimizer", a);
-    } else if (key.rfind("optimizer.", 0) == 0) {
-      parameters::apply_override(o, optimizer_node_parameters(), "optimizer", a);
     } else {
-      throw std::invalid_argument("'" + a + "': not an optimizer. or dds. parameter");
+      parameters::apply_override(o, optimizer_node_parameters(), "optimizer", a);
     }
   }
   map_optimizer::validate(o.optimizer);

@@ -48,18 +48,12 @@ const parameters::Table<EstimatorOptions>& estimator_parameters() {
 }
 
 void apply_overrides(EstimatorOptions& o, const std::vector<std::string>& assignments) {
-  std::vector<std::string> filter, dds;
-  for (const std::string& a : assignments) {
-    if (a.rfind("filter.", 0) == 0) {
-      filter.push_back(a);
-    } else if (a.rfind("dds.", 0) == 0) {
-      dds.push_back(a);
-    } else if (a.rfind("estimator.", 0) == 0) {
-      parameters::apply_override(o, estimator_parameters(), "estimator", a);
-    } else {
-      throw std::invalid_argument("'" + a + "': not a filter., estimator. or dds. parameter");
-    }
-  }
+  std::vector<std::string> rest = assignments;
+  const std::vector<std::string> filter = parameters::take_section(rest, "filter");
+  const std::vector<std::string> dds = parameters::take_section(rest, "dds");
+  const std::vector<std::string> estimator = parameters::take_section(rest, "estimator");
+  if (!rest.empty()) throw std::invalid_argument("'" + rest.front() + "': not a filter., estimator. or dds. parameter");
+  for (const std::string& a : estimator) parameters::apply_override(o, estimator_parameters(), "estimator", a);
   slam::apply_overrides(o.filter, filter);
   dds::resolve_settings(o.dds, dds);
 }

@@ -52,33 +52,6 @@ std::optional<int> configure(const char* name, const Body& body) {
   return std::nullopt;
 }
 
-// The set-up of a process that runs until it is stopped: parses `argv` for
-// `--flag value` pairs of `flags`, then calls `configure(args)` to read the
-// configuration. Returns the exit status when the process is to end here:
-// 0 after --help (`usage` printed to stdout); 2 for a config::ConfigError
-// ("<name>: config error: <what>") or a std::invalid_argument, which is a
-// command-line error ("<name>: <what>", then `usage`, on stderr). Returns
-// nothing when the process is to go on; other exceptions pass through.
-template <class Configure>
-std::optional<int> set_up(const char* name, const char* usage, int argc, char** argv,
-                          const std::set<std::string>& flags, const Configure& configure) {
-  try {
-    const CommandLine args(argc, argv, flags);
-    if (args.help()) {
-      std::puts(usage);
-      return 0;
-    }
-    configure(args);
-  } catch (const config::ConfigError& e) {
-    std::fprintf(stderr, "%s: config error: %s\n", name, e.what());
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "%s: %s\n%s\n", name, e.what(), usage);
-    return 2;
-  }
-  return std::nullopt;
-}
-
 // Prints "# <name>: effective configuration" and `yaml` to stdout, flushed.
 void print_effective_configuration(const char* name, const std::string& yaml);
 

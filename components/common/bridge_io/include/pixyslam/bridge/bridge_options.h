@@ -36,10 +36,6 @@ struct BridgeCommandLine {
 void add_bridge_flags(app::Cli& cli, BridgeCommandLine& args, const std::string& config_help,
                       const std::string& set_example);
 
-// The overrides of `section` (its assignments, "section.KEY=V") apart from the
-// others, which stay in `overrides`.
-std::vector<std::string> take_overrides(std::vector<std::string>& overrides, const std::string& section);
-
 // The bridges' command-line overrides of what the config file set: --device
 // PATH replaces `serial_device` (std::invalid_argument unless it is an
 // absolute path); the DDS settings resolved (dds::resolve_settings: the

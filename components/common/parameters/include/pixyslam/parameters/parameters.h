@@ -5,6 +5,7 @@
 // unit, default and help text. Range checks, the effective configuration,
 // `--set path=value` overrides and the help text all come from the table
 // (YAML reading: pixyslam/config/parameters_yaml.h). Pure (std only).
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -123,6 +124,21 @@ Parameter<Options> text(std::string path, std::string help, std::function<std::s
   return p;
 }
 
+// "a, b,,c" -> {"a", "b", "c"}: comma-separated items, blanks around them
+// trimmed, empty ones dropped.
+inline std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> items;
+  std::string::size_type start = 0;
+  while (start <= text.size()) {
+    const auto comma = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, comma - start);
+    const auto first = item.find_first_not_of(" \t");
+    if (first != std::string::npos) items.push_back(item.substr(first, item.find_last_not_of(" \t") - first + 1));
+    start = comma + 1;
+  }
+  return items;
+}
+
 // A list of texts: a YAML sequence, or comma-separated on a command line or
 // in the environment; `check` (may be empty) refuses a bad item.
 template <class Options>
@@ -134,19 +150,7 @@ Parameter<Options> list(std::string path, std::string help, std::function<std::v
     for (const std::string& item : member(const_cast<Options&>(o))) joined += (joined.empty() ? "" : ",") + item;
     return joined;
   };
-  p.set_choice = [member](Options& o, const std::string& v) {
-    std::vector<std::string>& out = member(o);
-    out.clear();
-    std::string rest = v;
-    while (!rest.empty()) {
-      const auto comma = rest.find(',');
-      std::string item = rest.substr(0, comma);
-      const auto first = item.find_first_not_of(" \t");
-      const auto last = item.find_last_not_of(" \t");
-      if (first != std::string::npos) out.push_back(item.substr(first, last - first + 1));
-      rest = comma == std::string::npos ? std::string() : rest.substr(comma + 1);
-    }
-  };
+  p.set_choice = [member](Options& o, const std::string& v) { member(o) = split_list(v); };
   return p;
 }
 
@@ -219,13 +223,7 @@ void check_text(const Parameter<Options>& p, const Options& o) {
     p.check(p.get_choice(o));
     return;
   }
-  const std::string joined = p.get_choice(o);
-  std::string rest = joined;
-  while (!rest.empty()) {
-    const auto comma = rest.find(',');
-    p.check(rest.substr(0, comma));
-    rest = comma == std::string::npos ? std::string() : rest.substr(comma + 1);
-  }
+  for (const std::string& item : split_list(p.get_choice(o))) p.check(item);
 }
 
 // Every number within its range, every text through its check; throws
@@ -305,6 +303,15 @@ void set_from_text(Options& o, const Table<Options>& table, const std::string& s
       p->set(o, v);
     }
   }
+}
+
+// The assignments of `section` ("section.KEY=V"), moved out of `assignments`
+// (the others stay, in order): for a process whose --set reaches several sections.
+inline std::vector<std::string> take_section(std::vector<std::string>& assignments, const std::string& section) {
+  std::vector<std::string> taken, rest;
+  for (std::string& a : assignments) (a.rfind(section + ".", 0) == 0 ? taken : rest).push_back(std::move(a));
+  assignments = std::move(rest);
+  return taken;
 }
 
 // "path=value": set_from_text for one override (e.g. from `--set`).

@@ -14,7 +14,7 @@
 #include "pixyslam/diagnostics/diagnostics_publisher.h"
 #include "pixyslam/dds/participant.h"
 #include "pixyslam/logger/mcap_writer.h"
-#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/logger_node/logger_options.h"
 
 namespace pixyslam::logger_node {
@@ -141,7 +141,7 @@ class LoggerNode {
   diagnostics::Snapshot diagnostics_snapshot() const;
 
   LoggerOptions options_;
-  std::vector<const TopicInfo*> topic_infos_;  // per topics_ entry
+  std::vector<const dds::TopicInfo*> topic_infos_;  // per topics_ entry
   logger::McapWriter writer_;  // after construction: the writer thread's alone (stop()'s if never started)
   std::size_t file_index_ = 0;
   std::chrono::steady_clock::time_point file_opened_;

@@ -1,4 +1,4 @@
-#include "pixyslam/logger_node/cdr_payload.h"
+#include "pixyslam/dds/cdr_payload.h"
 
 #include <algorithm>
 #include <cstring>
@@ -8,7 +8,7 @@
 #include <fastdds/dds/topic/TopicDataType.hpp>
 #include <fastdds/rtps/common/SerializedPayload.h>
 
-namespace pixyslam::logger_node {
+namespace pixyslam::dds {
 
 namespace fdds = eprosima::fastdds::dds;
 using eprosima::fastrtps::rtps::SerializedPayload_t;
@@ -141,4 +141,4 @@ bool decode_header(std::string_view type_name, const std::uint8_t* data, std::si
   return false;
 }
 
-}  // namespace pixyslam::logger_node
+}  // namespace pixyslam::dds

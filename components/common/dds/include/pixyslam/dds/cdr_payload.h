@@ -12,7 +12,7 @@ namespace eprosima::fastdds::dds {
 class TopicDataType;
 }  // namespace eprosima::fastdds::dds
 
-namespace pixyslam::logger_node {
+namespace pixyslam::dds {
 
 // CDR payloads of the project's messages, exactly as a Fast DDS 2.9 DataWriter
 // puts them on the wire: the 4-byte encapsulation header (0x00 0x01 0x00 0x00
@@ -75,4 +75,4 @@ struct SampleHeader {
 bool decode_header(std::string_view type_name, const std::uint8_t* data, std::size_t size,
                    SampleHeader& header, std::string& error);
 
-}  // namespace pixyslam::logger_node
+}  // namespace pixyslam::dds
