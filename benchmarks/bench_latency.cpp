@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "pixyslam/sim/sim_world.h"
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/cli.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/dds/endpoints.h"
@@ -38,17 +38,7 @@ std::string own_folder() {
 
 }  // namespace
 
-int run(int argc, char** argv) {
-  const std::string source_config = std::string(PIXYSLAM_CONFIG_DIR) + "/slam_estimator.yaml";
-  const app::CommandLine args(argc, argv, {"config", "duration"});
-  if (args.help()) {
-    std::printf("usage: bench_latency [--config config/slam_estimator.yaml] [--duration S]\n"
-                "  end-to-end latency Odometry -> MapState through a separate slam_estimator on loopback\n");
-    return 0;
-  }
-  const std::string config = args.get("config", source_config);
-  const double duration_s = args.number("duration", 60.0);
-
+int run(const std::string& config, double duration_s) {
   // The estimator as its own process, its output forwarded with a prefix.
   launcher::ProcessGroup estimator(own_folder(), stdout);
   std::vector<std::string> command{"slam_estimator", "--config", config};
@@ -139,7 +129,15 @@ int run(int argc, char** argv) {
 }  // namespace pixyslam::bench
 
 int main(int argc, char** argv) {
-  pixyslam::app::StopSignal::install();
-  // A bad flag or config exits 2, any other error 1 (as every program here).
-  return pixyslam::app::run_main("bench_latency", [&] { return pixyslam::bench::run(argc, argv); });
+  using namespace pixyslam;
+  app::StopSignal::install();
+  std::string config = std::string(PIXYSLAM_CONFIG_DIR) + "/slam_estimator.yaml";
+  double duration_s = 60.0;
+  app::Cli cli{"bench_latency",
+               "End-to-end latency Odometry -> MapState through a separate slam_estimator on loopback."};
+  cli.option("--config", config, "the estimator's YAML (default config/slam_estimator.yaml)").existing_file().type("FILE");
+  cli.option("--duration", duration_s, "seconds of odometry (default 60)").positive().type("S");
+  if (const auto done = cli.parse(argc, argv)) return *done;
+  // A bad config exits 2, any other error 1 (as every program here).
+  return app::run_main("bench_latency", [&] { return bench::run(config, duration_s); });
 }

@@ -20,12 +20,12 @@
 #include <thread>
 #include <vector>
 
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/cli.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/log_tool/sequence_check.h"
-#include "pixyslam/logger/mcap_reader.h"
+#include "pixyslam/mcap/mcap_reader.h"
 #include "process_group.h"
 
 namespace pixyslam::bench {
@@ -72,23 +72,25 @@ double cpu_seconds(int pid) {
 
 }  // namespace
 
-int run(int argc, char** argv) {
-  const app::CommandLine args(argc, argv, {"rate", "duration", "compression", "out", "domain"});
-  if (args.help()) {
-    std::printf("usage: bench_logger_throughput [--rate 10000] [--duration 10] [--compression zstd] [--out FILE.mcap] "
-                "[--domain D]\n  Odometry at RATE/s to a separate logger on loopback; its CPU use and what it lost\n");
-    return 0;
-  }
-  const double rate_hz = args.number("rate", 10000.0);
-  const double duration_s = args.number("duration", 10.0);
-  const std::string compression = args.get("compression", "zstd");
-  const int domain = static_cast<int>(args.number("domain", 150 + ::getpid() % 80));
+struct Arguments {
+  double rate_hz = 10000.0;
+  double duration_s = 10.0;
+  std::string compression = "zstd";
+  std::string out;  // "": a temporary file
+  int domain = 150 + static_cast<int>(::getpid() % 80);
+};
+
+int run(const Arguments& a) {
+  const double rate_hz = a.rate_hz;
+  const double duration_s = a.duration_s;
+  const std::string& compression = a.compression;
+  const int domain = a.domain;
   const std::string profiles = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/profiles.xml";
 
   const std::filesystem::path work =
       std::filesystem::temp_directory_path() / ("pixyslam_bench_logger_" + std::to_string(::getpid()));
   std::filesystem::create_directories(work);
-  const std::string out = args.get("out", (work / "bench.mcap").string());
+  const std::string out = a.out.empty() ? (work / "bench.mcap").string() : a.out;
   const std::string config = (work / "logger.yaml").string();
   {
     std::ofstream yaml(config);
@@ -143,9 +145,9 @@ int run(int argc, char** argv) {
   logger.stop_all(std::chrono::seconds(20));
   const bool logger_ok = logger.status(0).ok();
 
-  const logger::McapReader reader(out);
+  const mcap::McapReader reader(out);
   std::vector<std::uint64_t> seqs;
-  for (const logger::McapMessage& m : reader.messages()) seqs.push_back(m.sequence);
+  for (const mcap::McapMessage& m : reader.messages()) seqs.push_back(m.sequence);
   const log_tool::SequenceReport seq = log_tool::analyze_sequence(seqs);
   // A failed write (DDS history full past its blocking time) still used up its
   // seq (dds::Writer::publish): such seqs were never sent, so not lost here.
@@ -169,14 +171,24 @@ int run(int argc, char** argv) {
   }
   std::printf("  result: %s\n", complete && logger_ok ? "no message lost" : "MESSAGES LOST or logger failed");
   if (failures > 0) std::printf("  (%llu seq numbers missing = publish failures: never sent)\n", static_cast<unsigned long long>(failures));
-  if (!args.has("out")) std::filesystem::remove_all(work);
+  if (a.out.empty()) std::filesystem::remove_all(work);
   return complete && logger_ok ? 0 : 1;
 }
 
 }  // namespace pixyslam::bench
 
 int main(int argc, char** argv) {
-  pixyslam::app::StopSignal::install();
-  // A bad flag or config exits 2, any other error 1 (as every program here).
-  return pixyslam::app::run_main("bench_logger_throughput", [&] { return pixyslam::bench::run(argc, argv); });
+  using namespace pixyslam;
+  app::StopSignal::install();
+  bench::Arguments a;
+  app::Cli cli{"bench_logger_throughput",
+               "Odometry at RATE per second to a separate logger on loopback: its CPU use and what it lost."};
+  cli.option("--rate", a.rate_hz, "messages per second (default 10000)").positive().type("HZ");
+  cli.option("--duration", a.duration_s, "seconds (default 10)").positive().type("S");
+  cli.option("--compression", a.compression, "chunk compression (default zstd)").choices({"none", "zstd", "lz4"}).type("C");
+  cli.option("--out", a.out, "the MCAP file to write (default: a temporary file)").type("FILE.mcap");
+  cli.option("--domain", a.domain, "DDS domain (default 150 + pid % 80)").range(0, 232).type("N");
+  if (const auto done = cli.parse(argc, argv)) return *done;
+  // A bad config exits 2, any other error 1 (as every program here).
+  return app::run_main("bench_logger_throughput", [&] { return bench::run(a); });
 }

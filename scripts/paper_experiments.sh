@@ -6,4 +6,4 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 out=${1:-$root/build/paper_experiments}
 "$root/scripts/build.sh" >/dev/null
-"${BUILD_DIR:-$root/build}/bin/paper_experiments" --config-dir "$root/config" --out-dir "$out" --check 1
+"${BUILD_DIR:-$root/build}/bin/paper_experiments" --config-dir "$root/config" --out-dir "$out" --check

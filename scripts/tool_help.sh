@@ -12,7 +12,8 @@ cat <<'TEXT'
 
 What each program prints for `--help` (exit 0, nothing started: ctest `help_all_executables` checks
 that for every executable of the build, and that an unknown flag exits 2). Exit codes everywhere:
-0 ok, 1 runtime failure (for `sim_evaluator`: its check failed), 2 usage or configuration error;
+0 ok, 1 runtime failure (or a check that failed: `sim_evaluator`, `mrclam_eval`, `paper_experiments
+--check`, `pixyslam_spy check`), 2 usage or configuration error;
 the evaluations and benchmarks on the MRCLAM data set (`mrclam_eval`, `bench_mrclam_frame`,
 `bench_map_optimizer`) exit 77 when it is absent (skipped), `slam_offline mrclam` 1.
 Flags mean the same everywhere: `--config FILE` (the process's YAML; for the inspection tools one
@@ -21,9 +22,21 @@ with a `dds:` mapping), `--domain N`, `--set KEY=VALUE` (a parameter of the conf
 `pixyslam_log` is `pixyslam_spy` under its old name. Regenerate with
 `scripts/tool_help.sh > docs/tools.md`.
 TEXT
+# The subcommands of the tools that have them: each one's own --help.
+declare -A subcommands=(
+  [pixyslam_spy]="participants topics echo hz diagnostics info check print compare"
+  [map_view]="live render video"
+  [slam_offline]="sim mrclam hardware"
+  [pixyslam_calibrate]="camera odometry noise"
+)
 for tool in "${tools[@]}"; do
   [[ -x $bin/$tool ]] || continue  # optional parts (map_view, the optimiser) may be off
   printf '\n## `%s`\n\n```\n' "$tool"
   "$bin/$tool" --help 2>&1 | sed "s#$root#<checkout>#g"
   printf '```\n'
+  for sub in ${subcommands[$tool]:-}; do
+    printf '\n### `%s %s`\n\n```\n' "$tool" "$sub"
+    "$bin/$tool" "$sub" --help 2>&1 | sed "s#$root#<checkout>#g"
+    printf '```\n'
+  done
 done

@@ -21,8 +21,8 @@
 #include <vector>
 
 #include "pixyslam/dds/topics.h"
-#include "pixyslam/logger/mcap_reader.h"
-#include "pixyslam/logger/mcap_writer.h"
+#include "pixyslam/mcap/mcap_reader.h"
+#include "pixyslam/mcap/mcap_writer.h"
 #include "pixyslam/dds/cdr_payload.h"
 
 namespace pixyslam {
@@ -31,12 +31,12 @@ namespace {
 using Bytes = std::vector<std::uint8_t>;
 
 void write_log(const std::string& path, int count, std::size_t chunk_size) {
-  logger::McapWriterOptions options;
+  mcap::McapWriterOptions options;
   options.chunk_size_bytes = chunk_size;
-  options.compression = logger::mcap_compression_available(logger::McapCompression::kZstd)
-                            ? logger::McapCompression::kZstd
-                            : logger::McapCompression::kNone;
-  logger::McapWriter writer(path, options);
+  options.compression = mcap::mcap_compression_available(mcap::McapCompression::kZstd)
+                            ? mcap::McapCompression::kZstd
+                            : mcap::McapCompression::kNone;
+  mcap::McapWriter writer(path, options);
   const std::uint16_t schema = writer.add_schema("pixyslam::msg::Odometry", "omgidl", msg::idl_text("odometry"));
   const std::uint16_t channel = writer.add_channel(std::string(dds::kOdometryTopic), "cdr", schema);
   for (int i = 1; i <= count; ++i) {
@@ -75,7 +75,7 @@ int run(const std::string& dir, int count) {
   {
     // The unchunked file up to its Data End record, then a Footer pointing at no summary.
     const Bytes unchunked = read_bytes(dir + "/unchunked.mcap");
-    const logger::McapReader full(unchunked, "unchunked");
+    const mcap::McapReader full(unchunked, "unchunked");
     Bytes bare(unchunked.begin(), unchunked.begin() + static_cast<std::ptrdiff_t>(full.recovery().valid_bytes));
     std::uint64_t pos = 8;
     while (pos < bare.size()) {
@@ -94,17 +94,17 @@ int run(const std::string& dir, int count) {
     write_bytes(dir + "/no_summary.mcap", bare);
   }
   const Bytes file = read_bytes(closed);
-  const logger::McapReader reader(file, closed);
+  const mcap::McapReader reader(file, closed);
   if (!reader.clean() || reader.chunks().size() < 20) {
     std::fprintf(stderr, "mcap_damage_fixture: %s is not a clean file of 20+ chunks\n%s", closed.c_str(),
                  reader.diagnostics_text().c_str());
     return 1;
   }
-  const std::vector<logger::McapChunkInfo>& chunks = reader.chunks();
-  const logger::McapChunkInfo& victim = chunks[chunks.size() / 10];
-  const logger::McapChunkInfo& cut = chunks[chunks.size() - 3];
+  const std::vector<mcap::McapChunkInfo>& chunks = reader.chunks();
+  const mcap::McapChunkInfo& victim = chunks[chunks.size() / 10];
+  const mcap::McapChunkInfo& cut = chunks[chunks.size() - 3];
   std::uint64_t before_cut = 0;
-  for (const logger::McapChunkInfo& c : chunks) {
+  for (const mcap::McapChunkInfo& c : chunks) {
     if (c.offset < cut.offset) before_cut += c.message_count;
   }
 

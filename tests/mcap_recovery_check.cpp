@@ -16,7 +16,7 @@
 
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/log_tool/sequence_check.h"
-#include "pixyslam/logger/mcap_reader.h"
+#include "pixyslam/mcap/mcap_reader.h"
 
 namespace pixyslam {
 namespace {
@@ -32,8 +32,8 @@ int run(int argc, char** argv) {
   const std::string path = argv[1];
   const app::CommandLine args(argc - 1, argv + 1, {"topic", "sent", "max-loss", "expect-footer"});
   const std::string topic = args.get("topic");
-  const logger::McapReader reader(path);
-  const logger::McapRecovery& r = reader.recovery();
+  const mcap::McapReader reader(path);
+  const mcap::McapRecovery& r = reader.recovery();
   std::printf("file %s: %llu bytes, valid %llu, ignored at end %llu\n", path.c_str(),
               static_cast<unsigned long long>(r.file_size), static_cast<unsigned long long>(r.valid_bytes),
               static_cast<unsigned long long>(r.bytes_ignored_at_end));
@@ -41,7 +41,7 @@ int run(int argc, char** argv) {
               r.header_present, r.data_end_present, r.summary_present, r.footer_present,
               static_cast<unsigned long long>(r.complete_chunks), static_cast<unsigned long long>(r.rejected_chunks),
               static_cast<unsigned long long>(r.messages_recovered));
-  for (const logger::McapDiagnostic& d : reader.diagnostics()) {
+  for (const mcap::McapDiagnostic& d : reader.diagnostics()) {
     std::printf("diagnostic at %llu: %s\n", static_cast<unsigned long long>(d.offset), d.message.c_str());
   }
   bool ok = true;
@@ -55,7 +55,7 @@ int run(int argc, char** argv) {
     fail(std::string("footer ") + (r.footer_present ? "present" : "missing"));
   }
   std::uint64_t in_chunks = 0;
-  for (const logger::McapChunkInfo& c : reader.chunks()) {
+  for (const mcap::McapChunkInfo& c : reader.chunks()) {
     if (!c.valid) fail("chunk at " + std::to_string(c.offset) + " not valid");
     in_chunks += c.message_count;
   }
@@ -65,16 +65,16 @@ int run(int argc, char** argv) {
   if (r.messages_recovered != reader.messages().size()) fail("messages_recovered differs from the messages read");
   // Every diagnostic must be about the end of the file (the cut), none about
   // anything before it.
-  for (const logger::McapDiagnostic& d : reader.diagnostics()) {
+  for (const mcap::McapDiagnostic& d : reader.diagnostics()) {
     if (d.offset < r.valid_bytes) fail("diagnostic before the cut: " + d.message);
   }
 
-  const logger::McapChannel* channel = reader.find_channel(topic);
+  const mcap::McapChannel* channel = reader.find_channel(topic);
   std::vector<std::uint64_t> seqs;
   if (channel == nullptr) {
     fail("no channel '" + topic + "'");
   } else {
-    for (const logger::McapMessage& m : reader.messages()) {
+    for (const mcap::McapMessage& m : reader.messages()) {
       if (m.channel_id == channel->id) seqs.push_back(m.sequence);
     }
   }

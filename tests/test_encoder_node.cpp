@@ -1,4 +1,4 @@
-// The encoder bridge's node layer: Arduino clock mapping, message conversion,
+// The encoder bridge's node layer: message conversion,
 // options, and the node itself driven by a scripted byte source (and once by a
 // real pseudo-terminal), publishing Odometry over DDS on the loopback profile
 // to a reader in the same test.
@@ -22,7 +22,7 @@
 #include "pixyslam/bridge/byte_source.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/encoder/arduino_line_parser.h"
-#include "pixyslam/encoder_node/arduino_clock.h"
+#include "pixyslam/encoder/arduino_clock.h"
 #include "pixyslam/encoder_node/encoder_node.h"
 #include "pixyslam/encoder_node/encoder_node_options.h"
 #include "pixyslam/encoder_node/odometry_conversions.h"
@@ -35,62 +35,6 @@ using std::chrono::milliseconds;
 using test_support::LogLines;
 
 constexpr std::int64_t kMs = 1000000;  // ns
-
-// ---------------------------------------------------------------- ArduinoClock
-
-TEST(ArduinoClock, TheLeastDelayedSampleSetsTheOffset) {
-  ArduinoClock clock(1.0);
-  const std::int64_t base = 5000 * kMs;  // host time of Arduino time 0
-  // Delays 5, 2, 7, 3 ms: each sample maps to its Arduino time + base + the
-  // smallest delay seen so far.
-  EXPECT_EQ(clock.to_host_ns(0, base + 5 * kMs), base + 5 * kMs);
-  EXPECT_EQ(clock.to_host_ns(20000, base + 20 * kMs + 2 * kMs), base + 22 * kMs);
-  EXPECT_EQ(clock.to_host_ns(40000, base + 40 * kMs + 7 * kMs), base + 42 * kMs);
-  EXPECT_EQ(clock.last_excess_delay_ns(), 5 * kMs);
-  EXPECT_EQ(clock.to_host_ns(60000, base + 60 * kMs + 3 * kMs), base + 62 * kMs);
-  EXPECT_EQ(clock.offset_ns(), base + 2 * kMs);
-}
-
-TEST(ArduinoClock, AnOldMinimumLeavesWithTheWindow) {
-  ArduinoClock clock(0.1);  // 100 ms of Arduino time
-  const std::int64_t base = 1000 * kMs;
-  clock.to_host_ns(0, base + 1 * kMs);  // a lucky 1 ms sample
-  for (std::uint32_t t_us = 20000; t_us <= 100000; t_us += 20000) {
-    EXPECT_EQ(clock.to_host_ns(t_us, base + t_us * 1000 + 4 * kMs), base + t_us * 1000 + 1 * kMs);
-  }
-  // 120 ms: the 1 ms sample is older than the window; 4 ms is the new floor.
-  EXPECT_EQ(clock.to_host_ns(120000, base + 124 * kMs), base + 124 * kMs);
-}
-
-TEST(ArduinoClock, MicrosWrapIsSeamless) {
-  ArduinoClock clock(1.0);
-  const std::uint32_t before_wrap = 0xffffffffu - 9999u;  // 10 ms before the wrap
-  const std::int64_t host = 7000 * kMs;
-  EXPECT_EQ(clock.to_host_ns(before_wrap, host), host);
-  // 20 ms later the counter reads 10000 us after the wrap.
-  EXPECT_EQ(clock.to_host_ns(10000u, host + 20 * kMs + 3 * kMs), host + 20 * kMs);
-  EXPECT_EQ(clock.counters().jumps, 0u);
-}
-
-TEST(ArduinoClock, AResetWithoutRstStartsOver) {
-  ArduinoClock clock(1.0);
-  const std::int64_t host = 9000 * kMs;
-  clock.to_host_ns(3000000, host);  // 3 s after boot
-  clock.to_host_ns(3020000, host + 20 * kMs);
-  // The Arduino rebooted: its clock reads 5 ms. A step back: history dropped,
-  // the sample maps to its own receive time.
-  EXPECT_EQ(clock.to_host_ns(5000, host + 900 * kMs), host + 900 * kMs);
-  EXPECT_EQ(clock.counters().jumps, 1u);
-  EXPECT_EQ(clock.to_host_ns(25000, host + 921 * kMs), host + 920 * kMs);
-}
-
-TEST(ArduinoClock, RestartForgetsTheHistory) {
-  ArduinoClock clock(1.0);
-  clock.to_host_ns(0, 100 * kMs);
-  clock.restart();
-  EXPECT_EQ(clock.to_host_ns(20000, 150 * kMs), 150 * kMs);  // not 120 ms
-  EXPECT_EQ(clock.counters().restarts, 1u);
-}
 
 // ---------------------------------------------------------------- conversions
 

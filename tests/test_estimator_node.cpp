@@ -179,7 +179,7 @@ TEST(EstimatorNode, ResumesFromItsCheckpointAfterARestart) {
   std::vector<eval::TimedPose> before, after;
   bool resumed_first = true, resumed_second = false;
   run_node(0.0, restart_s, before, resumed_first);
-  const MapCheckpoint saved = read_map_checkpoint(options.checkpoint.file);
+  const slam::MapCheckpoint saved = slam::read_map_checkpoint(options.checkpoint.file);
   EXPECT_GE(saved.landmarks.size(), 8u);
   EXPECT_FALSE(resumed_first);  // no file at the first start
   run_node(resume_s, world.duration_s, after, resumed_second);
@@ -225,11 +225,11 @@ TEST(EstimatorNode, IgnoresAStaleCheckpoint) {
   std::filesystem::create_directories(dir);
   EstimatorOptions options = test_options();
   options.checkpoint.file = (dir / "checkpoint.yaml").string();
-  MapCheckpoint old;
+  slam::MapCheckpoint old;
   old.stamp_ns = dds::now_ns() - 3600ull * 1000000000ull;  // an hour ago
   old.pose.mean = slam::Pose2(5.0, 5.0, 1.0);
   old.landmarks.push_back({7, Eigen::Vector2d(6.0, 5.0), Eigen::Matrix2d::Identity() * 0.01, 3});
-  write_map_checkpoint(options.checkpoint.file, old);
+  slam::write_map_checkpoint(options.checkpoint.file, old);
   {
     EstimatorNode node(options);
     node.start();
@@ -248,7 +248,7 @@ TEST(EstimatorNode, IgnoresAStaleCheckpoint) {
     EXPECT_NEAR(node.latest_map_state().mean_pose().x_m(), 0.0, 1e-9);
   }
   // The clean stop saved the new (empty) map over the stale one.
-  EXPECT_TRUE(read_map_checkpoint(options.checkpoint.file).landmarks.empty());
+  EXPECT_TRUE(slam::read_map_checkpoint(options.checkpoint.file).landmarks.empty());
   std::filesystem::remove_all(dir);
 }
 

@@ -21,7 +21,7 @@
 
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/log_tool/sequence_check.h"
-#include "pixyslam/logger/mcap_reader.h"
+#include "pixyslam/mcap/mcap_reader.h"
 #include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/logger_node/logger_node.h"
 #include "pixyslam/logger_node/logger_options.h"
@@ -275,7 +275,7 @@ TEST(LoggerOptions, SelectedTopicsAndCompression) {
       "logger_test.yaml");
   const LoggerOptions o = read_logger_options(root, "/cfg");
   EXPECT_EQ(o.topics, std::vector<std::string>{"pixyslam/map_state"});
-  EXPECT_EQ(o.compression, logger::McapCompression::kNone);
+  EXPECT_EQ(o.compression, mcap::McapCompression::kNone);
   EXPECT_TRUE(o.fsync);
   EXPECT_EQ(o.dds.profiles_file, "/cfg/dds/profiles.xml");
 }
@@ -518,12 +518,12 @@ msg::OptimisedMap optimised_map(int i) {
 // Every message of `topic` in `reader`, decoded; checks the MCAP fields
 // against the header on the way.
 template <class Message>
-std::vector<Message> decoded(const logger::McapReader& reader, const std::string& topic) {
+std::vector<Message> decoded(const mcap::McapReader& reader, const std::string& topic) {
   std::vector<Message> out;
-  const logger::McapChannel* channel = reader.find_channel(topic);
+  const mcap::McapChannel* channel = reader.find_channel(topic);
   EXPECT_NE(channel, nullptr) << topic;
   if (channel == nullptr) return out;
-  for (const logger::McapMessage& m : reader.messages()) {
+  for (const mcap::McapMessage& m : reader.messages()) {
     if (m.channel_id != channel->id) continue;
     Message message;
     std::string error;
@@ -536,7 +536,7 @@ std::vector<Message> decoded(const logger::McapReader& reader, const std::string
 }
 
 template <class Message>
-void expect_recorded(const logger::McapReader& reader, const std::vector<Message>& sent) {
+void expect_recorded(const mcap::McapReader& reader, const std::vector<Message>& sent) {
   const std::string topic(dds::MessageTraits<Message>::topic);
   const std::vector<Message> got = decoded<Message>(reader, topic);
   ASSERT_EQ(got.size(), sent.size()) << topic;
@@ -641,25 +641,25 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
             std::string::npos)
       << node.counters_text();
 
-  const logger::McapReader reader(file.path());
+  const mcap::McapReader reader(file.path());
   EXPECT_TRUE(reader.clean()) << reader.diagnostics_text();
   ASSERT_TRUE(reader.statistics().has_value());
   EXPECT_EQ(reader.statistics()->message_count, 680u);
   EXPECT_EQ(reader.messages().size(), 680u);
-  for (const logger::McapChunkInfo& chunk : reader.chunks()) {
-    EXPECT_EQ(chunk.compression, logger::mcap_compression_name(default_compression()));
+  for (const mcap::McapChunkInfo& chunk : reader.chunks()) {
+    EXPECT_EQ(chunk.compression, mcap::mcap_compression_name(default_compression()));
   }
 
   // Channels and schemas.
   ASSERT_EQ(reader.channels().size(), 6u);
   ASSERT_EQ(reader.schemas().size(), 6u);
   for (const TopicInfo& info : known_topics()) {
-    const logger::McapChannel* channel = reader.find_channel(info.topic);
+    const mcap::McapChannel* channel = reader.find_channel(info.topic);
     ASSERT_NE(channel, nullptr) << info.topic;
     EXPECT_EQ(channel->message_encoding, "cdr");
     EXPECT_EQ(channel->metadata.at("type_name"), info.type_name);
     EXPECT_EQ(channel->metadata.at("robot_id"), "test_robot");
-    const logger::McapSchema* schema = reader.find_schema(channel->schema_id);
+    const mcap::McapSchema* schema = reader.find_schema(channel->schema_id);
     ASSERT_NE(schema, nullptr) << info.topic;
     EXPECT_EQ(schema->name, info.type_name);
     EXPECT_EQ(schema->encoding, "omgidl");
@@ -674,16 +674,16 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
   expect_recorded(reader, truths_sent);
   expect_recorded(reader, optimised_sent);
   std::uint64_t previous_log_time = 0;
-  for (const logger::McapMessage& m : reader.messages()) {
+  for (const mcap::McapMessage& m : reader.messages()) {
     EXPECT_GE(m.log_time_ns, start_ns);
     EXPECT_LE(m.log_time_ns, end_ns);
     EXPECT_GE(m.log_time_ns, previous_log_time);  // written in receive order
     previous_log_time = m.log_time_ns;
   }
   // The bytes are what a Fast DDS writer sends for that sample.
-  const logger::McapChannel* odometry_channel = reader.find_channel("pixyslam/odometry");
+  const mcap::McapChannel* odometry_channel = reader.find_channel("pixyslam/odometry");
   const auto first = std::find_if(reader.messages().begin(), reader.messages().end(),
-                                  [&](const logger::McapMessage& m) { return m.channel_id == odometry_channel->id; });
+                                  [&](const mcap::McapMessage& m) { return m.channel_id == odometry_channel->id; });
   ASSERT_NE(first, reader.messages().end());
   EXPECT_EQ(first->data, to_cdr(odometry_sent.front()));
 }
@@ -716,12 +716,12 @@ TEST(LoggerNode, DropsAndCountsSamplesBeyondTheQueueBound) {
   c = node.counters();
   EXPECT_EQ(c.topics[0].written, 10u);
   EXPECT_EQ(c.topics[0].dropped, 20u);
-  const logger::McapReader reader(file.path());
+  const mcap::McapReader reader(file.path());
   EXPECT_TRUE(reader.clean()) << reader.diagnostics_text();
   ASSERT_EQ(reader.messages().size(), 10u);
   EXPECT_EQ(reader.channels().size(), 1u);
   std::vector<std::uint64_t> seqs;
-  for (const logger::McapMessage& m : reader.messages()) seqs.push_back(m.sequence);
+  for (const mcap::McapMessage& m : reader.messages()) seqs.push_back(m.sequence);
   EXPECT_EQ(describe(analyze_sequence(seqs)), "seq 1..10");
 }
 
@@ -745,13 +745,13 @@ TEST(LoggerNode, FlushTimerBoundsWhatACrashLoses) {
   // Still recording (no footer yet), as a killed logger would leave the file.
   std::this_thread::sleep_for(std::chrono::milliseconds(600));
   {
-    const logger::McapReader reader(file.path());
+    const mcap::McapReader reader(file.path());
     EXPECT_FALSE(reader.recovery().footer_present);
     EXPECT_EQ(reader.recovery().messages_recovered, 50u) << reader.diagnostics_text();
     EXPECT_EQ(reader.messages().size(), 50u);
   }
   node.stop();
-  const logger::McapReader reader(file.path());
+  const mcap::McapReader reader(file.path());
   EXPECT_TRUE(reader.clean()) << reader.diagnostics_text();
   EXPECT_EQ(reader.messages().size(), 50u);
 }
@@ -776,7 +776,7 @@ void expect_complete_rotation(const std::vector<std::string>& files, const Logge
   ASSERT_EQ(c.files.size(), files.size());
   std::vector<std::uint64_t> seqs;
   for (std::size_t i = 0; i < files.size(); ++i) {
-    const logger::McapReader reader(files[i]);
+    const mcap::McapReader reader(files[i]);
     EXPECT_TRUE(reader.clean()) << files[i] << ":\n" << reader.diagnostics_text();
     EXPECT_EQ(reader.channels().size(), channels) << files[i];
     EXPECT_EQ(reader.schemas().size(), channels) << files[i];
@@ -785,9 +785,9 @@ void expect_complete_rotation(const std::vector<std::string>& files, const Logge
     EXPECT_EQ(c.files[i].counters.messages, reader.messages().size()) << files[i];
     ASSERT_TRUE(reader.statistics().has_value());
     EXPECT_EQ(reader.statistics()->message_count, reader.messages().size());
-    const logger::McapChannel* odometry = reader.find_channel("pixyslam/odometry");
+    const mcap::McapChannel* odometry = reader.find_channel("pixyslam/odometry");
     ASSERT_NE(odometry, nullptr) << files[i];
-    for (const logger::McapMessage& m : reader.messages()) {
+    for (const mcap::McapMessage& m : reader.messages()) {
       if (m.channel_id == odometry->id) seqs.push_back(m.sequence);
     }
   }
@@ -803,7 +803,7 @@ TEST(LoggerNode, RotatesBySizeIntoCompleteFiles) {
   LoggerOptions options = node_options(base.path());
   options.topics = {"pixyslam/*", "!pixyslam/ground_truth"};
   options.rotate_size_bytes = 65536;
-  options.compression = logger::McapCompression::kNone;  // sizes as written
+  options.compression = mcap::McapCompression::kNone;  // sizes as written
   LoggerNode node(options);
   node.start();
   dds::Participant robot(loopback_options(), "test_robot");
@@ -875,7 +875,7 @@ TEST(LoggerNode, WriteFailuresKeepTheFileAndRecordingGoesOnInANewOne) {
   std::filesystem::create_directories(fallback);
   LoggerOptions options = node_options(base.path());
   options.topics = {"pixyslam/odometry"};
-  options.compression = logger::McapCompression::kNone;
+  options.compression = mcap::McapCompression::kNone;
   options.flush_period_s = 0.05;
   options.retry_period_s = 0.2;
   options.fallback_dir = fallback.string();
@@ -916,12 +916,12 @@ TEST(LoggerNode, WriteFailuresKeepTheFileAndRecordingGoesOnInANewOne) {
   std::vector<std::uint64_t> seqs;
   for (const LoggedFile& f : c.files) {
     if (std::filesystem::path(f.path).parent_path() == fallback) ++in_fallback;
-    const logger::McapReader reader(f.path);
+    const mcap::McapReader reader(f.path);
     EXPECT_GT(reader.messages().size(), 0u) << f.path << "\n" << reader.diagnostics_text();
     if (!f.closed) {
       EXPECT_FALSE(reader.recovery().footer_present) << f.path;
     }
-    for (const logger::McapMessage& m : reader.messages()) seqs.push_back(m.sequence);
+    for (const mcap::McapMessage& m : reader.messages()) seqs.push_back(m.sequence);
   }
   EXPECT_GE(in_fallback, 1u);
   EXPECT_LT(in_fallback, c.files.size());
@@ -952,7 +952,7 @@ TEST(LoggerNode, AnExistingRecordingIsNeverOverwritten) {
   std::string text;
   std::getline(kept, text);
   EXPECT_EQ(text, "earlier recording");
-  EXPECT_TRUE(logger::McapReader(first_restart).clean());
+  EXPECT_TRUE(mcap::McapReader(first_restart).clean());
   std::filesystem::remove(first_restart);
 }
 

@@ -10,9 +10,9 @@
 
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/slam/fastslam2.h"
-#include "pixyslam/slam_node/map_checkpoint.h"
+#include "pixyslam/slam/map_checkpoint.h"
 
-namespace pixyslam::slam_node {
+namespace pixyslam::slam {
 namespace {
 
 MapCheckpoint sample_checkpoint() {
@@ -177,5 +177,39 @@ TEST(MapCheckpoint, FilterRejectsANonFiniteStartPose) {
   EXPECT_THROW(slam::FastSlam2(slam::FilterOptions{}, bad), std::invalid_argument);
 }
 
+// The checkpoint is the filter's own estimate (not a copy of a published
+// message): pose and covariance as pose_estimate() gives them, the map chosen
+// as the estimator publishes it.
+TEST(MapCheckpoint, IsTheFiltersEstimate) {
+  FilterOptions o;
+  o.particles = 20;
+  FastSlam2 filter(o, Pose2(0.5, -0.25, 0.3));
+  for (int i = 1; i <= 30; ++i) {
+    const double t = 0.1 * i;
+    filter.add_odometry({t, 0.2, 0.1});
+    ObservationFrame f;
+    f.t_s = t + 0.05;
+    f.detections.push_back({1, 2.0 - 0.02 * i, 0.3, 0.05, 0.02});
+    f.detections.push_back({2, 3.0 - 0.02 * i, -0.4, 0.05, 0.02});
+    filter.add_observations(f);
+  }
+  const PoseEstimate e = filter.pose_estimate();
+  const MapCheckpoint best = checkpoint_of(filter, 42, false);
+  EXPECT_EQ(best.stamp_ns, 42u);
+  EXPECT_EQ(best.pose.mean, e.mean);
+  EXPECT_TRUE(best.pose.cov.isApprox(e.cov, 1e-12));
+  EXPECT_EQ(best.pose.cov, best.pose.cov.transpose());
+  ASSERT_EQ(best.landmarks.size(), 2u);
+  const std::vector<LandmarkEstimate> of_best = filter.landmarks_of_best();
+  const std::vector<LandmarkEstimate> mixture = filter.landmarks_mixture();
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(best.landmarks[i].id, of_best[i].id);
+    EXPECT_EQ(best.landmarks[i].mean, of_best[i].mean);
+    EXPECT_EQ(checkpoint_of(filter, 42, true).landmarks[i].cov, mixture[i].cov);
+  }
+  // Particles disagree a little: the mixture's covariance holds their spread.
+  EXPECT_NE(mixture[0].cov, of_best[0].cov);
+}
+
 }  // namespace
-}  // namespace pixyslam::slam_node
+}  // namespace pixyslam::slam

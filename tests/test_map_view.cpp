@@ -14,7 +14,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "pixyslam/config/yaml_reader.h"
-#include "pixyslam/logger/mcap_writer.h"
+#include "pixyslam/mcap/mcap_writer.h"
 #include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/map_view/image_output.h"
 #include "pixyslam/map_view/map_log.h"
@@ -608,7 +608,7 @@ TEST(MsgConversion, TrajectoryDecimation) {
 // omgidl schemas), interleaved by time; with `optimised_every` > 0 an
 // optimised_map channel too, one solution every that many steps.
 void write_log(const std::string& path, int steps, bool with_map_channel, int optimised_every = 0) {
-  logger::McapWriter writer(path, {});
+  mcap::McapWriter writer(path, {});
   std::uint16_t optimised_channel = 0;
   if (optimised_every > 0) {
     const std::uint16_t schema =
@@ -749,7 +749,7 @@ TEST(MapViewLog, BadLogsAreInputErrorsNamingTheFile) {
   // A map_state channel whose payloads are not MapState.
   const std::string garbage = (dir / "garbage.mcap").string();
   {
-    logger::McapWriter writer(garbage, {});
+    mcap::McapWriter writer(garbage, {});
     const std::uint16_t channel = writer.add_channel("pixyslam/map_state", "cdr", 0);
     const std::vector<std::uint8_t> junk = {0x00, 0x01, 0x00, 0x00, 0xff, 0xff, 0xff, 0x7f};
     writer.write_message(channel, 1, 1, 1, junk);

@@ -19,11 +19,11 @@
 
 #include <gtest/gtest.h>
 
-#include "pixyslam/logger/crc32.h"
-#include "pixyslam/logger/mcap_reader.h"
-#include "pixyslam/logger/mcap_writer.h"
+#include "pixyslam/mcap/crc32.h"
+#include "pixyslam/mcap/mcap_reader.h"
+#include "pixyslam/mcap/mcap_writer.h"
 
-namespace pixyslam::logger {
+namespace pixyslam::mcap {
 namespace {
 
 using Bytes = std::vector<std::uint8_t>;
@@ -997,4 +997,4 @@ TEST(McapDamage, SingleByteCorruptionSweepIsAlwaysReportedAsDamage) {
 }
 
 }  // namespace
-}  // namespace pixyslam::logger
+}  // namespace pixyslam::mcap

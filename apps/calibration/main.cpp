@@ -22,11 +22,13 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "pixyslam/app/cli.h"
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/app/process_main.h"
 #include "mrclam_dataset.h"
@@ -47,19 +49,20 @@ namespace {
 
 using namespace pixyslam;
 
-constexpr const char* kUsage =
-    "usage: pixyslam_calibrate camera (--samples POLES.csv | --images PHOTOS.csv) --config PIXY_BRIDGE.yaml\n"
-    "                                 [--out FILE]\n"
-    "       pixyslam_calibrate odometry --straight REC=METRES[,...] --turn REC=DEGREES[,...]\n"
-    "                                   --config ENCODER_BRIDGE.yaml [--out FILE]\n"
-    "       pixyslam_calibrate noise --mrclam DIR --robot N --config BASE.yaml --out FILE.yaml [--ground-truth]\n"
-    "                                [--fit-range-scale] [--keys v_sigma,w_sigma,range_sigma,bearing_sigma,...]\n"
-    "           (odometry noise densities, range/bearing sigmas, the range's cos-bearing exponent, command\n"
-    "            lag (and with --fit-range-scale the range scale) from the filter's innovations, and the\n"
-    "            measurement errors' correlation time from pairs of sightings, without ground truth;\n"
-    "            --ground-truth also fits them with it and prints both with the relative difference;\n"
-    "            --keys: write only these of v_sigma, w_sigma, range_sigma, bearing_sigma, range_scale,\n"
-    "            range_exponent, odometry_delay, error_correlation)\n";
+// The flags a command was given, by name without dashes (filled by the
+// command line; only given flags are present).
+struct Flags {
+  std::map<std::string, std::string> values;
+  bool has(const std::string& name) const { return values.count(name) != 0; }
+  const std::string& get(const std::string& name) const {
+    const auto it = values.find(name);
+    if (it == values.end()) throw app::UsageError("--" + name + " is required");
+    return it->second;
+  }
+  double number(const std::string& name, double fallback) const {
+    return has(name) ? std::stod(get(name)) : fallback;
+  }
+};
 
 std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -100,7 +103,7 @@ std::vector<calibration::OdometryRun> read_runs(const std::string& flag, const s
 }
 
 // The pole samples of --samples, or measured in the photos of --images.
-std::vector<calibration::PoleSample> camera_samples(const app::CommandLine& args, config::YamlReader& root,
+std::vector<calibration::PoleSample> camera_samples(const Flags& args, config::YamlReader& root,
                                                     const pixy::PixyOptions& pixy, std::string& source) {
   if (args.has("samples") == args.has("images")) throw std::invalid_argument("give one of --samples and --images");
   if (args.has("samples")) {
@@ -124,7 +127,7 @@ std::vector<calibration::PoleSample> camera_samples(const app::CommandLine& args
 #endif
 }
 
-int calibrate_camera(const app::CommandLine& args) {
+int calibrate_camera(const Flags& args) {
   const std::string config_path = args.get("config");
   const std::string config_text = config::read_config_text(config_path);  // regular file, size-capped
   config::YamlReader root = config::YamlReader::from_string(config_text, config_path);
@@ -165,7 +168,7 @@ int calibrate_camera(const app::CommandLine& args) {
   return 0;
 }
 
-int odometry(const app::CommandLine& args) {
+int odometry(const Flags& args) {
   const std::string config_path = args.get("config");
   const encoder::EncoderOptions options = encoder::read_encoder_options_file(config_path);
   const auto straights = read_runs("straight", args.get("straight"), 1.0);
@@ -219,7 +222,7 @@ void print_parameters(const char* title, const calibration::NoiseParameters& p) 
               p.range_scale, p.range_cos_bearing_exponent, p.odometry_delay_s, p.error_correlation_s);
 }
 
-int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_scale) {
+int noise(const Flags& args, bool with_ground_truth, bool fit_range_scale) {
   const std::string config_path = args.get("config");
   // --keys: which of the values to write (default all but the range scale,
   // which --fit-range-scale adds). The error correlation is fitted, and used by
@@ -353,39 +356,52 @@ int noise(const app::CommandLine& args, bool with_ground_truth, bool fit_range_s
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::vector<std::string> all(argv + 1, argv + argc);
-  if (const auto status = app::usage_exit(all, kUsage)) return *status;
-  const std::string command = all[0];
-  if (command != "camera" && command != "odometry" && command != "noise") {
-    std::fprintf(stderr, "pixyslam_calibrate: unknown command '%s'\n%s", command.c_str(), kUsage);
-    return 2;
-  }
-  if (command == "noise") {
-    // --ground-truth takes no value: taken out before the `--key value` flags.
-    std::vector<char*> rest;
-    bool with_ground_truth = false, fit_range_scale = false;
-    for (int i = 1; i < argc; ++i) {
-      if (std::string(argv[i]) == "--ground-truth") {
-        with_ground_truth = true;
-      } else if (std::string(argv[i]) == "--fit-range-scale") {
-        fit_range_scale = true;
-      } else {
-        rest.push_back(argv[i]);
-      }
-    }
-    return app::run_main("pixyslam_calibrate", [&] {
-      const app::CommandLine args(static_cast<int>(rest.size()), rest.data(),
-                                  std::set<std::string>{"mrclam", "robot", "config", "out", "keys"});
-      if (args.help()) {
-        std::printf("%s", kUsage);
-        return 0;
-      }
-      return noise(args, with_ground_truth, fit_range_scale);
-    });
-  }
+  app::Cli cli{"pixyslam_calibrate",
+               "Camera, odometry and noise calibration from measurements, written as the YAML the bridges and the "
+               "filter read (docs/calibration.md)."};
+  Flags flags;
+  // --NAME VALUE into flags.values["NAME"] when given.
+  const auto value = [&](app::Cli& command, const std::string& name, const std::string& help, const char* type) {
+    return &command
+                .option_each(
+                    "--" + name, [&flags, name](const std::string& v) { flags.values[name] = v; }, help)
+                .type(type);
+  };
+  app::Cli& camera = cli.subcommand("camera", "the focal length from poles seen at known places");
+  value(camera, "samples", "distance_m,height_px[,x_px,bearing_rad] per pole seen at a known place", "POLES.csv");
+  value(camera, "images", "image,distance_m[,bearing_rad] per photo of a pole (camera backend builds)", "PHOTOS.csv");
+  value(camera, "config", "the pixy bridge's YAML", "PIXY_BRIDGE.yaml")->required();
+  value(camera, "out", "write the config with the fitted keys replaced (comments kept)", "FILE");
+
+  app::Cli& odometry_command = cli.subcommand("odometry", "wheel radius and base from straight runs and turns");
+  value(odometry_command, "straight", "REC=METRES,...: Arduino captures of straight runs and the distance driven",
+        "LIST")
+      ->required();
+  value(odometry_command, "turn", "REC=DEGREES,...: captures of turns in place (> 0 counter-clockwise)", "LIST")
+      ->required();
+  value(odometry_command, "config", "the encoder bridge's YAML", "ENCODER_BRIDGE.yaml")->required();
+  value(odometry_command, "out", "write the config with the fitted keys replaced (comments kept)", "FILE");
+
+  bool with_ground_truth = false, fit_range_scale = false;
+  app::Cli& noise_command = cli.subcommand(
+      "noise",
+      "odometry noise densities, range and bearing sigmas, the range's cos-bearing exponent and command lag from "
+      "the filter's own innovations (never the ground truth); the errors' correlation time from pairs of sightings");
+  value(noise_command, "mrclam", "the MRCLAM data set folder of the recording", "DIR")->required();
+  value(noise_command, "robot", "the robot, 1-5", "N")->required();
+  value(noise_command, "config", "the base YAML (filter: and mrclam:)", "BASE.yaml")->required();
+  value(noise_command, "out", "write BASE with the calibrated keys replaced", "FILE.yaml")->required();
+  value(noise_command, "keys",
+        "write only these of v_sigma, w_sigma, range_sigma, bearing_sigma, range_scale, range_exponent, "
+        "odometry_delay, error_correlation",
+        "LIST");
+  noise_command.flag("--ground-truth", with_ground_truth,
+                     "also fit against the ground truth and print both with their relative difference");
+  noise_command.flag("--fit-range-scale", fit_range_scale, "also fit (and write) the range scale");
+  if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("pixyslam_calibrate", [&] {
-    const app::CommandLine args(argc - 1, argv + 1, command == "camera" ? std::set<std::string>{"samples", "images", "config", "out"}
-                                                                        : std::set<std::string>{"straight", "turn", "config", "out"});
-    return command == "camera" ? calibrate_camera(args) : odometry(args);
+    if (camera.chosen()) return calibrate_camera(flags);
+    if (odometry_command.chosen()) return odometry(flags);
+    return noise(flags, with_ground_truth, fit_range_scale);
   });
 }

@@ -5,9 +5,10 @@
 // error at 1 m, wrong ids and the detection time per frame.
 //   camera_eval --config-dir config [--seed S]
 #include <cstdio>
+#include <string>
 
 #include "camera_eval.h"
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/cli.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/pixy/pixy_options.h"
@@ -15,22 +16,24 @@
 
 int main(int argc, char** argv) {
   using namespace pixyslam;
+  std::string dir;
+  double seed = 1;
+  app::Cli cli{"camera_eval",
+               "The colour-code detector on the synthetic camera through the simulated world: per landmark the "
+               "frames in view and detected, range error at 1 m, wrong ids, detection time per frame."};
+  cli.option("--config-dir", dir, "the config folder (pixy_bridge.yaml, slam_sim.yaml)").required().type("DIR");
+  cli.option("--seed", seed, "the world's seed").range(0, 1e15).type("S");
+  if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("camera_eval", [&] {
-    const app::CommandLine args(argc, argv, {"config-dir", "seed"});
-    if (args.help()) {
-      std::printf("usage: camera_eval --config-dir config [--seed S]\n"
-                  "  the colour-code detector on the synthetic camera through the simulated world\n");
-      return 0;
-    }
-    const std::string dir = args.get("config-dir");
-    config::YamlReader pixy_root = config::YamlReader::from_file(dir + "/pixy_bridge.yaml");
+    const std::string dir_path = dir;
+    config::YamlReader pixy_root = config::YamlReader::from_file(dir_path + "/pixy_bridge.yaml");
     config::YamlReader pixy_yaml = pixy_root.child("pixy");
     const pixy::PixyOptions pixy = pixy::read_pixy_options(pixy_yaml);
-    config::YamlReader sim_root = config::YamlReader::from_file(dir + "/slam_sim.yaml");
+    config::YamlReader sim_root = config::YamlReader::from_file(dir_path + "/slam_sim.yaml");
     config::YamlReader world_yaml = sim_root.child("world");
     camera_eval::EvalOptions options;
     options.world = sim::read_world_options(world_yaml);
-    options.seed = static_cast<std::uint64_t>(args.number("seed", 1));
+    options.seed = static_cast<std::uint64_t>(seed);
     config::YamlReader filter_yaml = sim_root.child("filter");
     options.filter = slam::read_filter_options(filter_yaml);
     // Whole-pixel boxes of a camera image: the aspect check forgives one pixel.

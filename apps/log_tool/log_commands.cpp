@@ -14,7 +14,7 @@
 #include "pixyslam/dds/topics.h"
 #include "pixyslam/log_tool/message_format.h"
 #include "pixyslam/log_tool/sequence_check.h"
-#include "pixyslam/logger/mcap_reader.h"
+#include "pixyslam/mcap/mcap_reader.h"
 #include "pixyslam/dds/cdr_payload.h"
 
 namespace pixyslam::log_tool {
@@ -49,8 +49,8 @@ std::string plural(std::uint64_t n, const char* one, const char* many) {
 }
 
 // Where a damaged file is damaged, in one line.
-std::string damage_summary(const logger::McapReader& reader) {
-  const logger::McapDamage& d = reader.damage();
+std::string damage_summary(const mcap::McapReader& reader) {
+  const mcap::McapDamage& d = reader.damage();
   std::string s = "first damage at offset " + std::to_string(d.intact_until) + "; " +
                   plural(d.records.size(), "damaged record", "damaged records") + ", " +
                   plural(d.bytes_skipped, "byte", "bytes") + " skipped, " +
@@ -60,25 +60,25 @@ std::string damage_summary(const logger::McapReader& reader) {
   return s;
 }
 
-std::string status_text(const logger::McapReader& reader) {
-  const logger::McapRecovery& r = reader.recovery();
-  const logger::McapDamage& d = reader.damage();
+std::string status_text(const mcap::McapReader& reader) {
+  const mcap::McapRecovery& r = reader.recovery();
+  const mcap::McapDamage& d = reader.damage();
   switch (reader.state()) {
-    case logger::McapFileState::kComplete:
+    case mcap::McapFileState::kComplete:
       return std::string("complete (footer") + (r.summary_present ? " and summary" : "") + " present" +
              (r.summary_present ? "" : ", no summary section") + ", no problems)";
-    case logger::McapFileState::kNotClosed:
+    case mcap::McapFileState::kNotClosed:
       return "RECOVERED, not closed (no footer; records intact up to offset " + std::to_string(d.intact_until) +
              ", " + std::to_string(r.bytes_ignored_at_end) + " bytes after it ignored)";
-    case logger::McapFileState::kDamaged: break;
+    case mcap::McapFileState::kDamaged: break;
   }
   return "DAMAGED (" + damage_summary(reader) + ")";
 }
 
 // The summary line of `info`: the same facts as the status, never contradicting it.
-std::string summary_text(const logger::McapReader& reader) {
-  const logger::McapRecovery& r = reader.recovery();
-  const logger::McapDamage& d = reader.damage();
+std::string summary_text(const mcap::McapReader& reader) {
+  const mcap::McapRecovery& r = reader.recovery();
+  const mcap::McapDamage& d = reader.damage();
   if (d.summary_found) return d.chunk_index_used ? "yes (chunk index used)" : "yes";
   if (r.summary_present) return "present but damaged (not used to find chunks)";
   return (d.footer_found || r.footer_present) ? "none (the footer points at no summary)" : "no";
@@ -86,18 +86,18 @@ std::string summary_text(const logger::McapReader& reader) {
 
 // On `err`, for a damaged file: one line saying so, then every diagnostic
 // with its offset (at most `max_lines`, 0 = all).
-void report_damage(const logger::McapReader& reader, std::ostream& err, std::size_t max_lines) {
+void report_damage(const mcap::McapReader& reader, std::ostream& err, std::size_t max_lines) {
   const std::string& path = reader.path();
-  if (reader.state() == logger::McapFileState::kNotClosed) {
-    const logger::McapRecovery& r = reader.recovery();
+  if (reader.state() == mcap::McapFileState::kNotClosed) {
+    const mcap::McapRecovery& r = reader.recovery();
     err << path << ": not closed (no footer; records intact up to offset " << reader.damage().intact_until << ", "
         << r.bytes_ignored_at_end << " bytes after it ignored)\n";
     return;
   }
-  if (reader.state() != logger::McapFileState::kDamaged) return;
+  if (reader.state() != mcap::McapFileState::kDamaged) return;
   err << path << ": damaged: " << damage_summary(reader) << "\n";
   std::size_t lines = 0;
-  for (const logger::McapDiagnostic& d : reader.diagnostics()) {
+  for (const mcap::McapDiagnostic& d : reader.diagnostics()) {
     if (max_lines > 0 && lines == max_lines) {
       err << path << ": " << reader.diagnostics().size() - lines
           << " more diagnostics (pixyslam_log info lists them all)\n";
@@ -111,8 +111,8 @@ void report_damage(const logger::McapReader& reader, std::ostream& err, std::siz
 }  // namespace
 
 int run_info(const std::string& path, std::ostream& out, std::ostream& err) {
-  const logger::McapReader reader(path);
-  const logger::McapRecovery& rec = reader.recovery();
+  const mcap::McapReader reader(path);
+  const mcap::McapRecovery& rec = reader.recovery();
   const auto& messages = reader.messages();
 
   out << "file:        " << path << "\n";
@@ -125,7 +125,7 @@ int run_info(const std::string& path, std::ostream& out, std::ostream& err) {
   std::uint64_t last = 0;
   std::map<std::uint16_t, std::uint64_t> per_channel;
   std::map<std::uint16_t, std::pair<std::uint64_t, std::uint64_t>> channel_span;  // first, last log time
-  for (const logger::McapMessage& m : messages) {
+  for (const mcap::McapMessage& m : messages) {
     first = std::min(first, m.log_time_ns);
     last = std::max(last, m.log_time_ns);
     ++per_channel[m.channel_id];
@@ -145,7 +145,7 @@ int run_info(const std::string& path, std::ostream& out, std::ostream& err) {
   std::map<std::string, std::uint64_t> by_compression;
   std::uint64_t compressed = 0;
   std::uint64_t uncompressed = 0;
-  for (const logger::McapChunkInfo& c : reader.chunks()) {
+  for (const mcap::McapChunkInfo& c : reader.chunks()) {
     ++by_compression[compression_name(c.compression)];
     compressed += c.compressed_size;
     uncompressed += c.uncompressed_size;
@@ -163,12 +163,12 @@ int run_info(const std::string& path, std::ostream& out, std::ostream& err) {
   out << "\n";
 
   out << "schemas:     " << reader.schemas().size() << "\n";
-  for (const logger::McapSchema& s : reader.schemas()) {
+  for (const mcap::McapSchema& s : reader.schemas()) {
     out << "  " << s.id << "  " << s.name << "  (" << s.encoding << ", " << s.data.size() << " bytes)\n";
   }
   out << "topics:      " << reader.channels().size() << "\n";
-  for (const logger::McapChannel& c : reader.channels()) {
-    const logger::McapSchema* schema = reader.find_schema(c.schema_id);
+  for (const mcap::McapChannel& c : reader.channels()) {
+    const mcap::McapSchema* schema = reader.find_schema(c.schema_id);
     // The topic's rate between its own first and last message.
     char rate[32] = "";
     const auto span = channel_span.find(c.id);
@@ -192,18 +192,18 @@ int run_info(const std::string& path, std::ostream& out, std::ostream& err) {
         << "  valid bytes " << rec.valid_bytes << " of " << rec.file_size << ", ignored at end "
         << rec.bytes_ignored_at_end << "\n";
   }
-  if (reader.state() == logger::McapFileState::kNotClosed) {
+  if (reader.state() == mcap::McapFileState::kNotClosed) {
     out << "diagnostics: " << reader.diagnostics().size() << "\n";
-    for (const logger::McapDiagnostic& d : reader.diagnostics()) {
+    for (const mcap::McapDiagnostic& d : reader.diagnostics()) {
       out << "  offset " << d.offset << ": " << d.message << "\n";
     }
   }
-  if (reader.state() == logger::McapFileState::kDamaged) {
-    const logger::McapDamage& damage = reader.damage();
+  if (reader.state() == mcap::McapFileState::kDamaged) {
+    const mcap::McapDamage& damage = reader.damage();
     out << "damage:      " << plural(damage.records.size(), "damaged record", "damaged records") << ", "
         << plural(damage.bytes_skipped, "byte", "bytes") << " skipped in "
         << plural(damage.skipped.size(), "range", "ranges") << " (diagnostics on stderr)\n";
-    for (const logger::McapDamagedRecord& d : damage.records) {
+    for (const mcap::McapDamagedRecord& d : damage.records) {
       out << "  offset " << d.offset << " .. " << d.end << ": " << d.what << "\n";
     }
     report_damage(reader, err, 0);
@@ -216,7 +216,7 @@ namespace {
 
 // What one topic (channel) of a file holds.
 struct TopicCheck {
-  const logger::McapChannel* channel = nullptr;
+  const mcap::McapChannel* channel = nullptr;
   std::string type_name;
   std::uint64_t messages = 0;
   std::uint64_t undecodable = 0;
@@ -229,7 +229,7 @@ struct TopicCheck {
 }  // namespace
 
 int run_check(const CheckRequest& request, std::ostream& out, std::ostream& err) {
-  const logger::McapReader reader(request.path);
+  const mcap::McapReader reader(request.path);
   bool ok = true;
 
   if (reader.clean()) {
@@ -240,17 +240,17 @@ int run_check(const CheckRequest& request, std::ostream& out, std::ostream& err)
     out << (pass ? "OK   " : "FAIL ") << "file: " << status_text(reader) << ", " << reader.diagnostics().size()
         << " diagnostics, " << reader.recovery().bytes_ignored_at_end << " bytes ignored at end"
         << (pass ? " (allowed)" : " (--allow-recovered to check it anyway)") << "\n";
-    if (reader.state() == logger::McapFileState::kDamaged) report_damage(reader, err, 20);
+    if (reader.state() == mcap::McapFileState::kDamaged) report_damage(reader, err, 20);
   }
 
   std::map<std::uint16_t, TopicCheck> topics;
-  for (const logger::McapChannel& c : reader.channels()) {
+  for (const mcap::McapChannel& c : reader.channels()) {
     TopicCheck& t = topics[c.id];
     t.channel = &c;
-    const logger::McapSchema* schema = reader.find_schema(c.schema_id);
+    const mcap::McapSchema* schema = reader.find_schema(c.schema_id);
     t.type_name = schema ? schema->name : "";
   }
-  for (const logger::McapMessage& m : reader.messages()) {
+  for (const mcap::McapMessage& m : reader.messages()) {
     auto it = topics.find(m.channel_id);
     if (it == topics.end()) continue;  // the reader reports messages of unknown channels
     TopicCheck& t = it->second;
@@ -342,12 +342,12 @@ bool decode_value(const std::string& topic, const std::vector<std::uint8_t>& byt
 // Every message of `topic` in `path`, decoded, in file order. Throws naming
 // the file and message index of an undecodable payload.
 std::vector<Value> decoded_messages(const std::string& path, const std::string& topic) {
-  const logger::McapReader reader(path);
-  const logger::McapChannel* channel = reader.find_channel(topic);
+  const mcap::McapReader reader(path);
+  const mcap::McapChannel* channel = reader.find_channel(topic);
   if (channel == nullptr) throw std::runtime_error(path + ": no channel '" + topic + "'");
   std::vector<Value> values;
   std::size_t index = 0;
-  for (const logger::McapMessage& m : reader.messages()) {
+  for (const mcap::McapMessage& m : reader.messages()) {
     if (m.channel_id != channel->id) continue;
     Value value = Value::structure();
     std::string error;
@@ -363,13 +363,13 @@ std::vector<Value> decoded_messages(const std::string& path, const std::string& 
 }  // namespace
 
 int run_print(const PrintRequest& request, std::ostream& out, std::ostream& err) {
-  const logger::McapReader reader(request.path);
+  const mcap::McapReader reader(request.path);
   if (!request.topic.empty() && reader.find_channel(request.topic) == nullptr) {
     throw std::runtime_error(request.path + ": no channel '" + request.topic + "'");
   }
   int status = 0;
-  for (const logger::McapMessage& m : reader.messages()) {
-    const logger::McapChannel* channel = reader.find_channel(m.channel_id);
+  for (const mcap::McapMessage& m : reader.messages()) {
+    const mcap::McapChannel* channel = reader.find_channel(m.channel_id);
     if (channel == nullptr || (!request.topic.empty() && channel->topic != request.topic)) continue;
     Value value = Value::structure();
     std::string error;
@@ -387,7 +387,7 @@ int run_print(const PrintRequest& request, std::ostream& out, std::ostream& err)
   // After the messages, so that it is the last thing a terminal shows.
   out.flush();
   report_damage(reader, err, 20);
-  return reader.state() == logger::McapFileState::kDamaged ? 1 : status;
+  return reader.state() == mcap::McapFileState::kDamaged ? 1 : status;
 }
 
 int run_compare(const CompareRequest& request, std::ostream& out) {

@@ -26,7 +26,9 @@
 #include <vector>
 
 #include "log_commands.h"
+#include "pixyslam/app/cli.h"
 #include "pixyslam/app/command_line.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/yaml_text.h"
@@ -41,182 +43,146 @@
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: " PIXYSLAM_TOOL_NAME " participants [--duration S] [DDS options]\n"
-    "       " PIXYSLAM_TOOL_NAME " topics [--duration S] [DDS options]\n"
-    "       " PIXYSLAM_TOOL_NAME " echo TOPIC [--json] [--count N] [--duration S] [DDS options]\n"
-    "       " PIXYSLAM_TOOL_NAME " hz TOPIC [--duration S] [DDS options]\n"
-    "       " PIXYSLAM_TOOL_NAME " diagnostics [--duration S] [DDS options]\n"
-    "       " PIXYSLAM_TOOL_NAME " info FILE.mcap\n"
-    "       " PIXYSLAM_TOOL_NAME " check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]\n"
-    "       " PIXYSLAM_TOOL_NAME " print FILE.mcap [--topic TOPIC] [--json]\n"
-    "       " PIXYSLAM_TOOL_NAME " compare A.mcap B.mcap --topic TOPIC [--ignore FIELD,...] [--tolerance X]\n"
-    "DDS options: --config FILE (YAML with a dds: mapping; default " PIXYSLAM_DEFAULT_PROFILES_FILE
-    ", domain 0)\n"
-    "             --domain N (overrides the file's domain_id)\n"
-    "TOPIC: pixyslam/odometry, pixyslam/landmark_observation, pixyslam/map_state, pixyslam/ground_truth,\n"
-    "       pixyslam/diagnostics, pixyslam/optimised_map\n";
-
 // TOPIC=N, N a non-negative integer.
 void add_expectation(const std::string& text, pixyslam::log_tool::CheckRequest& request) {
   const auto eq = text.rfind('=');
   if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) {
-    throw std::invalid_argument("--expect needs TOPIC=N, got '" + text + "'");
+    throw pixyslam::app::UsageError("--expect needs TOPIC=N, got '" + text + "'");
   }
   const std::string count = text.substr(eq + 1);
   if (count.find_first_not_of("0123456789") != std::string::npos || count.size() > 18) {
-    throw std::invalid_argument("--expect " + text + ": N must be a non-negative integer");
+    throw pixyslam::app::UsageError("--expect " + text + ": N must be a non-negative integer");
   }
   if (!request.expected.emplace(text.substr(0, eq), std::stoull(count)).second) {
-    throw std::invalid_argument("--expect given twice for '" + text.substr(0, eq) + "'");
+    throw pixyslam::app::UsageError("--expect given twice for '" + text.substr(0, eq) + "'");
   }
 }
 
-double non_negative_number(const std::string& flag, const std::string& text) {
-  std::size_t used = 0;
-  double v = -1.0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != text.size() || !(v >= 0.0)) throw std::invalid_argument(flag + " needs a number >= 0, got '" + text + "'");
-  return v;
-}
+constexpr const char* kTopics =
+    "TOPIC: pixyslam/odometry, pixyslam/landmark_observation, pixyslam/map_state, pixyslam/ground_truth,\n"
+    "       pixyslam/diagnostics, pixyslam/optimised_map";
 
-// Everything after the subcommand.
-struct Arguments {
-  std::vector<std::string> positional;
-  std::string dds_config;
-  std::vector<std::string> dds_overrides;  // --domain
-  double seconds = -1.0;  // -1: the command's default
-  std::size_t count = 0;
-  bool json = false;
-  std::string topic;  // print --topic
-  pixyslam::log_tool::CheckRequest check;
-  pixyslam::log_tool::CompareRequest compare;
+// The DDS settings of a live command: --config FILE, --domain N.
+struct DdsArguments {
+  std::string config;
+  std::vector<std::string> overrides;  // --domain
+
+  void add_to(pixyslam::app::Cli& command) {
+    command
+        .option("--config", config,
+                std::string("a YAML with a dds: mapping (default ") + PIXYSLAM_DEFAULT_PROFILES_FILE + ", domain 0)")
+        .existing_file()
+        .type("FILE");
+    command
+        .option_each(
+            "--domain", [this](const std::string& d) { overrides.push_back(pixyslam::dds::domain_override(d)); },
+            "DDS domain (overrides the config's and PIXYSLAM_DDS_DOMAIN)")
+        .type("N");
+  }
+  pixyslam::dds::DdsOptions resolve() const {
+    pixyslam::dds::DdsOptions o = pixyslam::dds::read_dds_options_file(config, PIXYSLAM_DEFAULT_PROFILES_FILE);
+    pixyslam::dds::resolve_settings(o, overrides);
+    return o;
+  }
 };
-
-Arguments parse(const std::string& command, const std::vector<std::string>& args) {
-  const bool live = command == "participants" || command == "topics" || command == "echo" || command == "hz" ||
-                    command == "diagnostics";
-  Arguments a;
-  for (std::size_t i = 1; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw std::invalid_argument(arg + " needs a value");
-      return args[++i];
-    };
-    if (live && arg == "--config") {
-      a.dds_config = value();
-    } else if (live && arg == "--domain") {
-      a.dds_overrides.push_back(pixyslam::dds::domain_override(value()));
-    } else if (live && arg == "--duration") {
-      a.seconds = non_negative_number(arg, value());
-    } else if (command == "echo" && arg == "--count") {
-      const double c = non_negative_number(arg, value());
-      if (c != static_cast<double>(static_cast<std::size_t>(c))) throw std::invalid_argument("--count must be an integer");
-      a.count = static_cast<std::size_t>(c);
-    } else if ((command == "echo" || command == "print") && arg == "--json") {
-      a.json = true;
-    } else if (command == "check" && arg == "--expect") {
-      add_expectation(value(), a.check);
-    } else if (command == "check" && arg.rfind("--expect=", 0) == 0) {
-      add_expectation(arg.substr(9), a.check);
-    } else if (command == "check" && arg == "--allow-recovered") {
-      a.check.allow_recovered = true;
-    } else if (command == "print" && arg == "--topic") {
-      a.topic = value();
-    } else if (command == "compare" && arg == "--topic") {
-      a.compare.topic = value();
-    } else if (command == "compare" && arg == "--ignore") {
-      for (std::string& field : pixyslam::config::split_comma_list(value())) {
-        a.compare.ignored.push_back(std::move(field));
-      }
-    } else if (command == "compare" && arg == "--tolerance") {
-      a.compare.tolerance = non_negative_number(arg, value());
-    } else if (arg.rfind("-", 0) == 0) {
-      throw std::invalid_argument("unknown option '" + arg + "' for " + command);
-    } else {
-      a.positional.push_back(arg);
-    }
-  }
-  if (command == "compare") {
-    if (a.positional.size() != 2) throw std::invalid_argument("compare needs exactly two MCAP files");
-    if (a.compare.topic.empty()) throw std::invalid_argument("compare needs --topic");
-    return a;
-  }
-  const std::size_t wanted = (command == "participants" || command == "topics" || command == "diagnostics") ? 0 : 1;
-  if (a.positional.size() != wanted) {
-    const char* what = command == "info" || command == "check" || command == "print" ? "an MCAP file" : "a TOPIC";
-    if (wanted == 0) throw std::invalid_argument(command + " takes no positional argument");
-    throw std::invalid_argument(command + " needs exactly " + what);
-  }
-  return a;
-}
-
-pixyslam::dds::DdsOptions dds_options(const Arguments& a) {
-  using namespace pixyslam;
-  dds::DdsOptions o = dds::read_dds_options_file(a.dds_config, PIXYSLAM_DEFAULT_PROFILES_FILE);
-  dds::resolve_settings(o, a.dds_overrides);
-  return o;
-}
 
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
-  const std::vector<std::string> args(argv + 1, argv + argc);
-  if (const auto status = app::usage_exit(args, kUsage)) return *status;
-  const std::string& command = args[0];
-  Arguments a;
-  try {
-    if (command != "participants" && command != "topics" && command != "echo" && command != "hz" &&
-        command != "diagnostics" &&
-        command != "info" && command != "check" && command != "compare" &&
-        command != "print") {
-      throw std::invalid_argument("unknown command '" + command + "'");
-    }
-    a = parse(command, args);
-    if (command == "info" || command == "check" || command == "compare" || command == "print") {
-      app::require_files(a.positional);
-    }
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, PIXYSLAM_TOOL_NAME ": %s\n%s", e.what(), kUsage);
-    return 2;
-  }
+  app::Cli cli{PIXYSLAM_TOOL_NAME,
+               "Inspects the live system (participants, topics, echo, hz, diagnostics) and its recordings (info, "
+               "check, print, compare), decoding with the project's own types."};
+  cli.footer(std::string(kTopics) + "\nExit status: 0 ok, 1 check failed / too few samples / file unreadable or "
+                                    "damaged, 2 command-line or config error.");
+  DdsArguments dds_args;
+  double seconds = -1.0;  // -1: the command's default
+  auto add_duration = [&](app::Cli& command, const char* default_s) {
+    command.option("--duration", seconds, std::string("listen S seconds (default ") + default_s + ")")
+        .non_negative()
+        .type("S");
+  };
+  app::Cli& participants = cli.subcommand("participants", "the participants on the domain: process, host, pid");
+  add_duration(participants, "4");
+  dds_args.add_to(participants);
+  app::Cli& topics = cli.subcommand("topics", "the topics on the domain with their types, writers and readers");
+  add_duration(topics, "4");
+  dds_args.add_to(topics);
+  app::Cli& diagnostics = cli.subcommand("diagnostics", "each process's counters (the diagnostics topic)");
+  add_duration(diagnostics, "3");
+  dds_args.add_to(diagnostics);
+
+  log_tool::EchoRequest echo_request;
+  int count = 0;
+  app::Cli& echo = cli.subcommand("echo", "prints a topic's samples, the newest kept one first");
+  echo.option("topic", echo_request.topic, "the topic").required().type("TOPIC");
+  echo.flag("--json", echo_request.json, "one JSON object per line");
+  echo.option("--count", count, "stop after N samples (0: no limit)").non_negative().type("N");
+  add_duration(echo, "0: until Ctrl-C or --count");
+  dds_args.add_to(echo);
+
+  std::string hz_topic;
+  app::Cli& hz = cli.subcommand("hz", "a topic's rate, updated every second like ros2 topic hz");
+  hz.option("topic", hz_topic, "the topic").required().type("TOPIC");
+  add_duration(hz, "5");
+  dds_args.add_to(hz);
+
+  std::string info_file;
+  app::Cli& info = cli.subcommand("info", "a recording's topics, counts, rates and times");
+  info.option("file", info_file, "the MCAP file").required().existing_file().type("FILE.mcap");
+
+  log_tool::CheckRequest check_request;
+  app::Cli& check = cli.subcommand("check", "a recording is whole: every sequence 1..N, no damage");
+  check.option("file", check_request.path, "the MCAP file").required().existing_file().type("FILE.mcap");
+  check
+      .option_each(
+          "--expect", [&](const std::string& e) { add_expectation(e, check_request); },
+          "TOPIC holds exactly N messages (repeatable)")
+      .type("TOPIC=N");
+  check.flag("--allow-recovered", check_request.allow_recovered, "a file its writer did not close passes");
+
+  log_tool::PrintRequest print_request;
+  app::Cli& print = cli.subcommand("print", "a recording's messages, decoded");
+  print.option("file", print_request.path, "the MCAP file").required().existing_file().type("FILE.mcap");
+  print.option("--topic", print_request.topic, "only this topic").type("TOPIC");
+  print.flag("--json", print_request.json, "one JSON object per line");
+
+  log_tool::CompareRequest compare_request;
+  std::vector<std::string> compare_files;
+  std::string ignored;
+  app::Cli& compare = cli.subcommand("compare", "two recordings' messages of one topic, field by field");
+  compare.option("files", compare_files, "the two MCAP files").required().existing_file().type("A.mcap B.mcap");
+  compare.option("--topic", compare_request.topic, "the topic").required().type("TOPIC");
+  compare.option("--ignore", ignored, "fields not compared").type("FIELD,...");
+  compare.option("--tolerance", compare_request.tolerance, "largest difference of a number taken as equal")
+      .non_negative()
+      .type("X");
 
   try {
-    if (command == "info") return log_tool::run_info(a.positional[0], std::cout, std::cerr);
-    if (command == "print") return log_tool::run_print({a.positional[0], a.topic, a.json}, std::cout, std::cerr);
-    if (command == "compare") {
-      a.compare.first_path = a.positional[0];
-      a.compare.second_path = a.positional[1];
-      return log_tool::run_compare(a.compare, std::cout);
-    }
-    if (command == "check") {
-      a.check.path = a.positional[0];
-      return log_tool::run_check(a.check, std::cout, std::cerr);
-    }
-    const dds::DdsOptions options = dds_options(a);
-    if (command == "participants") return log_tool::run_participants(options, a.seconds < 0 ? 4.0 : a.seconds, std::cout);
-    if (command == "topics") return log_tool::run_topics(options, a.seconds < 0 ? 4.0 : a.seconds, std::cout);
-    if (command == "diagnostics") {
-      return log_tool::run_diagnostics(options, a.seconds < 0 ? 3.0 : a.seconds, std::cout);
-    }
-    if (command == "hz") return log_tool::run_hz(options, a.positional[0], a.seconds < 0 ? 5.0 : a.seconds, std::cout);
-    log_tool::EchoRequest request;
-    request.topic = a.positional[0];
-    request.json = a.json;
-    request.count = a.count;
-    request.seconds = a.seconds < 0 ? 0.0 : a.seconds;
-    return log_tool::run_echo(options, request, std::cout);
-  } catch (const config::ConfigError& e) {
-    std::fprintf(stderr, PIXYSLAM_TOOL_NAME ": config error: %s\n", e.what());
+    if (const auto done = cli.parse(argc, argv)) return *done;
+  } catch (const app::UsageError& e) {  // from --expect
+    std::fprintf(stderr, PIXYSLAM_TOOL_NAME ": %s (see --help)\n", e.what());
     return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, PIXYSLAM_TOOL_NAME ": %s\n", e.what());
-    return 1;
   }
+  return app::run_main(PIXYSLAM_TOOL_NAME, [&]() -> int {
+    if (info.chosen()) return log_tool::run_info(info_file, std::cout, std::cerr);
+    if (print.chosen()) return log_tool::run_print(print_request, std::cout, std::cerr);
+    if (check.chosen()) return log_tool::run_check(check_request, std::cout, std::cerr);
+    if (compare.chosen()) {
+      if (compare_files.size() != 2) throw app::UsageError("compare needs exactly two MCAP files");
+      compare_request.first_path = compare_files[0];
+      compare_request.second_path = compare_files[1];
+      for (std::string& field : config::split_comma_list(ignored)) compare_request.ignored.push_back(std::move(field));
+      return log_tool::run_compare(compare_request, std::cout);
+    }
+    const dds::DdsOptions options = dds_args.resolve();
+    if (participants.chosen()) return log_tool::run_participants(options, seconds < 0 ? 4.0 : seconds, std::cout);
+    if (topics.chosen()) return log_tool::run_topics(options, seconds < 0 ? 4.0 : seconds, std::cout);
+    if (diagnostics.chosen()) return log_tool::run_diagnostics(options, seconds < 0 ? 3.0 : seconds, std::cout);
+    if (hz.chosen()) return log_tool::run_hz(options, hz_topic, seconds < 0 ? 5.0 : seconds, std::cout);
+    echo_request.count = static_cast<std::size_t>(count);
+    echo_request.seconds = seconds < 0 ? 0.0 : seconds;
+    return log_tool::run_echo(options, echo_request, std::cout);
+  });
 }

@@ -95,13 +95,13 @@ LogPlayer::LogPlayer(const PlayerOptions& options, std::ostream& log) : options_
   // Topics of the logs that the project knows (with a CDR channel).
   std::vector<std::string> in_logs;
   for (const std::string& file : options_.files) {
-    readers_.push_back(std::make_unique<logger::McapReader>(file));
-    const logger::McapReader& reader = *readers_.back();
+    readers_.push_back(std::make_unique<mcap::McapReader>(file));
+    const mcap::McapReader& reader = *readers_.back();
     if (!reader.clean()) {
       log_ << "pixyslam_play: " << file << " is incomplete (" << reader.recovery().messages_recovered
            << " messages recovered); playing what was recovered\n";
     }
-    for (const logger::McapChannel& channel : reader.channels()) {
+    for (const mcap::McapChannel& channel : reader.channels()) {
       if (dds::find_topic(channel.topic) == nullptr || channel.message_encoding != "cdr") {
         log_ << "pixyslam_play: " << file << ": skipping channel '" << channel.topic << "' ("
              << channel.message_encoding << "): not a topic of this project\n";
@@ -128,9 +128,9 @@ LogPlayer::LogPlayer(const PlayerOptions& options, std::ostream& log) : options_
   }
 
   for (std::size_t f = 0; f < readers_.size(); ++f) {
-    const logger::McapReader& reader = *readers_[f];
+    const mcap::McapReader& reader = *readers_[f];
     for (std::size_t m = 0; m < reader.messages().size(); ++m) {
-      const logger::McapChannel* channel = reader.find_channel(reader.messages()[m].channel_id);
+      const mcap::McapChannel* channel = reader.find_channel(reader.messages()[m].channel_id);
       std::size_t index = kNotPlayed;
       if (channel != nullptr && channel->message_encoding == "cdr") {
         const auto it = channel_of_topic.find(channel->topic);

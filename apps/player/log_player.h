@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "pixyslam/dds/participant.h"
-#include "pixyslam/logger/mcap_reader.h"
+#include "pixyslam/mcap/mcap_reader.h"
 #include "pixyslam/player/playback_plan.h"
 
 namespace pixyslam::player {
@@ -63,7 +63,7 @@ class LogPlayer {
 
   PlayerOptions options_;
   std::ostream& log_;
-  std::vector<std::unique_ptr<logger::McapReader>> readers_;
+  std::vector<std::unique_ptr<mcap::McapReader>> readers_;
   std::vector<Entry> entries_;  // every message of every file, by log time
   std::vector<std::uint64_t> log_times_ns_;
   std::unique_ptr<dds::Participant> participant_;

@@ -4,131 +4,73 @@
 //                 [--wait-timeout S] [--config FILE] [--domain N] [--quiet]
 // Exit status: 0 played, 1 a file could not be read / nothing to play,
 // 2 command-line or config error.
-#include <cstdio>
-#include <exception>
-#include <optional>
 #include <iostream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "log_player.h"
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/cli.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
-#include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/yaml_text.h"
-#include "pixyslam/parameters/parameters.h"
 
 #ifndef PIXYSLAM_DEFAULT_PROFILES_FILE
 #define PIXYSLAM_DEFAULT_PROFILES_FILE ""
 #endif
 
-namespace {
-
-constexpr const char* kUsage =
-    "usage: pixyslam_play LOG.mcap [MORE.mcap ...] [options]\n"
-    "  --rate R          playback speed factor (default 1: the recorded timing)\n"
-    "  --start S         skip the first S seconds of the log\n"
-    "  --duration S      play S seconds of log time (default: to the end)\n"
-    "  --loop            start over at the end until Ctrl-C\n"
-    "  --topics LIST     comma-separated names, globs, !exclusions (default: every topic)\n"
-    "  --restamp         shift header stamps onto the current clock (for a live estimator)\n"
-    "  --wait-readers N  wait for N readers per topic before playing (default 1; 0: do not wait)\n"
-    "  --wait-timeout S  then play anyway (default 10)\n"
-    "  --config FILE     YAML with a dds: mapping (default " PIXYSLAM_DEFAULT_PROFILES_FILE ", domain 0)\n"
-    "  --domain N        overrides the domain id\n"
-    "  --quiet           no progress lines\n";
-
-double number(const std::string& flag, const std::string& text) {
-  const std::optional<double> v = pixyslam::parameters::parse_number(text);
-  if (!v) throw std::invalid_argument(flag + " needs a number, got '" + text + "'");
-  return *v;
-}
-
-int integer(const std::string& flag, const std::string& text, int min, int max) {
-  const double v = number(flag, text);
-  if (v != static_cast<int>(v) || v < min || v > max) {
-    throw std::invalid_argument(flag + " must be an integer " + std::to_string(min) + ".." + std::to_string(max) +
-                                ", got '" + text + "'");
-  }
-  return static_cast<int>(v);
-}
-
-pixyslam::player::PlayerOptions parse(const std::vector<std::string>& args) {
-  using namespace pixyslam;
-  player::PlayerOptions o;
-  std::string dds_config;
-  std::vector<std::string> dds_overrides;  // --domain
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw std::invalid_argument(arg + " needs a value");
-      return args[++i];
-    };
-    if (arg == "--rate") {
-      o.playback.rate = number(arg, value());
-    } else if (arg == "--start") {
-      o.playback.start_offset_s = number(arg, value());
-    } else if (arg == "--duration") {
-      o.playback.duration_s = number(arg, value());
-    } else if (arg == "--loop") {
-      o.playback.loop = true;
-    } else if (arg == "--topics") {
-      o.topics = config::split_comma_list(value());
-      if (o.topics.empty()) throw std::invalid_argument("--topics needs at least one topic");
-    } else if (arg == "--restamp") {
-      o.restamp = true;
-    } else if (arg == "--wait-readers") {
-      o.wait_readers = integer(arg, value(), 0, 1000);
-    } else if (arg == "--wait-timeout") {
-      o.wait_timeout_s = number(arg, value());
-      if (!(o.wait_timeout_s >= 0)) throw std::invalid_argument("--wait-timeout must be >= 0");
-    } else if (arg == "--config") {
-      dds_config = value();
-    } else if (arg == "--domain") {
-      dds_overrides.push_back(dds::domain_override(value()));
-    } else if (arg == "--quiet") {
-      o.progress_period_s = 0.0;
-    } else if (arg.rfind("-", 0) == 0) {
-      throw std::invalid_argument("unknown option '" + arg + "'");
-    } else {
-      o.files.push_back(arg);
-    }
-  }
-  if (o.files.empty()) throw std::invalid_argument("no MCAP file given");
-  app::require_files(o.files);
-  player::validate(o.playback);
-  o.dds = dds::read_dds_options_file(dds_config, PIXYSLAM_DEFAULT_PROFILES_FILE);
-  dds::resolve_settings(o.dds, dds_overrides);
-  return o;
-}
-
-}  // namespace
-
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
-  const std::vector<std::string> args(argv + 1, argv + argc);
-  if (const auto status = app::usage_exit(args, kUsage)) return *status;
-  player::PlayerOptions options;
-  try {
-    options = parse(args);
-  } catch (const config::ConfigError& e) {
-    std::fprintf(stderr, "pixyslam_play: config error: %s\n", e.what());
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "pixyslam_play: %s\n%s", e.what(), kUsage);
-    return 2;
+  player::PlayerOptions o;
+  std::string dds_config;
+  std::vector<std::string> dds_overrides;  // --domain
+  std::string topics;
+  bool quiet = false;
+  app::Cli cli{"pixyslam_play", "Replays MCAP logs written by the logger onto DDS, with the recorded timing."};
+  cli.option("logs", o.files, "the MCAP files, played in the order given (a rotated log: LOG_000.mcap LOG_001.mcap ...)")
+      .required()
+      .type("LOG.mcap");
+  cli.option("--rate", o.playback.rate, "playback speed factor (1: the recorded timing)").type("R");
+  cli.option("--start", o.playback.start_offset_s, "skip the first S seconds of the log").type("S");
+  cli.option("--duration", o.playback.duration_s, "play S seconds of log time (default: to the end)").type("S");
+  cli.flag("--loop", o.playback.loop, "start over at the end until Ctrl-C");
+  cli.option("--topics", topics, "comma-separated names, globs, !exclusions (default: every topic)").type("LIST");
+  cli.flag("--restamp", o.restamp, "shift header stamps onto the current clock (for a live estimator)");
+  cli.option("--wait-readers", o.wait_readers, "wait for N readers per topic before playing (0: do not wait)")
+      .range(0, 1000)
+      .type("N");
+  cli.option("--wait-timeout", o.wait_timeout_s, "then play anyway after S seconds").non_negative().type("S");
+  cli.option("--config", dds_config,
+             std::string("YAML with a dds: mapping (default ") + PIXYSLAM_DEFAULT_PROFILES_FILE + ", domain 0)")
+      .existing_file()
+      .type("FILE");
+  cli.option_each(
+         "--domain", [&](const std::string& d) { dds_overrides.push_back(dds::domain_override(d)); },
+         "DDS domain (overrides the config's and PIXYSLAM_DDS_DOMAIN)")
+      .type("N");
+  cli.flag("--quiet", quiet, "no progress lines");
+  if (const auto done = cli.parse(argc, argv)) return *done;
+  if (const auto failed = app::configure("pixyslam_play", [&] {
+        if (cli.given("--topics")) {
+          o.topics = config::split_comma_list(topics);
+          if (o.topics.empty()) throw std::invalid_argument("--topics needs at least one topic");
+        }
+        if (quiet) o.progress_period_s = 0.0;
+        app::require_files(o.files);
+        player::validate(o.playback);
+        o.dds = dds::read_dds_options_file(dds_config, PIXYSLAM_DEFAULT_PROFILES_FILE);
+        dds::resolve_settings(o.dds, dds_overrides);
+      })) {
+    return *failed;
   }
-  try {
-    player::LogPlayer player(options, std::cerr);
-    player.play();
+  return app::run_main("pixyslam_play", [&] {
+    try {
+      player::LogPlayer player(o, std::cerr);
+      player.play();
+    } catch (const std::invalid_argument& e) {
+      throw app::UsageError(e.what());  // e.g. a --topics pattern no log holds: exit 2
+    }
     return 0;
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "pixyslam_play: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "pixyslam_play: %s\n", e.what());
-    return 1;
-  }
+  });
 }

@@ -26,8 +26,8 @@
 // --optimise adds, to every full run and segment (and the LORO runs with the
 // held-out fit), the map optimiser over the whole run after the filter
 // (optimised_run.h): its ATE, heading RMSE and landmark errors beside the filter's.
-// Exit codes: 0 done, 77 dataset folder absent (skip), 1 error,
-// 3 a robot's mean ATE is not better than dead reckoning.
+// Exit codes: 0 done, 77 dataset folder absent (skip), 1 error or a robot's
+// mean ATE not better than dead reckoning, 2 command-line or config error.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -42,6 +42,8 @@
 #include <utility>
 #include <vector>
 
+#include "pixyslam/app/cli.h"
+#include "pixyslam/app/process_main.h"
 #include "blind_return.h"
 #include "mrclam_dataset.h"
 #include "mrclam_fit.h"
@@ -68,33 +70,6 @@ std::vector<int> parse_list(const std::string& text) {
     out.push_back(static_cast<int>(v));
   }
   return out;
-}
-
-constexpr const char* kUsage =
-    "usage: mrclam_eval --dataset DIR --config FILE [--robots 1,2] [--seeds 1,2] "
-    "[--association known_id|maximum_likelihood] [--segments SECONDS] [--loro] [--blind-return] [--optimise]\n"
-    "  --dataset DIR      MRCLAM data set folder (exit 77 when absent)\n"
-    "  --config FILE      filter options (filter:) and corrections (mrclam:)\n"
-    "  --robots LIST      robots to run, default 1,2,3,4,5\n"
-    "  --seeds LIST       filter seeds per robot, default 1,2,3\n"
-    "  --association M    known_id (default) or maximum_likelihood (ids withheld)\n"
-    "  --segments S       also restart each robot from the ground truth every S seconds\n"
-    "  --loro             leave one robot out: per robot with ground truth, the mrclam:\n"
-    "                     corrections fitted on the other robots with ground truth;\n"
-    "                     ATE and heading RMSE with that fit, with the config's mrclam:\n"
-    "                     values and with neutral corrections (1, 0, 0, 1, 0)\n"
-    "  --blind-return     restarts every 60 s with a blind stretch (heading bias on the\n"
-    "                     odometry), then only far new landmarks, then the first ones\n"
-    "                     again: the heading error before and after they return\n"
-    "  --optimise         also the map optimiser (Ceres) over every run after the filter";
-
-double parse_seconds(const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !(v > 0.0) || !std::isfinite(v)) {
-    throw std::invalid_argument("--segments needs a positive number of seconds, not '" + text + "'");
-  }
-  return v;
 }
 
 // The map optimiser's solution of a filter run, when asked for (--optimise).
@@ -448,43 +423,21 @@ void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<i
   }
 }
 
-int run(int argc, char** argv) {
-  std::string dataset, config_path, association;
+struct EvalArguments {
+  std::string dataset, config_path, association = "known_id";
   std::vector<int> robots{1, 2, 3, 4, 5}, seeds{1, 2, 3};
   double segment_every_s = 0.0;  // 0: no segments
   bool loro = false, blind_return = false, optimise = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::printf("%s\n", kUsage);
-      return 0;
-    }
-  }
-  for (int i = 1; i < argc; ++i) {
-    const std::string key = argv[i];
-    if (key == "--loro") {
-      loro = true;
-      continue;
-    }
-    if (key == "--blind-return") {
-      blind_return = true;
-      continue;
-    }
-    if (key == "--optimise") {
-      optimise = true;
-      continue;
-    }
-    if (i + 1 >= argc) throw std::invalid_argument(kUsage);
-    const std::string value = argv[++i];
-    if (key == "--dataset") dataset = value;
-    else if (key == "--config") config_path = value;
-    else if (key == "--robots") robots = parse_list(value);
-    else if (key == "--seeds") seeds = parse_list(value);
-    else if (key == "--association") association = value;
-    else if (key == "--segments") segment_every_s = parse_seconds(value);
-    else throw std::invalid_argument("unknown argument '" + key + "'\n" + kUsage);
-  }
-  if (dataset.empty() || config_path.empty()) throw std::invalid_argument(kUsage);
+};
+
+int run(const EvalArguments& a) {
+  const std::string& dataset = a.dataset;
+  const std::string& config_path = a.config_path;
+  const std::string& association = a.association;
+  const std::vector<int>& robots = a.robots;
+  const std::vector<int>& seeds = a.seeds;
+  const double segment_every_s = a.segment_every_s;
+  const bool loro = a.loro, blind_return = a.blind_return, optimise = a.optimise;
   if (!std::filesystem::is_directory(dataset)) {
     std::printf("SKIP: dataset folder %s not found\n", dataset.c_str());
     return 77;
@@ -494,11 +447,7 @@ int run(int argc, char** argv) {
   slam::FilterOptions options = slam::read_filter_options(filter_yaml);
   const offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
   root.finish();
-  if (association == "maximum_likelihood") {
-    options.association = slam::Association::kMaximumLikelihood;
-  } else if (!association.empty() && association != "known_id") {
-    throw std::invalid_argument("--association must be known_id or maximum_likelihood");
-  }
+  if (association == "maximum_likelihood") options.association = slam::Association::kMaximumLikelihood;
 
   std::printf("%-6s %-5s %9s %9s %9s %10s %10s %11s %11s %8s %5s %8s %7s %6s %6s\n", "robot", "seed", "ATE_m",
               "ATE_al_m", "DR_ATE_m", "head_deg", "DR_head", "lm_raw_m", "lm_align_m", "gated", "map", "wall_s",
@@ -629,7 +578,7 @@ int run(int argc, char** argv) {
   }
   if (!all_better) {
     std::printf("FAIL: some robot's mean ATE is not better than dead reckoning\n");
-    return 3;
+    return 1;
   }
   return 0;
 }
@@ -637,13 +586,38 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::invalid_argument& e) {  // a command-line error
-    std::fprintf(stderr, "mrclam_eval: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mrclam_eval: %s\n", e.what());
-    return 1;
-  }
+  EvalArguments a;
+  std::string robots, seeds;
+  app::Cli cli{"mrclam_eval",
+               "The accuracy table of the FastSLAM core on an MRCLAM data set: one parameter set for every robot, "
+               "several seeds per robot; segment starts, leave-one-robot-out and blind-return evaluations."};
+  cli.option("--dataset", a.dataset, "the MRCLAM data set folder (exit 77 when absent: a skip)").required().type("DIR");
+  app::add_config(cli, a.config_path, "filter options (filter:) and corrections (mrclam:)");
+  cli.option("--robots", robots, "robots to run (default 1,2,3,4,5)").type("LIST");
+  cli.option("--seeds", seeds, "filter seeds per robot (default 1,2,3)").type("LIST");
+  cli.option("--association", a.association, "known_id (default) or maximum_likelihood (ids withheld)")
+      .choices({"known_id", "maximum_likelihood"})
+      .type("M");
+  cli.option("--segments", a.segment_every_s, "also restart each robot from the ground truth every S seconds")
+      .positive()
+      .type("S");
+  cli.flag("--loro", a.loro,
+           "leave one robot out: per robot with ground truth, the mrclam: corrections fitted on the other robots; "
+           "ATE and heading RMSE with that fit, the config's values and neutral corrections");
+  cli.flag("--blind-return", a.blind_return,
+           "restarts every 60 s with a blind stretch, then far new landmarks, then the first ones again: the "
+           "heading error before and after they return");
+  cli.flag("--optimise", a.optimise, "also the map optimiser (Ceres) over every run after the filter");
+  cli.footer("Exit status: 0 done, 1 an error or a robot's mean ATE not better than dead reckoning, 2 a bad "
+             "command line or config, 77 the data set folder is absent (skip).");
+  if (const auto done = cli.parse(argc, argv)) return *done;
+  return app::run_main("mrclam_eval", [&] {
+    try {
+      if (cli.given("--robots")) a.robots = parse_list(robots);
+      if (cli.given("--seeds")) a.seeds = parse_list(seeds);
+    } catch (const std::invalid_argument& e) {
+      throw app::UsageError(e.what());
+    }
+    return run(a);
+  });
 }

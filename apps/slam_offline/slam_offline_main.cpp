@@ -1,6 +1,7 @@
 // slam_offline: runs the FastSLAM 2.0 core without DDS.
-//   slam_offline sim    --config FILE --out-dir DIR [--seed S] [--write-dataset DIR]
-//   slam_offline mrclam --dataset DIR --robot N --config FILE --out-dir DIR [--seed S] [--optimise]
+//   slam_offline sim      --config FILE --out-dir DIR [--seed S] [--set K=V] [--optimise] [--write-dataset DIR]
+//   slam_offline mrclam   --dataset DIR --robot N --config FILE --out-dir DIR [--seed S] [--set K=V] [--optimise]
+//   slam_offline hardware --config FILE --sim-config FILE --out-dir DIR [--duration S] [...]
 // Writes DIR/trajectory.csv and DIR/landmarks.csv and prints the evaluation.
 // --optimise (any mode): the map optimiser over the whole run after the filter;
 // trajectory.csv and landmarks.csv are then its solution, the filter's go to
@@ -10,7 +11,6 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
-#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -21,6 +21,8 @@
 #ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
 #include "optimised_run.h"
 #endif
+#include "pixyslam/app/cli.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/yaml_text.h"
 #include "pixyslam/eval/csv_io.h"
@@ -31,68 +33,19 @@ namespace {
 
 using namespace pixyslam;
 
-constexpr const char* kUsage =
-    "usage: slam_offline sim    --config FILE --out-dir DIR [--seed S] [--set ...] [--optimise] [--write-dataset DIR]\n"
-    "       slam_offline mrclam --dataset DIR --robot N --config FILE --out-dir DIR [--seed S] [--set ...] [--optimise]\n"
-    "       slam_offline hardware --config FILE --sim-config FILE --out-dir DIR [--seed S] [--set ...] [--duration S]\n"
-    "                           [--optimise]\n"
-    "         (hardware: the robot_sim hardware decoded by the bridges' parsers; the\n"
-    "          pixy/encoder configs are taken from beside --sim-config)\n"
-    "  --set KEY=VALUE,...  override filter parameters of the config, e.g.\n"
-    "              --set filter.particles=300,filter.resample.mode=every_frame\n"
-    "              (slam_estimator --help lists them)\n"
-    "  --optimise  also solve the whole run with the map optimiser (Ceres); its\n"
-    "              solution goes to trajectory.csv and landmarks.csv, the filter's\n"
-    "              to filter_trajectory.csv and filter_landmarks.csv\n"
-    "  --write-dataset DIR  (sim) also write the simulated recording as robot 1 of\n"
-    "              an MRCLAM data set in DIR, with its ground truth, for slam_offline\n"
-    "              mrclam, mrclam_eval and pixyslam_calibrate noise (landmark subjects\n"
-    "              are the pole ids shifted to start above 5 when needed)\n";
-
 struct Args {
-  std::string mode;
-  std::map<std::string, std::string> values;
+  std::string mode;  // sim, mrclam or hardware
+  std::string config;
+  std::string out_dir;
+  std::string seed;
+  std::vector<std::string> sets;  // --set
   bool optimise = false;
-  std::string get(const std::string& key) const {
-    auto it = values.find(key);
-    if (it == values.end()) throw std::invalid_argument("missing --" + key);
-    return it->second;
-  }
+  std::string write_dataset;  // sim
+  std::string dataset;        // mrclam
+  int robot = 0;              // mrclam
+  std::string sim_config;     // hardware
+  double duration_s = 85.0;   // hardware
 };
-
-Args parse_args(int argc, char** argv) {
-  if (argc < 2) throw std::invalid_argument("missing mode (sim or mrclam)");
-  Args a;
-  a.mode = argv[1];
-  if (a.mode != "sim" && a.mode != "mrclam" && a.mode != "hardware") {
-    throw std::invalid_argument("unknown mode '" + a.mode + "'");
-  }
-  for (int i = 2; i < argc; ++i) {
-    const std::string key = argv[i];
-    if (key == "--optimise") {
-      a.optimise = true;
-      continue;
-    }
-    static const char* known[] = {"--config",     "--out-dir",  "--seed",          "--dataset", "--robot",
-                                  "--sim-config", "--duration", "--write-dataset", "--set"};
-    bool ok = false;
-    for (const char* k : known) ok = ok || key == k;
-    if (!ok) throw std::invalid_argument("unknown argument '" + key + "'");
-    if (i + 1 >= argc) throw std::invalid_argument(key + " needs a value");
-    a.values[key.substr(2)] = argv[++i];
-  }
-  if (a.values.count("write-dataset") && a.mode != "sim") {
-    throw std::invalid_argument("--write-dataset: only in sim mode");
-  }
-  return a;
-}
-
-long parse_long(const std::string& text, const std::string& what) {
-  char* end = nullptr;
-  const long v = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0') throw std::invalid_argument(what + ": not an integer: '" + text + "'");
-  return v;
-}
 
 offline::RunInput sim_input(const sim::WorldRun& run) {
   offline::RunInput in;
@@ -139,34 +92,30 @@ void print_solve(const offline::OptimisedRun& opt) {
 #endif
 
 int run(const Args& args) {
-  const std::string config_path = args.get("config");
+  const std::string& config_path = args.config;
   config::YamlReader root = config::YamlReader::from_file(config_path);
   config::YamlReader filter_yaml = root.child("filter");
   slam::FilterOptions options = slam::read_filter_options(filter_yaml);
   std::vector<std::string> overrides;
-  if (args.values.count("seed")) overrides.push_back("filter.seed=" + args.get("seed"));
-  if (args.values.count("set")) {
-    for (const std::string& assignment : config::split_comma_list(args.get("set"))) overrides.push_back(assignment);
-  }
+  if (!args.seed.empty()) overrides.push_back("filter.seed=" + args.seed);
+  overrides.insert(overrides.end(), args.sets.begin(), args.sets.end());
   try {
     slam::apply_overrides(options, overrides);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(std::string("--seed/--set: ") + e.what());
+    throw app::UsageError(std::string("--seed/--set: ") + e.what());
   }
 
   offline::RunInput input;
   std::string title;
   if (args.mode == "hardware") {
     // The estimator's file: only its filter matters offline.
-    const std::string sim_config = args.get("sim-config");
+    const std::string& sim_config = args.sim_config;
     const std::string folder = std::filesystem::path(sim_config).parent_path().string();
     robot_sim::RobotSimConfig hw = robot_sim::load_robot_sim_config(
         sim_config, (std::filesystem::path(folder) / "pixy_bridge.yaml").string(),
         (std::filesystem::path(folder) / "encoder_bridge.yaml").string());
-    if (args.values.count("seed")) hw.hardware.seed = options.seed;
-    double duration = 85.0;
-    if (args.values.count("duration")) duration = std::stod(args.get("duration"));
-    input = offline::hardware_input(hw, duration);
+    if (!args.seed.empty()) hw.hardware.seed = options.seed;
+    input = offline::hardware_input(hw, args.duration_s);
     title = "emulated hardware, " + std::to_string(input.landmarks.size()) + " visible poles, " +
             std::to_string(input.frames.size()) + " frames with detections";
   } else if (args.mode == "sim") {
@@ -175,20 +124,20 @@ int run(const Args& args) {
     root.finish();
     const sim::WorldRun run = sim::simulate(world);
     input = sim_input(run);
-    if (args.values.count("write-dataset")) {
-      mrclam::write_robot(args.get("write-dataset"), sim_recording(run));
-      std::printf("wrote the recording as robot 1 of the MRCLAM data set %s\n", args.get("write-dataset").c_str());
+    if (!args.write_dataset.empty()) {
+      mrclam::write_robot(args.write_dataset, sim_recording(run));
+      std::printf("wrote the recording as robot 1 of the MRCLAM data set %s\n", args.write_dataset.c_str());
     }
     title = "simulated world, " + std::to_string(run.poles.size()) + " poles, " +
             std::to_string(run.frames.size()) + " camera frames";
   } else {
     const offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
     root.finish();
-    const std::string dataset = args.get("dataset");
-    const long robot = parse_long(args.get("robot"), "--robot");
-    const mrclam::RobotData data = mrclam::load_robot(dataset, static_cast<int>(robot));
+    const std::string& dataset = args.dataset;
+    const int robot = args.robot;
+    const mrclam::RobotData data = mrclam::load_robot(dataset, robot);
     input = offline::mrclam_input(data, model);
-    std::printf("MRCLAM %s robot %ld: %zu odometry rows, %zu frames, landmarks from %s\n", dataset.c_str(), robot,
+    std::printf("MRCLAM %s robot %d: %zu odometry rows, %zu frames, landmarks from %s\n", dataset.c_str(), robot,
                 data.odometry.size(), data.frames.size(), data.landmark_file.c_str());
     std::printf("dropped rows           %zu robot (subjects 1-5), %zu unknown barcode\n", data.counts.robot_rows,
                 data.counts.unknown_barcode_rows);
@@ -200,7 +149,7 @@ int run(const Args& args) {
 #ifndef PIXYSLAM_HAVE_MAP_OPTIMIZER
   if (args.optimise) throw std::runtime_error("--optimise: this build has no map optimiser (built without Ceres)");
 #endif
-  const std::filesystem::path out = args.get("out-dir");
+  const std::filesystem::path out = args.out_dir;
   const offline::RunResult result = offline::run_filter(options, input);
   std::filesystem::create_directories(out);
   const auto write = [&out](const std::string& prefix, const offline::RunResult& r) {
@@ -227,20 +176,37 @@ int run(const Args& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-  }
-  try {
-    return run(parse_args(argc, argv));
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "slam_offline: %s\n%s", e.what(), kUsage);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "slam_offline: %s\n", e.what());
-    return 1;
-  }
+  Args args;
+  app::Cli cli{"slam_offline",
+               "Runs the FastSLAM 2.0 core without DDS on a simulated world, an MRCLAM robot or the emulated "
+               "hardware; writes OUT/trajectory.csv and OUT/landmarks.csv and prints the evaluation."};
+  auto common = [&](app::Cli& mode) {
+    app::add_config(mode, args.config, "the YAML with the filter: section (and world: in sim mode)");
+    mode.option("--out-dir", args.out_dir, "write trajectory.csv and landmarks.csv into DIR").required().type("DIR");
+    mode.option("--seed", args.seed, "the filter's seed (filter.seed)").type("S");
+    app::add_set(mode, args.sets, "filter.particles=300 (slam_estimator --help lists them)");
+    mode.flag("--optimise",
+              args.optimise,
+              "also solve the whole run with the map optimiser (Ceres): its solution goes to trajectory.csv and "
+              "landmarks.csv, the filter's to filter_trajectory.csv and filter_landmarks.csv");
+  };
+  app::Cli& sim = cli.subcommand("sim", "the simulated world of the config's world: section");
+  common(sim);
+  sim.option("--write-dataset", args.write_dataset,
+             "also write the recording as robot 1 of an MRCLAM data set in DIR, with its ground truth")
+      .type("DIR");
+  app::Cli& mrclam = cli.subcommand("mrclam", "one robot of an MRCLAM data set");
+  common(mrclam);
+  mrclam.option("--dataset", args.dataset, "the data set's folder (e.g. ../shared/data/mrclam/Dataset6)")
+      .required()
+      .type("DIR");
+  mrclam.option("--robot", args.robot, "the robot, 1-5").required().range(1, 5).type("N");
+  app::Cli& hardware = cli.subcommand(
+      "hardware", "the robot_sim hardware decoded by the bridges' parsers (their configs beside --sim-config)");
+  common(hardware);
+  hardware.option("--sim-config", args.sim_config, "robot_sim's YAML").required().existing_file().type("FILE");
+  hardware.option("--duration", args.duration_s, "seconds of hardware time (default 85)").non_negative().type("S");
+  if (const auto done = cli.parse(argc, argv)) return *done;
+  args.mode = sim.chosen() ? "sim" : mrclam.chosen() ? "mrclam" : "hardware";
+  return app::run_main("slam_offline", [&] { return run(args); });
 }

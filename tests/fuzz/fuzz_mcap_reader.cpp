@@ -9,34 +9,34 @@
 #include <vector>
 
 #include "fuzz_common.h"
-#include "pixyslam/logger/mcap_reader.h"
+#include "pixyslam/mcap/mcap_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
-    const pixyslam::logger::McapReader reader(std::vector<std::uint8_t>(data, data + size), "fuzz.mcap");
-    const pixyslam::logger::McapRecovery& r = reader.recovery();
+    const pixyslam::mcap::McapReader reader(std::vector<std::uint8_t>(data, data + size), "fuzz.mcap");
+    const pixyslam::mcap::McapRecovery& r = reader.recovery();
     FUZZ_CHECK(r.file_size == size);
     FUZZ_CHECK(r.valid_bytes <= size);
     FUZZ_CHECK(r.valid_bytes + r.bytes_ignored_at_end == size);
     FUZZ_CHECK(r.messages_recovered == reader.messages().size());
     // The damage report: complete exactly when clean, ranges inside the file
     // and adding up, nothing damaged in a file only cut short.
-    const pixyslam::logger::McapDamage& d = reader.damage();
-    FUZZ_CHECK((d.state == pixyslam::logger::McapFileState::kComplete) == reader.clean());
+    const pixyslam::mcap::McapDamage& d = reader.damage();
+    FUZZ_CHECK((d.state == pixyslam::mcap::McapFileState::kComplete) == reader.clean());
     FUZZ_CHECK(d.intact_until <= size);
     std::uint64_t skipped = 0;
     std::uint64_t previous_end = 0;
-    for (const pixyslam::logger::McapByteRange& range : d.skipped) {
+    for (const pixyslam::mcap::McapByteRange& range : d.skipped) {
       FUZZ_CHECK(range.begin < range.end && range.end <= size && range.begin >= previous_end);
       previous_end = range.end;
       skipped += range.end - range.begin;
     }
     FUZZ_CHECK(skipped == d.bytes_skipped);
-    for (const pixyslam::logger::McapDamagedRecord& record : d.records) FUZZ_CHECK(record.end <= size);
-    if (d.state == pixyslam::logger::McapFileState::kNotClosed) {
+    for (const pixyslam::mcap::McapDamagedRecord& record : d.records) FUZZ_CHECK(record.end <= size);
+    if (d.state == pixyslam::mcap::McapFileState::kNotClosed) {
       FUZZ_CHECK(d.records.empty() && d.skipped.empty() && !r.footer_present);
     }
-    for (const pixyslam::logger::McapMessage& m : reader.messages()) {
+    for (const pixyslam::mcap::McapMessage& m : reader.messages()) {
       (void)reader.find_channel(m.channel_id);  // a message may name an unknown channel: no crash
     }
     (void)reader.diagnostics_text();

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "fuzz_common.h"
-#include "pixyslam/bridge/bridge_options.h"
+#include "pixyslam/bridge/process_options.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/encoder/encoder_options.h"
 #include "pixyslam/pixy/pixy_options.h"

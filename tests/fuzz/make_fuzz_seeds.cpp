@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "pixyslam/encoder/arduino_line_parser.h"
-#include "pixyslam/logger/mcap_reader.h"
-#include "pixyslam/logger/mcap_writer.h"
+#include "pixyslam/mcap/mcap_reader.h"
+#include "pixyslam/mcap/mcap_writer.h"
 #include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/pixy/pixy_block_parser.h"
 
@@ -159,17 +159,17 @@ int main(int argc, char** argv) {
   const fs::path mcap = root / "fuzz_mcap_reader";
   fs::create_directories(mcap);
   for (const bool chunked : {true, false}) {
-    logger::McapWriterOptions options;
+    mcap::McapWriterOptions options;
     options.chunk_size_bytes = chunked ? 256 : 0;
     const fs::path path = mcap / (chunked ? "chunked.mcap" : "unchunked.mcap");
-    logger::McapWriter writer(path.string(), options);
+    mcap::McapWriter writer(path.string(), options);
     const std::uint16_t schema = writer.add_schema("pixyslam::msg::Odometry", "omgidl", "struct Odometry {};");
     const std::uint16_t channel = writer.add_channel("pixyslam/odometry", "cdr", schema);
     for (std::uint64_t i = 1; i <= 4; ++i) {
       writer.write_message(channel, static_cast<std::uint32_t>(i), i * 1000, i * 1000, pixyslam::dds::to_cdr(odometry(i)));
     }
     writer.close();
-    (void)logger::McapReader(path.string());  // the seed must itself be clean
+    (void)mcap::McapReader(path.string());  // the seed must itself be clean
   }
   std::cout << "seeds written under " << root << "\n";
   return 0;

@@ -5,18 +5,18 @@
 #include <memory>
 
 #include "pixyslam/dds/topics.h"
-#include "pixyslam/logger/mcap_reader.h"
+#include "pixyslam/mcap/mcap_reader.h"
 #include "pixyslam/dds/cdr_payload.h"
 
 namespace pixyslam::map_view {
 namespace {
 
 template <class Message>
-void decode_channel(const logger::McapReader& reader, const logger::McapChannel& channel, MapLog::Kind kind,
+void decode_channel(const mcap::McapReader& reader, const mcap::McapChannel& channel, MapLog::Kind kind,
                     std::vector<Message>& out, std::vector<MapLog::Entry>& entries, std::size_t& undecodable) {
   typename dds::MessageTraits<Message>::PubSubType type;
   std::string error;
-  for (const logger::McapMessage& m : reader.messages()) {
+  for (const mcap::McapMessage& m : reader.messages()) {
     if (m.channel_id != channel.id) continue;
     Message sample;
     if (!dds::deserialize_payload(type, m.data.data(), m.data.size(), &sample, error)) {
@@ -28,7 +28,7 @@ void decode_channel(const logger::McapReader& reader, const logger::McapChannel&
   }
 }
 
-void check_encoding(const std::string& path, const logger::McapChannel& channel) {
+void check_encoding(const std::string& path, const mcap::McapChannel& channel) {
   if (channel.message_encoding != "cdr") {
     throw InputError(path + ": channel '" + channel.topic + "' has message encoding '" + channel.message_encoding +
                      "', expected 'cdr'");
@@ -38,9 +38,9 @@ void check_encoding(const std::string& path, const logger::McapChannel& channel)
 }  // namespace
 
 MapLog MapLog::read(const std::string& path) {
-  std::unique_ptr<logger::McapReader> reader;
+  std::unique_ptr<mcap::McapReader> reader;
   try {
-    reader = std::make_unique<logger::McapReader>(path);
+    reader = std::make_unique<mcap::McapReader>(path);
   } catch (const std::exception& e) {
     throw InputError(e.what());  // names the file
   }
@@ -49,10 +49,10 @@ MapLog MapLog::read(const std::string& path) {
   const std::string map_topic(dds::kMapStateTopic);
   const std::string truth_topic(dds::kGroundTruthTopic);
   const std::string optimised_topic(dds::kOptimisedMapTopic);
-  const logger::McapChannel* map_channel = reader->find_channel(map_topic);
+  const mcap::McapChannel* map_channel = reader->find_channel(map_topic);
   if (map_channel == nullptr) {
     std::string topics;
-    for (const logger::McapChannel& c : reader->channels()) topics += (topics.empty() ? "" : ", ") + c.topic;
+    for (const mcap::McapChannel& c : reader->channels()) topics += (topics.empty() ? "" : ", ") + c.topic;
     throw InputError(path + ": no '" + map_topic + "' channel (topics: " + (topics.empty() ? "none" : topics) +
                      "); record it with the logger");
   }
@@ -63,11 +63,11 @@ MapLog MapLog::read(const std::string& path) {
                      (log.undecodable_ > 0 ? " that decodes (" + std::to_string(log.undecodable_) + " bad payloads)"
                                            : std::string(" on '" + map_topic + "'")));
   }
-  if (const logger::McapChannel* truth_channel = reader->find_channel(truth_topic)) {
+  if (const mcap::McapChannel* truth_channel = reader->find_channel(truth_topic)) {
     check_encoding(path, *truth_channel);
     decode_channel(*reader, *truth_channel, Kind::kGroundTruth, log.ground_truths_, log.entries_, log.undecodable_);
   }
-  if (const logger::McapChannel* optimised_channel = reader->find_channel(optimised_topic)) {
+  if (const mcap::McapChannel* optimised_channel = reader->find_channel(optimised_topic)) {
     check_encoding(path, *optimised_channel);
     decode_channel(*reader, *optimised_channel, Kind::kOptimisedMap, log.optimised_maps_, log.entries_,
                    log.undecodable_);
@@ -75,7 +75,7 @@ MapLog MapLog::read(const std::string& path) {
   std::stable_sort(log.entries_.begin(), log.entries_.end(),
                    [](const Entry& a, const Entry& b) { return a.time_ns < b.time_ns; });
   if (!reader->clean()) {
-    const logger::McapRecovery& r = reader->recovery();
+    const mcap::McapRecovery& r = reader->recovery();
     log.recovery_note_ = "file not complete or damaged: " + std::to_string(reader->diagnostics().size()) +
                          " problem(s), " + std::to_string(r.rejected_chunks) + " chunk(s) rejected, " +
                          std::to_string(r.bytes_ignored_at_end) + " byte(s) ignored at the end";

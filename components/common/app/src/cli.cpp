@@ -1,5 +1,6 @@
 #include "pixyslam/app/cli.h"
 
+#include <cmath>
 #include <cstdio>
 
 #include <CLI/CLI.hpp>
@@ -12,7 +13,8 @@ Cli::Option& Cli::Option::required() {
 }
 
 Cli::Option& Cli::Option::existing_file() {
-  option_->check(CLI::ExistingFile);
+  CLI::Validator exists = CLI::ExistingFile;
+  option_->check(exists.description(""));  // "--config FILE", not "FILE:FILE"
   return *this;
 }
 
@@ -21,19 +23,38 @@ Cli::Option& Cli::Option::range(double min, double max) {
   return *this;
 }
 
-Cli::Option& Cli::Option::non_negative() {
-  option_->check(CLI::Validator(
-      [](std::string& text) -> std::string {
+namespace {
+
+// A number (the whole text) satisfying `ok`, else "must be <what>, got 'T'".
+CLI::Validator number_check(bool (*ok)(double), const std::string& what) {
+  return CLI::Validator(
+      [ok, what](std::string& text) -> std::string {
         std::size_t used = 0;
-        double v = -1.0;
+        double v = std::nan("");
         try {
           v = std::stod(text, &used);
         } catch (const std::exception&) {
           used = 0;
         }
-        return used == text.size() && v >= 0.0 ? std::string() : "must be a number >= 0, got '" + text + "'";
+        return used == text.size() && ok(v) ? std::string() : "must be a number " + what + ", got '" + text + "'";
       },
-      ">= 0"));
+      what);
+}
+
+}  // namespace
+
+Cli::Option& Cli::Option::non_negative() {
+  option_->check(number_check([](double v) { return v >= 0.0 && std::isfinite(v); }, ">= 0"));
+  return *this;
+}
+
+Cli::Option& Cli::Option::positive() {
+  option_->check(number_check([](double v) { return v > 0.0 && std::isfinite(v); }, "> 0"));
+  return *this;
+}
+
+Cli::Option& Cli::Option::choices(const std::vector<std::string>& allowed) {
+  option_->check(CLI::IsMember(allowed));
   return *this;
 }
 
@@ -48,7 +69,17 @@ Cli::Option& Cli::Option::type(const std::string& name) {
 }
 
 Cli::Cli(const std::string& name, const std::string& description)
-    : app_(std::make_unique<CLI::App>(description, name)) {}
+    : owned_(std::make_unique<CLI::App>(description, name)), app_(owned_.get()) {}
+
+Cli::Cli(CLI::App* subcommand) : app_(subcommand) {}
+
+Cli& Cli::subcommand(const std::string& name, const std::string& description) {
+  app_->require_subcommand(1);
+  subcommands_.push_back(std::unique_ptr<Cli>(new Cli(app_->add_subcommand(name, description))));
+  return *subcommands_.back();
+}
+
+bool Cli::chosen() const { return app_->parsed(); }
 
 Cli::~Cli() = default;
 
@@ -62,6 +93,10 @@ Cli::Option& Cli::option(const std::string& name, std::string& value, const std:
 }
 
 Cli::Option& Cli::option(const std::string& name, double& value, const std::string& help) {
+  return keep(app_->add_option(name, value, help));
+}
+
+Cli::Option& Cli::option(const std::string& name, int& value, const std::string& help) {
   return keep(app_->add_option(name, value, help));
 }
 
@@ -90,12 +125,20 @@ std::optional<int> Cli::parse(int argc, char** argv) {
   try {
     app_->parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
-    std::fputs(app_->help().c_str(), stdout);
+    std::fputs(app_->help().c_str(), stdout);  // a subcommand's own when it was given: "TOOL COMMAND --help"
     return 0;
   } catch (const CLI::CallForAllHelp&) {
     std::fputs(app_->help("", CLI::AppFormatMode::All).c_str(), stdout);
     return 0;
   } catch (const CLI::ParseError& e) {
+    // A word where a subcommand was expected: name it and the choices.
+    if (!subcommands_.empty() && app_->get_subcommands().empty() && argc > 1 && argv[1][0] != '-') {
+      std::string names;
+      for (const auto& sub : subcommands_) names += (names.empty() ? "" : ", ") + sub->app_->get_name();
+      std::fprintf(stderr, "%s: unknown command '%s' (one of: %s; see --help)\n", app_->get_name().c_str(), argv[1],
+                   names.c_str());
+      return 2;
+    }
     std::fprintf(stderr, "%s: %s (see --help)\n", app_->get_name().c_str(), e.what());
     return 2;
   }

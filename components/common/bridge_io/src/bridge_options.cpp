@@ -7,13 +7,6 @@
 
 namespace pixyslam::bridge {
 
-BridgeProcessOptions read_bridge_process_options(config::YamlReader& node) {
-  BridgeProcessOptions o;
-  o.reopen_period_s = node.number("reopen_period_s", 0.01, 3600.0, o.reopen_period_s);
-  o.status_period_s = node.number("status_period_s", 0.0, 86400.0, o.status_period_s);
-  return o;
-}
-
 DeviceReaderOptions device_reader_options(const BridgeProcessOptions& o) {
   DeviceReaderOptions d;
   d.reopen_period = std::chrono::milliseconds(std::llround(o.reopen_period_s * 1000.0));
@@ -50,11 +43,6 @@ void apply_command_line(const BridgeCommandLine& args, std::string& serial_devic
                               (std::filesystem::is_directory(st) ? " (a directory)" : ""));
   }
   if (!std::ifstream(profiles).good()) throw config::ConfigError(where + ": cannot read '" + profiles + "'");
-}
-
-std::string to_yaml_lines(const BridgeProcessOptions& o) {
-  return "  reopen_period_s: " + yaml_number(o.reopen_period_s) + "\n" +
-         "  status_period_s: " + yaml_number(o.status_period_s) + "\n";
 }
 
 }  // namespace pixyslam::bridge

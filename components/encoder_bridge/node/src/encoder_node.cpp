@@ -18,9 +18,7 @@ EncoderNode::EncoderNode(const EncoderNodeOptions& options, bridge::LogFunction 
 EncoderNode::EncoderNode(const EncoderNodeOptions& options, std::unique_ptr<bridge::ByteSource> source,
                          bridge::LogFunction log, bridge::ClockFunction clock)
     : options_(options),
-      odometry_(options.encoder),
-      accumulator_(options.encoder.publish_rate_hz),
-      clock_(options.clock_window_s),
+      stream_(options.encoder, options.clock_window_s),
       runtime_("encoder_bridge", options.dds, options.process, std::move(source), std::move(log),
                std::move(clock), mutex_) {}
 
@@ -41,7 +39,7 @@ void EncoderNode::start() {
 
 std::vector<diagnostics::Counter> EncoderNode::diagnostic_counters_locked() const {
   const encoder::ArduinoParserCounters& p = parser_.counters();
-  const encoder::WheelCounters& w = odometry_.counters();
+  const encoder::WheelCounters& w = stream_.wheel_counters();
   return {{"bytes_in", p.bytes_in, false},
           {"bytes_skipped", p.bytes_skipped, true},
           {"samples", p.samples, false},
@@ -53,7 +51,7 @@ std::vector<diagnostics::Counter> EncoderNode::diagnostic_counters_locked() cons
           {"sequence_backwards", w.sequence_backwards, true},
           {"time_gaps", w.time_gaps, true},
           {"implausible_steps", w.implausible, true},
-          {"empty_periods", empty_periods_, true}};
+          {"empty_periods", stream_.empty_periods(), true}};
 }
 
 void EncoderNode::stop() { runtime_.stop(); }
@@ -67,12 +65,12 @@ EncoderNodeCounters EncoderNode::counters() const {
   EncoderNodeCounters c;
   c.device = runtime_.device_counters();
   c.parser = parser_.counters();
-  c.wheel = odometry_.counters();
-  c.accumulator = accumulator_.counters();
-  c.clock = clock_.counters();
+  c.wheel = stream_.wheel_counters();
+  c.accumulator = stream_.accumulator_counters();
+  c.clock = stream_.clock().counters();
   c.published = runtime_.published();
   c.publish_failures = runtime_.publish_failures();
-  c.empty_periods = empty_periods_;
+  c.empty_periods = stream_.empty_periods();
   return c;
 }
 
@@ -83,8 +81,8 @@ std::vector<std::string> EncoderNode::status_lines() const {
 
 std::vector<std::string> EncoderNode::status_lines_locked() const {
   const encoder::ArduinoParserCounters& p = parser_.counters();
-  const encoder::WheelCounters& w = odometry_.counters();
-  const ArduinoClock::Counters& k = clock_.counters();
+  const encoder::WheelCounters& w = stream_.wheel_counters();
+  const encoder::ArduinoClock::Counters& k = stream_.clock().counters();
   std::ostringstream lines, motion;
   lines << "status: lines: samples " << p.samples << ", resets " << p.resets << ", rejected "
         << p.rejected_lines() << " (framing " << p.bad_framing << ", checksum " << p.bad_checksum
@@ -95,48 +93,26 @@ std::vector<std::string> EncoderNode::status_lines_locked() const {
          << w.sequence_gaps << " (lost " << w.lost_samples << "), seq backwards " << w.sequence_backwards
          << ", time gaps " << w.time_gaps << ", implausible " << w.implausible << ", ticks/rev mismatches "
          << w.ticks_per_revolution_mismatches << "; clock restarts " << k.restarts << ", jumps " << k.jumps
-         << ", last excess delay " << static_cast<double>(clock_.last_excess_delay_ns()) * 1e-6
+         << ", last excess delay " << static_cast<double>(stream_.clock().last_excess_delay_ns()) * 1e-6
          << " ms; odometry published " << runtime_.published() << ", failed " << runtime_.publish_failures()
-         << ", empty periods " << empty_periods_;
+         << ", empty periods " << stream_.empty_periods();
   return {runtime_.device_status_line(), lines.str(), motion.str()};
 }
 
-double EncoderNode::to_seconds(std::int64_t host_ns) const {
-  return static_cast<double>(host_ns - static_cast<std::int64_t>(epoch_ns_)) * 1e-9;
-}
-
-void EncoderNode::on_open() {
-  clock_.restart();  // a reopened link (an Uno also resets) starts a new clock estimate
-}
+void EncoderNode::on_open() { stream_.restart_clock(); }
 
 void EncoderNode::on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns) {
   parser_.feed(data, size, [&](const encoder::ArduinoMessage& message) {
     if (const auto* sample = std::get_if<encoder::EncoderSample>(&message)) {
-      on_sample(*sample, receive_ns);
+      stream_.add_sample(*sample, receive_ns, [this](const encoder::StreamOutput& o) { publish(o); });
     } else {
       on_reset(std::get<encoder::EncoderReset>(message));
     }
   });
 }
 
-void EncoderNode::on_sample(const encoder::EncoderSample& sample, std::uint64_t receive_ns) {
-  const std::int64_t host_ns = clock_.to_host_ns(sample.arduino_time_us, static_cast<std::int64_t>(receive_ns));
-  if (!has_epoch_) {
-    const std::int64_t positive = std::max<std::int64_t>(host_ns, 0);
-    epoch_ns_ = static_cast<std::uint64_t>(positive - positive % 1000000000);
-    has_epoch_ = true;
-  }
-  const double t_s = to_seconds(host_ns);
-  sample_times_.push_back(t_s);
-  last_sample_ns_ = receive_ns;
-  const encoder::WheelUpdate update = odometry_.update(sample);
-  accumulator_.add(t_s, update, [this](const encoder::OdometryOutput& o) { publish(o); });
-  last_time_s_ = std::max(last_time_s_, t_s);
-}
-
 void EncoderNode::on_reset(const encoder::EncoderReset& reset) {
-  odometry_.reset(reset);
-  clock_.restart();
+  stream_.reset(reset);
   std::string line = "Arduino (re)started: firmware '" + reset.firmware_version + "', ticks_per_revolution " +
                      std::to_string(reset.ticks_per_revolution);
   if (reset.ticks_per_revolution != 0 &&
@@ -148,28 +124,11 @@ void EncoderNode::on_reset(const encoder::EncoderReset& reset) {
 }
 
 void EncoderNode::on_poll(std::uint64_t now_ns) {
-  // No sample for max_sample_gap_s: close the elapsed periods as "no data",
-  // one period at a time at most, up to max_sample_gap_s ago.
-  const auto stall_ns = static_cast<std::uint64_t>(std::llround(options_.encoder.max_sample_gap_s * 1e9));
-  if (has_epoch_ && now_ns > last_sample_ns_ + stall_ns) {
-    const double gap_s = to_seconds(static_cast<std::int64_t>(now_ns - stall_ns));
-    if (gap_s >= last_time_s_ + accumulator_.period_s()) {
-      accumulator_.mark_gap(gap_s, [this](const encoder::OdometryOutput& o) { publish(o); });
-      last_time_s_ = gap_s;
-    }
-  }
+  stream_.poll(now_ns, [this](const encoder::StreamOutput& o) { publish(o); });
 }
 
-void EncoderNode::publish(const encoder::OdometryOutput& output) {
-  // Samples stamped before the period's end that no earlier output counted.
-  const double end_s = output.t_s + output.duration_s;
-  std::uint32_t samples = 0;
-  while (!sample_times_.empty() && sample_times_.front() < end_s) {
-    ++samples;
-    sample_times_.pop_front();
-  }
-  if (samples == 0) ++empty_periods_;
-  msg::Odometry m = to_odometry_msg(output, samples, epoch_ns_);
+void EncoderNode::publish(const encoder::StreamOutput& output) {
+  msg::Odometry m = to_odometry_msg(output.odometry, output.samples, output.epoch_ns);
   runtime_.publish(m);
 }
 

@@ -152,7 +152,7 @@ void LoggerNode::open_first_file() {
 }
 
 void LoggerNode::open_file(std::size_t index, const std::string& path_override) {
-  logger::McapWriterOptions file;
+  mcap::McapWriterOptions file;
   file.chunk_size_bytes = options_.chunk_size_bytes;
   file.compression = options_.compression;
   file.sync_after_chunk = options_.fsync;
@@ -201,7 +201,7 @@ void LoggerNode::update_file_counters() {
   totals_.files = closed_files_;
   if (!file_given_up_) totals_.files.push_back(LoggedFile{writer_.path(), writer_.counters(), !writer_.is_open()});
   totals_.recording = writer_.is_open() || !file_given_up_;
-  logger::McapWriterCounters sum;
+  mcap::McapWriterCounters sum;
   for (const LoggedFile& f : totals_.files) {
     sum.messages += f.counters.messages;
     sum.schemas += f.counters.schemas;

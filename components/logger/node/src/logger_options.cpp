@@ -9,9 +9,9 @@
 
 namespace pixyslam::logger_node {
 
-logger::McapCompression default_compression() {
-  return logger::mcap_compression_available(logger::McapCompression::kZstd) ? logger::McapCompression::kZstd
-                                                                            : logger::McapCompression::kNone;
+mcap::McapCompression default_compression() {
+  return mcap::mcap_compression_available(mcap::McapCompression::kZstd) ? mcap::McapCompression::kZstd
+                                                                            : mcap::McapCompression::kNone;
 }
 
 namespace {
@@ -24,8 +24,8 @@ std::vector<std::string> all_topics() {
 
 constexpr std::uint64_t kMinRotateSizeBytes = 65536;
 
-std::string compression_name(logger::McapCompression c) {
-  return c == logger::McapCompression::kNone ? "none" : logger::mcap_compression_name(c);
+std::string compression_name(mcap::McapCompression c) {
+  return c == mcap::McapCompression::kNone ? "none" : mcap::mcap_compression_name(c);
 }
 
 }  // namespace
@@ -36,7 +36,7 @@ bool rotation_enabled(const LoggerOptions& options) {
 
 const parameters::Table<LoggerOptions>& logger_parameters() {
   using O = LoggerOptions;
-  using C = logger::McapCompression;
+  using C = mcap::McapCompression;
   namespace P = parameters;
   static const P::Table<O> table = {
       P::text<O>("output_file", "the MCAP file (kept if it holds data: the next free indexed name is used)",
@@ -81,7 +81,7 @@ void validate(const LoggerOptions& o) {
                                 "value " + parameters::number_text(o.rotate_period_s) +
                                     " is too small: 0 (off) or at least 1");
   }
-  if (!logger::mcap_compression_available(o.compression)) {
+  if (!mcap::mcap_compression_available(o.compression)) {
     const std::string name = compression_name(o.compression);
     throw parameters::RuleError("logger", "compression",
                                 "'" + name + "' is not available in this build (install lib" + name +

@@ -38,7 +38,7 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options)
       std::fprintf(stderr, "slam_estimator: no checkpoint at %s: starting from scratch\n", k.file.c_str());
     } else {
       try {
-        checkpoint_ = read_map_checkpoint(k.file);
+        checkpoint_ = slam::read_map_checkpoint(k.file);
       } catch (const config::ConfigError& e) {
         std::fprintf(stderr, "slam_estimator: checkpoint unusable, starting from scratch: %s\n", e.what());
       }
@@ -189,12 +189,12 @@ void EstimatorNode::step(const slam::SensorInput& input) {
 void EstimatorNode::create_filter(double first_t_s) {
   const CheckpointOptions& k = options_.checkpoint;
   if (checkpoint_) {
-    const MapCheckpoint& c = *checkpoint_;
+    const slam::MapCheckpoint& c = *checkpoint_;
     const double gap_s =
         static_cast<double>(static_cast<std::int64_t>(inbox_.epoch_ns() - c.stamp_ns)) * 1e-9 + first_t_s;
     // A checkpoint from the future (another clock, a replayed log) is as unusable as an old one.
     if (gap_s >= -1.0 && gap_s <= k.max_age_s) {
-      const slam::PoseGaussian pose = resume_pose(c, gap_s, k.max_speed_mps, k.max_turn_rate_radps);
+      const slam::PoseGaussian pose = slam::resume_pose(c, gap_s, k.max_speed_mps, k.max_turn_rate_radps);
       filter_ = std::make_unique<slam::FastSlam2>(options_.filter, pose);
       filter_->set_prior_map(c.landmarks);
       counters_.resumed = true;
@@ -214,22 +214,10 @@ void EstimatorNode::create_filter(double first_t_s) {
 }
 
 void EstimatorNode::write_checkpoint(bool final) {
-  MapCheckpoint c;
-  c.stamp_ns = map_state_.header().stamp_ns();
-  const msg::Pose2D& mean = map_state_.mean_pose();
-  c.pose.mean = slam::Pose2(mean.x_m(), mean.y_m(), mean.theta_rad());
-  for (int i = 0; i < 9; ++i) c.pose.cov(i / 3, i % 3) = map_state_.pose_covariance()[static_cast<std::size_t>(i)];
-  c.pose.cov = 0.5 * (c.pose.cov + c.pose.cov.transpose()).eval();
-  for (const msg::LandmarkEstimate& l : map_state_.landmarks()) {
-    slam::LandmarkEstimate e;
-    e.id = l.landmark_id();
-    e.mean = Eigen::Vector2d(l.x_m(), l.y_m());
-    e.cov << l.cov_xx_m2(), l.cov_xy_m2(), l.cov_xy_m2(), l.cov_yy_m2();
-    e.times_observed = l.times_observed();
-    c.landmarks.push_back(e);
-  }
+  const slam::MapCheckpoint c =
+      slam::checkpoint_of(*filter_, map_state_.header().stamp_ns(), options_.landmarks == "mixture");
   try {
-    write_map_checkpoint(options_.checkpoint.file, c);
+    slam::write_map_checkpoint(options_.checkpoint.file, c);
     ++counters_.checkpoints_written;
     last_checkpoint_ns_ = c.stamp_ns;
     if (final) {

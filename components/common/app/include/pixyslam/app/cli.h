@@ -28,6 +28,8 @@ class Cli {
     Option& existing_file();
     Option& range(double min, double max);
     Option& non_negative();
+    Option& positive();  // a finite number > 0
+    Option& choices(const std::vector<std::string>& allowed);
     Option& needs(Option& other);  // given only together with `other`
     Option& type(const std::string& name);  // the value's name in --help, e.g. "DIR"
 
@@ -43,6 +45,7 @@ class Cli {
   // "--name" is a flag with a value; a name without dashes is positional.
   Option& option(const std::string& name, std::string& value, const std::string& help);
   Option& option(const std::string& name, double& value, const std::string& help);
+  Option& option(const std::string& name, int& value, const std::string& help);
   Option& option(const std::string& name, std::vector<std::string>& values, const std::string& help);
   // Calls `each` with every value given (repeatable).
   Option& option_each(const std::string& name, std::function<void(const std::string&)> each, const std::string& help);
@@ -50,15 +53,23 @@ class Cli {
   void footer(const std::string& text);
   bool given(const std::string& name) const;
 
+  // A subcommand ("pixyslam_spy echo ..."): its own options and --help; the
+  // parent then needs exactly one. chosen() after parse(): it was the one given.
+  Cli& subcommand(const std::string& name, const std::string& description);
+  bool chosen() const;
+
   // Returns the exit status when the process is to end here: 0 after --help
   // (the help on stdout), 2 for a usage error ("<name>: <what> (see --help)"
   // on stderr); nothing when it is to go on.
   std::optional<int> parse(int argc, char** argv);
 
  private:
+  explicit Cli(CLI::App* subcommand);
   Option& keep(CLI::Option* option);
-  std::unique_ptr<CLI::App> app_;
+  std::unique_ptr<CLI::App> owned_;  // the top level owns the CLI11 app; a subcommand does not
+  CLI::App* app_;
   std::vector<std::unique_ptr<Option>> options_;
+  std::vector<std::unique_ptr<Cli>> subcommands_;
 };
 
 // --config FILE: the process's YAML (must exist).

@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -13,8 +12,7 @@
 #include "pixyslam/bridge/byte_source.h"
 #include "pixyslam/bridge/device_reader.h"
 #include "pixyslam/encoder/arduino_line_parser.h"
-#include "pixyslam/encoder/wheel_odometry.h"
-#include "pixyslam/encoder_node/arduino_clock.h"
+#include "pixyslam/encoder/odometry_stream.h"
 #include "pixyslam/encoder_node/encoder_node_options.h"
 
 namespace pixyslam::encoder_node {
@@ -24,7 +22,7 @@ struct EncoderNodeCounters {
   encoder::ArduinoParserCounters parser;
   encoder::WheelCounters wheel;
   encoder::AccumulatorCounters accumulator;
-  ArduinoClock::Counters clock;
+  encoder::ArduinoClock::Counters clock;
   std::uint64_t published = 0;         // Odometry messages written
   std::uint64_t publish_failures = 0;  // writes DDS refused
   std::uint64_t empty_periods = 0;     // periods published without any sample (v = w = 0)
@@ -32,11 +30,11 @@ struct EncoderNodeCounters {
 
 // The encoder_bridge process: reads the Arduino's line protocol from a byte
 // source (the serial device, or a test's twin) on one reader thread,
-// parses it (ArduinoLineParser), turns samples into wheel motion
-// (WheelOdometry) and resamples that to publish_rate_hz (OdometryAccumulator),
-// publishing one msg::Odometry per period on the odometry topic, stamped at the
-// period's start on the host clock (dds::now_ns() domain; Arduino times are
-// mapped onto it by ArduinoClock), frame "base_link".
+// parses it (ArduinoLineParser) and turns samples into fixed-rate odometry
+// (OdometryStream: wheel motion resampled to publish_rate_hz), publishing one
+// msg::Odometry per period on the odometry topic, stamped at the period's
+// start on the host clock (dds::now_ns() domain; Arduino times are mapped onto
+// it by ArduinoClock), frame "base_link".
 //
 // Device trouble (missing, unplugged, read errors) is logged naming the device
 // and retried every reopen_period_s; it never stops the node. While no sample
@@ -72,10 +70,8 @@ class EncoderNode {
   void on_open();
   void on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns);
   void on_poll(std::uint64_t now_ns);
-  void on_sample(const encoder::EncoderSample& sample, std::uint64_t receive_ns);
   void on_reset(const encoder::EncoderReset& reset);
-  void publish(const encoder::OdometryOutput& output);
-  double to_seconds(std::int64_t host_ns) const;
+  void publish(const encoder::StreamOutput& output);
   std::vector<diagnostics::Counter> diagnostic_counters_locked() const;
   std::vector<std::string> status_lines_locked() const;
 
@@ -84,15 +80,7 @@ class EncoderNode {
   // Reader-thread state; others read it under mutex_.
   mutable std::mutex mutex_;
   encoder::ArduinoLineParser parser_;
-  encoder::WheelOdometry odometry_;
-  encoder::OdometryAccumulator accumulator_;
-  ArduinoClock clock_;
-  bool has_epoch_ = false;
-  std::uint64_t epoch_ns_ = 0;       // host time of t = 0 s in the core
-  std::deque<double> sample_times_;  // of samples not yet counted into an output, s
-  double last_time_s_ = 0.0;         // latest time passed to the accumulator
-  std::uint64_t last_sample_ns_ = 0;  // receive time of the latest sample
-  std::uint64_t empty_periods_ = 0;
+  encoder::OdometryStream stream_;
 
   bridge::BridgeRuntime<msg::Odometry> runtime_;  // last: its thread uses the members above
 };

@@ -13,7 +13,7 @@
 
 #include "pixyslam/diagnostics/diagnostics_publisher.h"
 #include "pixyslam/dds/participant.h"
-#include "pixyslam/logger/mcap_writer.h"
+#include "pixyslam/mcap/mcap_writer.h"
 #include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/logger_node/logger_options.h"
 
@@ -43,7 +43,7 @@ struct TopicCounters {
 // One MCAP file of the recording.
 struct LoggedFile {
   std::string path;
-  logger::McapWriterCounters counters;  // final once the file is closed
+  mcap::McapWriterCounters counters;  // final once the file is closed
   bool closed = false;                  // summary and footer written
 };
 
@@ -51,7 +51,7 @@ struct LoggerCounters {
   std::vector<TopicCounters> topics;  // in the order of options.topics
   std::size_t queue_peak_bytes = 0;   // most payload bytes ever waiting
   std::size_t queue_peak_messages = 0;
-  logger::McapWriterCounters file;    // totals over every file (final after stop())
+  mcap::McapWriterCounters file;    // totals over every file (final after stop())
   std::vector<LoggedFile> files;      // in order; one unless rotating
   std::string error;                  // a failure that stopped recording for good ("" if none)
   std::uint64_t write_failures = 0;   // files given up after a write failure (disk full, ...)
@@ -142,7 +142,7 @@ class LoggerNode {
 
   LoggerOptions options_;
   std::vector<const dds::TopicInfo*> topic_infos_;  // per topics_ entry
-  logger::McapWriter writer_;  // after construction: the writer thread's alone (stop()'s if never started)
+  mcap::McapWriter writer_;  // after construction: the writer thread's alone (stop()'s if never started)
   std::size_t file_index_ = 0;
   std::chrono::steady_clock::time_point file_opened_;
   bool file_given_up_ = false;  // the writer's file failed and is in closed_files_

@@ -7,12 +7,12 @@
 
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/dds/participant.h"
-#include "pixyslam/logger/mcap_writer.h"
+#include "pixyslam/mcap/mcap_writer.h"
 
 namespace pixyslam::logger_node {
 
 // zstd when the MCAP library was built with it, else none.
-logger::McapCompression default_compression();
+mcap::McapCompression default_compression();
 
 // Everything the logger process is configured with (config/logger.yaml).
 struct LoggerOptions {
@@ -36,7 +36,7 @@ struct LoggerOptions {
   // `logger.chunk_size_bytes`: uncompressed bytes per MCAP chunk before it is written.
   std::size_t chunk_size_bytes = std::size_t{1} << 20;
   // `logger.compression`: none | zstd | lz4 (chunk compression).
-  logger::McapCompression compression = default_compression();
+  mcap::McapCompression compression = default_compression();
   // `logger.flush_period_s`: the open chunk is written at least this often, so
   // a crash loses at most about this much (0: only when a chunk is full).
   double flush_period_s = 1.0;

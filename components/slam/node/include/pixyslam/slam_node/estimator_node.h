@@ -18,7 +18,7 @@
 #include "pixyslam/slam/fastslam2.h"
 #include "pixyslam/slam/sensor_queue.h"
 #include "pixyslam/slam_node/estimator_options.h"
-#include "pixyslam/slam_node/map_checkpoint.h"
+#include "pixyslam/slam/map_checkpoint.h"
 #include "pixyslam/slam_node/sensor_inbox.h"
 
 namespace pixyslam::slam_node {
@@ -91,7 +91,7 @@ class EstimatorNode {
   msg::MapState map_state_;
   std::vector<std::pair<std::uint64_t, slam::Pose2>> trajectory_;
   EstimatorCounters counters_;
-  std::optional<MapCheckpoint> checkpoint_;  // read at start, used by create_filter()
+  std::optional<slam::MapCheckpoint> checkpoint_;  // read at start, used by create_filter()
   std::uint64_t last_checkpoint_ns_ = 0;
 };
 

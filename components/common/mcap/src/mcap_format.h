@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-namespace pixyslam::logger::detail {
+namespace pixyslam::mcap::detail {
 
 inline constexpr std::array<std::uint8_t, 8> kMagic = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
 
@@ -146,4 +146,4 @@ std::vector<std::uint8_t> compress_chunk(const std::string& compression, const s
 std::vector<std::uint8_t> decompress_chunk(const std::string& compression, const std::uint8_t* data,
                                            std::size_t size, std::uint64_t uncompressed_size);
 
-}  // namespace pixyslam::logger::detail
+}  // namespace pixyslam::mcap::detail

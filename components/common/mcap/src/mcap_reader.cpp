@@ -1,4 +1,4 @@
-#include "pixyslam/logger/mcap_reader.h"
+#include "pixyslam/mcap/mcap_reader.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -10,9 +10,9 @@
 #include <utility>
 
 #include "mcap_format.h"
-#include "pixyslam/logger/crc32.h"
+#include "pixyslam/mcap/crc32.h"
 
-namespace pixyslam::logger {
+namespace pixyslam::mcap {
 
 using namespace detail;
 
@@ -1475,4 +1475,4 @@ std::string McapReader::diagnostics_text() const {
   return out.str();
 }
 
-}  // namespace pixyslam::logger
+}  // namespace pixyslam::mcap

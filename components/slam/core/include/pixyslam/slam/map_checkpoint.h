@@ -7,7 +7,7 @@
 #include "pixyslam/slam/fastslam2.h"
 #include "pixyslam/slam/types.h"
 
-namespace pixyslam::slam_node {
+namespace pixyslam::slam {
 
 // What the estimator needs to resume after a crash or restart: the mean pose
 // with its covariance and the map, at a stamp (ns, the sensors' clock). Written
@@ -17,6 +17,11 @@ struct MapCheckpoint {
   slam::PoseGaussian pose;
   std::vector<slam::LandmarkEstimate> landmarks;
 };
+
+// The filter's estimate as a checkpoint: its mean pose and covariance
+// (symmetrised) at stamp_ns, and its map (the landmarks' weighted mixture over
+// the particles, or those of the best particle).
+MapCheckpoint checkpoint_of(const FastSlam2& filter, std::uint64_t stamp_ns, bool mixture_landmarks);
 
 std::string to_yaml(const MapCheckpoint& checkpoint);
 // Parses to_yaml()'s text; config::ConfigError naming `origin` and the key on
@@ -35,4 +40,4 @@ void write_map_checkpoint(const std::string& path, const MapCheckpoint& checkpoi
 slam::PoseGaussian resume_pose(const MapCheckpoint& checkpoint, double gap_s, double max_speed_mps,
                                double max_turn_rate_radps);
 
-}  // namespace pixyslam::slam_node
+}  // namespace pixyslam::slam

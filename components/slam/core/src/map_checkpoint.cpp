@@ -1,4 +1,4 @@
-#include "pixyslam/slam_node/map_checkpoint.h"
+#include "pixyslam/slam/map_checkpoint.h"
 
 #include <cmath>
 #include <cstdio>
@@ -12,7 +12,7 @@
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/yaml_text.h"
 
-namespace pixyslam::slam_node {
+namespace pixyslam::slam {
 namespace {
 
 constexpr double kMaxCoordinate = 1e6;
@@ -32,6 +32,16 @@ bool is_covariance(const Eigen::Matrix<double, N, N>& c) {
 }
 
 }  // namespace
+
+MapCheckpoint checkpoint_of(const FastSlam2& filter, std::uint64_t stamp_ns, bool mixture_landmarks) {
+  const PoseEstimate estimate = filter.pose_estimate();
+  MapCheckpoint c;
+  c.stamp_ns = stamp_ns;
+  c.pose.mean = estimate.mean;
+  c.pose.cov = 0.5 * (estimate.cov + estimate.cov.transpose());
+  c.landmarks = mixture_landmarks ? filter.landmarks_mixture() : filter.landmarks_of_best();
+  return c;
+}
 
 std::string to_yaml(const MapCheckpoint& c) {
   std::ostringstream out;
@@ -138,4 +148,4 @@ slam::PoseGaussian resume_pose(const MapCheckpoint& checkpoint, double gap_s, do
   return g;
 }
 
-}  // namespace pixyslam::slam_node
+}  // namespace pixyslam::slam

@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-namespace pixyslam::logger {
+namespace pixyslam::mcap {
 
 // Chunk compression. kZstd and kLz4 exist only when the library was built with
 // libzstd / liblz4 (see mcap_compression_available); the names are MCAP's.
@@ -170,4 +170,4 @@ class McapWriter {
   std::vector<std::uint8_t> scratch_;
 };
 
-}  // namespace pixyslam::logger
+}  // namespace pixyslam::mcap

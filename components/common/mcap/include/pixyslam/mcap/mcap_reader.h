@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace pixyslam::logger {
+namespace pixyslam::mcap {
 
 struct McapSchema {
   std::uint16_t id = 0;
@@ -198,4 +198,4 @@ class McapReader {
   std::vector<McapDiagnostic> diagnostics_;
 };
 
-}  // namespace pixyslam::logger
+}  // namespace pixyslam::mcap

@@ -11,7 +11,7 @@
 #include <lz4frame.h>
 #endif
 
-namespace pixyslam::logger::detail {
+namespace pixyslam::mcap::detail {
 namespace {
 
 #ifdef PIXYSLAM_MCAP_HAVE_ZSTD
@@ -149,4 +149,4 @@ std::vector<std::uint8_t> decompress_chunk(const std::string& compression, const
   throw std::runtime_error("compression '" + compression + "' is not supported by this build");
 }
 
-}  // namespace pixyslam::logger::detail
+}  // namespace pixyslam::mcap::detail

@@ -1,4 +1,4 @@
-#include "pixyslam/logger/mcap_writer.h"
+#include "pixyslam/mcap/mcap_writer.h"
 
 #include <unistd.h>  // fsync, fileno
 
@@ -8,13 +8,13 @@
 #include <stdexcept>
 
 #include "mcap_format.h"
-#include "pixyslam/logger/crc32.h"
+#include "pixyslam/mcap/crc32.h"
 
 #ifndef PIXYSLAM_VERSION_STRING
 #define PIXYSLAM_VERSION_STRING "unknown"
 #endif
 
-namespace pixyslam::logger {
+namespace pixyslam::mcap {
 
 using detail::ByteSink;
 
@@ -422,4 +422,4 @@ void McapWriter::close() {
   }
 }
 
-}  // namespace pixyslam::logger
+}  // namespace pixyslam::mcap

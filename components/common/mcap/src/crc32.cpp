@@ -1,8 +1,8 @@
-#include "pixyslam/logger/crc32.h"
+#include "pixyslam/mcap/crc32.h"
 
 #include <array>
 
-namespace pixyslam::logger {
+namespace pixyslam::mcap {
 namespace {
 
 // Four tables for slicing-by-4: table[k][b] is the CRC of byte b followed by k zero bytes.
@@ -45,4 +45,4 @@ std::uint32_t crc32(std::string_view bytes, std::uint32_t previous) {
   return crc32(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size(), previous);
 }
 
-}  // namespace pixyslam::logger
+}  // namespace pixyslam::mcap

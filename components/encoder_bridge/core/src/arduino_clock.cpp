@@ -1,11 +1,11 @@
-#include "pixyslam/encoder_node/arduino_clock.h"
+#include "pixyslam/encoder/arduino_clock.h"
 
 #include <cmath>
 #include <stdexcept>
 
 #include "pixyslam/encoder/wheel_odometry.h"
 
-namespace pixyslam::encoder_node {
+namespace pixyslam::encoder {
 
 ArduinoClock::ArduinoClock(double window_s) {
   if (!(window_s > 0.0 && window_s <= 3600.0)) {
@@ -49,4 +49,4 @@ std::int64_t ArduinoClock::to_host_ns(std::uint32_t arduino_time_us, std::int64_
   return host_ns;
 }
 
-}  // namespace pixyslam::encoder_node
+}  // namespace pixyslam::encoder

@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <deque>
 
-namespace pixyslam::encoder_node {
+namespace pixyslam::encoder {
 
 // Maps the Arduino's micros() stamps onto the host clock (ns, the dds::now_ns()
 // domain). Each sample bounds the clock offset from above:
@@ -67,4 +67,4 @@ class ArduinoClock {
   Counters counters_;
 };
 
-}  // namespace pixyslam::encoder_node
+}  // namespace pixyslam::encoder
