@@ -16,4 +16,12 @@ build_dir=${BUILD_DIR:-$root/build}
 # while the armhf unit tests under qemu and the fuzz build (both niced) keep
 # the cores busy beside them from the start (with one more than cores, the fuzz
 # build waited ~150 s for the images and was the last test to end).
-ctest --test-dir "$build_dir" --output-on-failure --parallel "$(($(nproc) + 2))" --timeout 600 "$@"
+# The pure unit tests first, on their own (under a minute; a failure shows
+# early and they do not load the cores beside the timing-sensitive DDS runs).
+status=0
+if (($# == 0)); then
+  ctest --test-dir "$build_dir" --output-on-failure --parallel "$(nproc)" --timeout 600 -L '^unit$' || status=$?
+  set -- -LE '^unit$'
+fi
+ctest --test-dir "$build_dir" --output-on-failure --parallel "$(($(nproc) + 2))" --timeout 600 "$@" || status=$?
+exit "$status"
