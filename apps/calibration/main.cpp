@@ -59,9 +59,6 @@ struct Flags {
     if (it == values.end()) throw app::UsageError("--" + name + " is required");
     return it->second;
   }
-  double number(const std::string& name, double fallback) const {
-    return has(name) ? std::stod(get(name)) : fallback;
-  }
 };
 
 std::string read_file(const std::string& path) {
@@ -222,7 +219,7 @@ void print_parameters(const char* title, const calibration::NoiseParameters& p) 
               p.range_scale, p.range_cos_bearing_exponent, p.odometry_delay_s, p.error_correlation_s);
 }
 
-int noise(const Flags& args, bool with_ground_truth, bool fit_range_scale) {
+int noise(const Flags& args, int robot, bool with_ground_truth, bool fit_range_scale) {
   const std::string config_path = args.get("config");
   // --keys: which of the values to write (default all but the range scale,
   // which --fit-range-scale adds). The error correlation is fitted, and used by
@@ -261,8 +258,7 @@ int noise(const Flags& args, bool with_ground_truth, bool fit_range_scale) {
   model.range_cos_bearing_exponent = 0.0;
   model.odometry_delay_s = 0.0;
 
-  const double robot = args.number("robot", 0.0);
-  const mrclam::RobotData data = mrclam::load_robot(args.get("mrclam"), static_cast<int>(robot));
+  const mrclam::RobotData data = mrclam::load_robot(args.get("mrclam"), robot);
   mrclam::RobotData blind_data = data;
   blind_data.groundtruth.clear();  // a new robot has none: start at the origin
   blind_data.landmarks.clear();
@@ -383,12 +379,13 @@ int main(int argc, char** argv) {
   value(odometry_command, "out", "write the config with the fitted keys replaced (comments kept)", "FILE");
 
   bool with_ground_truth = false, fit_range_scale = false;
+  int robot = 0;
   app::Cli& noise_command = cli.subcommand(
       "noise",
       "odometry noise densities, range and bearing sigmas, the range's cos-bearing exponent and command lag from "
       "the filter's own innovations (never the ground truth); the errors' correlation time from pairs of sightings");
   value(noise_command, "mrclam", "the MRCLAM data set folder of the recording", "DIR")->required();
-  value(noise_command, "robot", "the robot, 1-5", "N")->required();
+  noise_command.option("--robot", robot, "the robot, 1-5").required().range(1, 5).type("N");
   value(noise_command, "config", "the base YAML (filter: and mrclam:)", "BASE.yaml")->required();
   value(noise_command, "out", "write BASE with the calibrated keys replaced", "FILE.yaml")->required();
   value(noise_command, "keys",
@@ -402,6 +399,6 @@ int main(int argc, char** argv) {
   return app::run_main("pixyslam_calibrate", [&] {
     if (camera.chosen()) return calibrate_camera(flags);
     if (odometry_command.chosen()) return odometry(flags);
-    return noise(flags, with_ground_truth, fit_range_scale);
+    return noise(flags, robot, with_ground_truth, fit_range_scale);
   });
 }

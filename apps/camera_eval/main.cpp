@@ -25,11 +25,10 @@ int main(int argc, char** argv) {
   cli.option("--seed", seed, "the world's seed").range(0, 1e15).type("S");
   if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("camera_eval", [&] {
-    const std::string dir_path = dir;
-    config::YamlReader pixy_root = config::YamlReader::from_file(dir_path + "/pixy_bridge.yaml");
+    config::YamlReader pixy_root = config::YamlReader::from_file(dir + "/pixy_bridge.yaml");
     config::YamlReader pixy_yaml = pixy_root.child("pixy");
     const pixy::PixyOptions pixy = pixy::read_pixy_options(pixy_yaml);
-    config::YamlReader sim_root = config::YamlReader::from_file(dir_path + "/slam_sim.yaml");
+    config::YamlReader sim_root = config::YamlReader::from_file(dir + "/slam_sim.yaml");
     config::YamlReader world_yaml = sim_root.child("world");
     camera_eval::EvalOptions options;
     options.world = sim::read_world_options(world_yaml);
