@@ -73,11 +73,7 @@ struct DdsArguments {
                 std::string("a YAML with a dds: mapping (default ") + PIXYSLAM_DEFAULT_PROFILES_FILE + ", domain 0)")
         .existing_file()
         .type("FILE");
-    command
-        .option_each(
-            "--domain", [this](const std::string& d) { overrides.push_back(pixyslam::dds::domain_override(d)); },
-            "DDS domain (overrides the config's and PIXYSLAM_DDS_DOMAIN)")
-        .type("N");
+    pixyslam::app::add_domain(command, overrides);
   }
   pixyslam::dds::DdsOptions resolve() const {
     pixyslam::dds::DdsOptions o = pixyslam::dds::read_dds_options_file(config, PIXYSLAM_DEFAULT_PROFILES_FILE);

@@ -110,10 +110,7 @@ int main(int argc, char** argv) {
       .type("DIR");
   live.option("--period", period, "seconds between snapshots (default: the config's snapshot_period_s)").type("S");
   live.flag("--no-window", live_request.no_window, "snapshots only, no window");
-  live.option_each(
-          "--domain", [&](const std::string& d) { dds_overrides.push_back(dds::domain_override(d)); },
-          "DDS domain (overrides the config's and PIXYSLAM_DDS_DOMAIN)")
-      .type("N");
+  app::add_domain(live, dds_overrides);
   app::add_verbose(live, verbose);
   live_view.add_to(live, false);
 

@@ -45,10 +45,7 @@ int main(int argc, char** argv) {
              std::string("YAML with a dds: mapping (default ") + PIXYSLAM_DEFAULT_PROFILES_FILE + ", domain 0)")
       .existing_file()
       .type("FILE");
-  cli.option_each(
-         "--domain", [&](const std::string& d) { dds_overrides.push_back(dds::domain_override(d)); },
-         "DDS domain (overrides the config's and PIXYSLAM_DDS_DOMAIN)")
-      .type("N");
+  app::add_domain(cli, dds_overrides);
   cli.flag("--quiet", quiet, "no progress lines");
   if (const auto done = cli.parse(argc, argv)) return *done;
   if (const auto failed = app::configure("pixyslam_play", [&] {

@@ -34,10 +34,7 @@ int main(int argc, char** argv) {
   cli.option("--arduino-link", arduino_link, "a symlink to the Arduino's pseudo-terminal at PATH").type("PATH");
   cli.option("--pixy-link", pixy_link, "a symlink to the Pixy's pseudo-terminal at PATH").type("PATH");
   cli.option("--camera-video", camera_video, "also write the synthetic camera's frames to FIFO").type("FIFO");
-  cli.option_each(
-         "--domain", [&](const std::string& d) { dds_overrides.push_back(dds::domain_override(d)); },
-         "DDS domain (overrides the config's and PIXYSLAM_DDS_DOMAIN)")
-      .type("N");
+  app::add_domain(cli, dds_overrides);
   if (const auto done = cli.parse(argc, argv)) return *done;
   robot_sim::RobotSimProcessConfig c;
   if (const auto failed = app::configure("robot_sim", [&] {

@@ -175,10 +175,7 @@ int main(int argc, char** argv) {
   cli.option("--config", args.config, "a YAML with a dds: mapping (e.g. config/slam_estimator.yaml)")
       .existing_file()
       .type("FILE");
-  cli.option_each(
-         "--domain", [&](const std::string& d) { args.dds_overrides.push_back(pixyslam::dds::domain_override(d)); },
-         "DDS domain (overrides the config's and PIXYSLAM_DDS_DOMAIN)")
-      .type("N");
+  app::add_domain(cli, args.dds_overrides);
   cli.option("--out-dir", args.out_dir, "write DIR/trajectory.csv and DIR/ground_truth.csv").type("DIR");
   cli.option("--max-ate", args.max_ate_m, "exit 1 if the pose ATE is above M (0: no check)")
       .type("M")

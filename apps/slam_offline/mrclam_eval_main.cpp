@@ -430,14 +430,14 @@ struct EvalArguments {
   bool loro = false, blind_return = false, optimise = false;
 };
 
-int run(const EvalArguments& a) {
-  const std::string& dataset = a.dataset;
-  const std::string& config_path = a.config_path;
-  const std::string& association = a.association;
-  const std::vector<int>& robots = a.robots;
-  const std::vector<int>& seeds = a.seeds;
-  const double segment_every_s = a.segment_every_s;
-  const bool loro = a.loro, blind_return = a.blind_return, optimise = a.optimise;
+int run(const EvalArguments& args) {
+  const std::string& dataset = args.dataset;
+  const std::string& config_path = args.config_path;
+  const std::string& association = args.association;
+  const std::vector<int>& robots = args.robots;
+  const std::vector<int>& seeds = args.seeds;
+  const double segment_every_s = args.segment_every_s;
+  const bool loro = args.loro, blind_return = args.blind_return, optimise = args.optimise;
   if (!std::filesystem::is_directory(dataset)) {
     std::printf("SKIP: dataset folder %s not found\n", dataset.c_str());
     return 77;

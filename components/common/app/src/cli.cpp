@@ -5,6 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "pixyslam/dds/dds_options.h"
+
 namespace pixyslam::app {
 
 Cli::Option& Cli::Option::required() {
@@ -177,6 +179,14 @@ Cli::Option& add_set(Cli& cli, std::vector<std::string>& assignments, const std:
           },
           "override a parameter of the config, e.g. --set " + example + " (repeatable; the list: --help)")
       .type("KEY=VALUE");
+}
+
+Cli::Option& add_domain(Cli& cli, std::vector<std::string>& dds_overrides) {
+  return cli
+      .option_each(
+          "--domain", [&dds_overrides](const std::string& d) { dds_overrides.push_back(dds::domain_override(d)); },
+          "DDS domain (overrides the config's and PIXYSLAM_DDS_DOMAIN)")
+      .type("N");
 }
 
 void add_verbose(Cli& cli, bool& verbose) {

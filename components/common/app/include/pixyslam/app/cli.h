@@ -80,6 +80,10 @@ Cli::Option& add_config(Cli& cli, std::string& path, const std::string& help);
 // `example` shows a key, e.g. "filter.particles=300".
 Cli::Option& add_set(Cli& cli, std::vector<std::string>& assignments, const std::string& example);
 
+// --domain N, repeatable (the last wins): "dds.domain_id=N" appended to
+// `dds_overrides` for dds::resolve_settings (the range is checked there, once).
+Cli::Option& add_domain(Cli& cli, std::vector<std::string>& dds_overrides);
+
 // --verbose: the long form of what a process prints at start (the effective configuration).
 void add_verbose(Cli& cli, bool& verbose);
 
