@@ -102,7 +102,9 @@ TEST(OdometryStream, PeriodsAtThePublishRateStampedFromTheFirstWholeSecond) {
   for (std::size_t i = 0; i < d.out.size(); ++i) {
     EXPECT_EQ(d.out[i].epoch_ns, kEpoch);
     EXPECT_NEAR(d.out[i].odometry.duration_s, 0.1, 1e-9);
-    if (i > 0) EXPECT_NEAR(d.out[i].odometry.t_s - d.out[i - 1].odometry.t_s, 0.1, 1e-9);
+    if (i > 0) {
+      EXPECT_NEAR(d.out[i].odometry.t_s - d.out[i - 1].odometry.t_s, 0.1, 1e-9);
+    }
     EXPECT_GT(d.out[i].odometry.v_mps, 0.0);
   }
   // Every sample before the last period's end is counted once: five per period.
