@@ -19,7 +19,7 @@
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/dds/endpoints.h"
-#include "process_group.h"
+#include "pixyslam/launcher/process_group.h"
 #include "../tests/sim_sensor_messages.h"
 
 namespace pixyslam::bench {

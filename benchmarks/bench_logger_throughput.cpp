@@ -26,7 +26,7 @@
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/log_tool/sequence_check.h"
 #include "pixyslam/mcap/mcap_reader.h"
-#include "process_group.h"
+#include "pixyslam/launcher/process_group.h"
 
 namespace pixyslam::bench {
 namespace {

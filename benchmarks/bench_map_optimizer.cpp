@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "mrclam_dataset.h"
-#include "optimised_run.h"
+#include "pixyslam/mrclam/mrclam_dataset.h"
+#include "pixyslam/offline/optimised_run.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/sim/sim_world.h"
 #include "pixyslam/slam/slam_options_yaml.h"

@@ -31,8 +31,8 @@
 #include <string>
 #include <vector>
 
-#include "mrclam_dataset.h"
-#include "offline_run.h"
+#include "pixyslam/mrclam/mrclam_dataset.h"
+#include "pixyslam/offline/offline_run.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/slam/slam_options_yaml.h"
 

@@ -1,6 +1,6 @@
 #pragma once
 
-// The simulated world's sensor streams (apps/sim_world) as the bridges publish
+// The simulated world's sensor streams (apps/simulation/sim_world) as the bridges publish
 // them, for feeding the estimator over DDS: used by test_estimator_node and by
 // benchmarks/bench_latency. The caller chooses the stamps.
 

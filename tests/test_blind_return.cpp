@@ -1,4 +1,4 @@
-// Blind-stretch-and-return cases (apps/slam_offline/blind_return.h): how a run is
+// Blind-stretch-and-return cases (pixyslam/offline/blind_return.h): how a run is
 // cut into seen / blind / far / return, how the return is scored, and the
 // filter on such a case in the simulated world (docs/mrclam.md, "Blind stretch
 // and return").
@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "blind_return.h"
+#include "pixyslam/offline/blind_return.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/eval/rigid_alignment.h"
 #include "pixyslam/sim/sim_world.h"

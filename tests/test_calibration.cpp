@@ -1,4 +1,4 @@
-// Camera and odometry calibration (apps/calibration): the fits recover known
+// Camera and odometry calibration (apps/tools/calibration): the fits recover known
 // parameters from measurements made with them, and bad input names its place.
 #include <cmath>
 #include <random>

@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "camera_eval.h"
+#include "pixyslam/camera_eval/camera_eval.h"
 #include "pixyslam/camera/colour_code_detector.h"
 #include "pixyslam/sim/synthetic_camera.h"
 #include "pixyslam/config/yaml_reader.h"

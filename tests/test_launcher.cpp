@@ -10,10 +10,10 @@
 
 #include <gtest/gtest.h>
 
-#include "deployment.h"
-#include "launch_plan.h"
+#include "pixyslam/launcher/deployment.h"
+#include "pixyslam/launcher/launch_plan.h"
 #include "pixyslam/config/yaml_reader.h"
-#include "process_group.h"
+#include "pixyslam/launcher/process_group.h"
 
 namespace pixyslam::launcher {
 namespace {

@@ -1,5 +1,5 @@
 // The map optimiser core (components/map_optimizer) and the offline run after
-// the filter (apps/slam_offline/optimised_run.h): exact data give the exact
+// the filter (pixyslam/offline/optimised_run.h): exact data give the exact
 // solution, a window solve holds what is outside it, bad input is counted and
 // dropped, and on the simulated robot the optimised map and trajectory are at
 // least as good as the filter's, also after a blind stretch with a heading bias.
@@ -13,8 +13,8 @@
 #include <Eigen/LU>
 #include <gtest/gtest.h>
 
-#include "blind_return.h"
-#include "optimised_run.h"
+#include "pixyslam/offline/blind_return.h"
+#include "pixyslam/offline/optimised_run.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/eval/rigid_alignment.h"
 #include "pixyslam/map_optimizer/map_optimizer.h"

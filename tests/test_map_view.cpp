@@ -723,25 +723,25 @@ TEST(MapViewLog, ReplaysTheOptimisedMapsOfALog) {
   EXPECT_EQ(count_like(render_map(final_state(plain, 0.0), o), optimised_like), 0);
 }
 
-TEST(MapViewLog, BadLogsAreInputErrorsNamingTheFile) {
+TEST(MapViewLog, BadLogsAreLogErrorsNamingTheFile) {
   const fs::path dir = temp_dir("bad");
   const std::string missing = (dir / "missing.mcap").string();
   try {
     MapLog::read(missing);
     FAIL() << "no exception";
-  } catch (const InputError& e) {
+  } catch (const LogError& e) {
     EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
   }
   const std::string text = (dir / "text.mcap").string();
   std::ofstream(text) << "not an mcap file at all\n";
-  EXPECT_THROW(MapLog::read(text), InputError);
+  EXPECT_THROW(MapLog::read(text), LogError);
 
   const std::string no_map = (dir / "no_map.mcap").string();
   write_log(no_map, 3, false);
   try {
     MapLog::read(no_map);
     FAIL() << "no exception";
-  } catch (const InputError& e) {
+  } catch (const LogError& e) {
     EXPECT_NE(std::string(e.what()).find("pixyslam/map_state"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find(no_map), std::string::npos) << e.what();
   }
@@ -758,7 +758,7 @@ TEST(MapViewLog, BadLogsAreInputErrorsNamingTheFile) {
   try {
     MapLog::read(garbage);
     FAIL() << "no exception";
-  } catch (const InputError& e) {
+  } catch (const LogError& e) {
     EXPECT_NE(std::string(e.what()).find("decodes"), std::string::npos) << e.what();
   }
 }

@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "mrclam_dataset.h"
+#include "pixyslam/mrclam/mrclam_dataset.h"
 
 namespace pixyslam::mrclam {
 namespace {

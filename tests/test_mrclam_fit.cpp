@@ -1,4 +1,4 @@
-// The fit of the MRCLAM corrections (apps/slam_offline/mrclam_fit.h) on
+// The fit of the MRCLAM corrections (pixyslam/mrclam/mrclam_fit.h) on
 // synthesised robots with known corrections: a robot driven by random commands
 // that act delay_s late and at speed v (scale - loss |w|), motion capture at
 // 100 Hz, a camera at 5 Hz reading poles on a grid with
@@ -13,7 +13,7 @@
 
 #include <gtest/gtest.h>
 
-#include "mrclam_fit.h"
+#include "pixyslam/mrclam/mrclam_fit.h"
 
 namespace pixyslam::mrclam {
 namespace {

@@ -1,5 +1,5 @@
 // The MRCLAM robot model applied to a dataset's commands and detections
-// (apps/slam_offline/offline_run.h, docs/mrclam.md).
+// (pixyslam/offline/offline_run.h, docs/mrclam.md).
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "mrclam_dataset.h"
-#include "offline_run.h"
+#include "pixyslam/mrclam/mrclam_dataset.h"
+#include "pixyslam/offline/offline_run.h"
 
 namespace pixyslam::offline {
 namespace {

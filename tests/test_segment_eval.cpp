@@ -1,12 +1,12 @@
 // Summary statistics, truth interpolation, segment starts and pose NEES of
-// mrclam_eval --segments (apps/slam_offline/segment_eval.h). No data files.
+// mrclam_eval --segments (pixyslam/offline/segment_eval.h). No data files.
 #include <cmath>
 #include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
 
-#include "segment_eval.h"
+#include "pixyslam/offline/segment_eval.h"
 
 namespace pixyslam::offline {
 namespace {

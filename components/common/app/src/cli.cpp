@@ -60,6 +60,11 @@ Cli::Option& Cli::Option::choices(const std::vector<std::string>& allowed) {
   return *this;
 }
 
+Cli::Option& Cli::Option::excludes(Option& other) {
+  option_->excludes(other.option_);
+  return *this;
+}
+
 Cli::Option& Cli::Option::needs(Option& other) {
   option_->needs(other.option_);
   return *this;

@@ -31,6 +31,7 @@ class Cli {
     Option& positive();  // a finite number > 0
     Option& choices(const std::vector<std::string>& allowed);
     Option& needs(Option& other);  // given only together with `other`
+    Option& excludes(Option& other);  // never given together with `other`
     Option& type(const std::string& name);  // the value's name in --help, e.g. "DIR"
 
    private:

@@ -1,0 +1,67 @@
+#pragma once
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pixyslam/launcher/launch_plan.h"
+
+namespace pixyslam::launcher {
+
+// How a child ended.
+struct ExitStatus {
+  bool exited = false;  // false: killed by a signal
+  int code = 0;         // exit code, or the signal number
+  bool stopped_by_us = false;
+  // A clean exit, or death by the SIGINT the launcher sent.
+  bool ok() const;
+  std::string describe() const;
+};
+
+// Child processes with their output (stdout and stderr) forwarded line by line
+// to `out` as "[name] line". Each child runs in its own process group, with
+// default signal dispositions, and gets SIGTERM if the process that started it
+// dies (PR_SET_PDEATHSIG, whatever killed it). stop_all() sends SIGINT, waits
+// up to a timeout, then SIGKILL; then it stops the descendants the children
+// left behind (this process is their subreaper). The destructor kills and
+// reaps whatever is left. Not thread-safe: one thread drives it; it reaps every
+// child of the process (waitpid(-1)).
+class ProcessGroup {
+ public:
+  ProcessGroup(std::string bin_dir, std::FILE* out);
+  ~ProcessGroup();
+  ProcessGroup(const ProcessGroup&) = delete;
+  ProcessGroup& operator=(const ProcessGroup&) = delete;
+
+  // Starts a child; throws std::runtime_error if the program is not found.
+  void start(const ProcessSpec& spec);
+  // Forwards output and reaps children for up to `timeout`; returns the indices
+  // of children that ended during the call.
+  std::vector<std::size_t> poll(std::chrono::milliseconds timeout);
+  // Stops the running children one at a time, newest first: SIGINT, then
+  // SIGKILL if one has not exited within `timeout`.
+  void stop_all(std::chrono::milliseconds timeout);
+
+  std::size_t size() const { return children_.size(); }
+  bool running(std::size_t i) const;
+  bool any_running() const;
+  const ProcessSpec& spec(std::size_t i) const;
+  const ExitStatus& status(std::size_t i) const;
+
+ private:
+  struct Child;
+  std::string resolve(const std::string& program) const;
+  void drain(Child& child, bool final);
+  void reap();
+  void stop_adopted(std::chrono::milliseconds timeout);
+
+  std::string bin_dir_;
+  std::FILE* out_;
+  std::vector<std::unique_ptr<Child>> children_;
+};
+
+}  // namespace pixyslam::launcher

@@ -1,0 +1,184 @@
+// pixyslam_spy: one inspection tool for the live system and its recordings,
+// decoding with the project's own types (no XTypes needed).
+//   pixyslam_spy participants | topics                     [DDS options] [--duration S]
+//   pixyslam_spy echo TOPIC [--json] [--count N] [--duration S] [DDS options]
+//   pixyslam_spy hz TOPIC [--duration S]                    [DDS options]
+//   pixyslam_spy diagnostics [--duration S]                 [DDS options]
+//   pixyslam_spy info FILE.mcap
+//   pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]
+//   pixyslam_spy print FILE.mcap [--topic T] [--json]
+//   pixyslam_spy compare A.mcap B.mcap --topic T [--ignore F,...] [--tolerance X]
+// DDS options: --config FILE (a YAML with a `dds:` mapping, e.g.
+// config/slam_estimator.yaml; default: config/dds/profiles.xml on domain 0),
+// --domain N. The same program is also built as pixyslam_log (info/check).
+// Exit status: 0 ok, 1 check failed / too few samples / file unreadable or
+// damaged (info, print, check; a file its writer did not close is not
+// damaged: info and print exit 0, check needs --allow-recovered),
+// 2 command-line or config error.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "pixyslam/log_tool/log_commands.h"
+#include "pixyslam/app/cli.h"
+#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/process_main.h"
+#include "pixyslam/app/stop_signal.h"
+#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/config/yaml_text.h"
+#include "pixyslam/log_tool/spy_commands.h"
+
+#ifndef PIXYSLAM_TOOL_NAME  // pixyslam_spy or pixyslam_log: the same program
+#define PIXYSLAM_TOOL_NAME "pixyslam_spy"
+#endif
+#ifndef PIXYSLAM_DEFAULT_PROFILES_FILE
+#define PIXYSLAM_DEFAULT_PROFILES_FILE ""
+#endif
+
+namespace {
+
+// TOPIC=N, N a non-negative integer.
+void add_expectation(const std::string& text, pixyslam::log_tool::CheckRequest& request) {
+  const auto eq = text.rfind('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) {
+    throw pixyslam::app::UsageError("--expect needs TOPIC=N, got '" + text + "'");
+  }
+  const std::string count = text.substr(eq + 1);
+  if (count.find_first_not_of("0123456789") != std::string::npos || count.size() > 18) {
+    throw pixyslam::app::UsageError("--expect " + text + ": N must be a non-negative integer");
+  }
+  if (!request.expected.emplace(text.substr(0, eq), std::stoull(count)).second) {
+    throw pixyslam::app::UsageError("--expect given twice for '" + text.substr(0, eq) + "'");
+  }
+}
+
+constexpr const char* kTopics =
+    "TOPIC: pixyslam/odometry, pixyslam/landmark_observation, pixyslam/map_state, pixyslam/ground_truth,\n"
+    "       pixyslam/diagnostics, pixyslam/optimised_map";
+
+// The DDS settings of a live command: --config FILE, --domain N.
+struct DdsArguments {
+  std::string config;
+  std::vector<std::string> overrides;  // --domain
+
+  void add_to(pixyslam::app::Cli& command) {
+    command
+        .option("--config", config,
+                std::string("a YAML with a dds: mapping (default ") + PIXYSLAM_DEFAULT_PROFILES_FILE + ", domain 0)")
+        .existing_file()
+        .type("FILE");
+    pixyslam::app::add_domain(command, overrides);
+  }
+  pixyslam::dds::DdsOptions resolve() const {
+    pixyslam::dds::DdsOptions o = pixyslam::dds::read_dds_options_file(config, PIXYSLAM_DEFAULT_PROFILES_FILE);
+    pixyslam::dds::resolve_settings(o, overrides);
+    return o;
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace pixyslam;
+  app::StopSignal::install();
+  app::Cli cli{PIXYSLAM_TOOL_NAME,
+               "Inspects the live system (participants, topics, echo, hz, diagnostics) and its recordings (info, "
+               "check, print, compare), decoding with the project's own types."};
+  cli.footer(std::string(kTopics) + "\nExit status: 0 ok, 1 check failed / too few samples / file unreadable or "
+                                    "damaged, 2 command-line or config error.");
+  DdsArguments dds_args;
+  double seconds = -1.0;  // -1: the command's default
+  auto add_duration = [&](app::Cli& command, const char* default_s) {
+    command.option("--duration", seconds, std::string("listen S seconds (default ") + default_s + ")")
+        .non_negative()
+        .type("S");
+  };
+  app::Cli& participants = cli.subcommand("participants", "the participants on the domain: process, host, pid");
+  add_duration(participants, "4");
+  dds_args.add_to(participants);
+  app::Cli& topics = cli.subcommand("topics", "the topics on the domain with their types, writers and readers");
+  add_duration(topics, "4");
+  dds_args.add_to(topics);
+  app::Cli& diagnostics = cli.subcommand("diagnostics", "each process's counters (the diagnostics topic)");
+  add_duration(diagnostics, "3");
+  dds_args.add_to(diagnostics);
+
+  log_tool::EchoRequest echo_request;
+  int count = 0;
+  app::Cli& echo = cli.subcommand("echo", "prints a topic's samples, the newest kept one first");
+  echo.option("topic", echo_request.topic, "the topic").required().type("TOPIC");
+  echo.flag("--json", echo_request.json, "one JSON object per line");
+  echo.option("--count", count, "stop after N samples (0: no limit)").non_negative().type("N");
+  add_duration(echo, "0: until Ctrl-C or --count");
+  dds_args.add_to(echo);
+
+  std::string hz_topic;
+  app::Cli& hz = cli.subcommand("hz", "a topic's rate, updated every second like ros2 topic hz");
+  hz.option("topic", hz_topic, "the topic").required().type("TOPIC");
+  add_duration(hz, "5");
+  dds_args.add_to(hz);
+
+  std::string info_file;
+  app::Cli& info = cli.subcommand("info", "a recording's topics, counts, rates and times");
+  info.option("file", info_file, "the MCAP file").required().existing_file().type("FILE.mcap");
+
+  log_tool::CheckRequest check_request;
+  app::Cli& check = cli.subcommand("check", "a recording is whole: every sequence 1..N, no damage");
+  check.option("file", check_request.path, "the MCAP file").required().existing_file().type("FILE.mcap");
+  check
+      .option_each(
+          "--expect", [&](const std::string& e) { add_expectation(e, check_request); },
+          "TOPIC holds exactly N messages (repeatable)")
+      .type("TOPIC=N");
+  check.flag("--allow-recovered", check_request.allow_recovered, "a file its writer did not close passes");
+
+  log_tool::PrintRequest print_request;
+  app::Cli& print = cli.subcommand("print", "a recording's messages, decoded");
+  print.option("file", print_request.path, "the MCAP file").required().existing_file().type("FILE.mcap");
+  print.option("--topic", print_request.topic, "only this topic").type("TOPIC");
+  print.flag("--json", print_request.json, "one JSON object per line");
+
+  log_tool::CompareRequest compare_request;
+  std::vector<std::string> compare_files;
+  std::string ignored;
+  app::Cli& compare = cli.subcommand("compare", "two recordings' messages of one topic, field by field");
+  compare.option("files", compare_files, "the two MCAP files").required().existing_file().type("A.mcap B.mcap");
+  compare.option("--topic", compare_request.topic, "the topic").required().type("TOPIC");
+  compare.option("--ignore", ignored, "fields not compared").type("FIELD,...");
+  compare.option("--tolerance", compare_request.tolerance, "largest difference of a number taken as equal")
+      .non_negative()
+      .type("X");
+
+  try {
+    if (const auto done = cli.parse(argc, argv)) return *done;
+  } catch (const app::UsageError& e) {  // from --expect
+    std::fprintf(stderr, PIXYSLAM_TOOL_NAME ": %s (see --help)\n", e.what());
+    return 2;
+  }
+  return app::run_main(PIXYSLAM_TOOL_NAME, [&]() -> int {
+    if (info.chosen()) return log_tool::run_info(info_file, std::cout, std::cerr);
+    if (print.chosen()) return log_tool::run_print(print_request, std::cout, std::cerr);
+    if (check.chosen()) return log_tool::run_check(check_request, std::cout, std::cerr);
+    if (compare.chosen()) {
+      if (compare_files.size() != 2) throw app::UsageError("compare needs exactly two MCAP files");
+      compare_request.first_path = compare_files[0];
+      compare_request.second_path = compare_files[1];
+      for (std::string& field : config::split_comma_list(ignored)) compare_request.ignored.push_back(std::move(field));
+      return log_tool::run_compare(compare_request, std::cout);
+    }
+    const dds::DdsOptions options = dds_args.resolve();
+    if (participants.chosen()) return log_tool::run_participants(options, seconds < 0 ? 4.0 : seconds, std::cout);
+    if (topics.chosen()) return log_tool::run_topics(options, seconds < 0 ? 4.0 : seconds, std::cout);
+    if (diagnostics.chosen()) return log_tool::run_diagnostics(options, seconds < 0 ? 3.0 : seconds, std::cout);
+    if (hz.chosen()) return log_tool::run_hz(options, hz_topic, seconds < 0 ? 5.0 : seconds, std::cout);
+    echo_request.count = static_cast<std::size_t>(count);
+    echo_request.seconds = seconds < 0 ? 0.0 : seconds;
+    return log_tool::run_echo(options, echo_request, std::cout);
+  });
+}
