@@ -20,7 +20,7 @@
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/launcher/process_group.h"
-#include "../tests/sim_sensor_messages.h"
+#include "../tests/support/sim_sensor_messages.h"
 
 namespace pixyslam::bench {
 namespace {

@@ -132,10 +132,7 @@ TEST(SlamOptionsYaml, MissingKeysKeepDefaults) {
 
 TEST(SlamOptionsYaml, ReadsTheShippedSimConfig) {
   // The repository's own sim config must load (its `world:` part is not ours).
-  // The source tree is found from this file's path (absolute with CMake/Ninja).
-  const std::filesystem::path config =
-      std::filesystem::path(__FILE__).parent_path().parent_path() / "config" / "slam_sim.yaml";
-  if (!std::filesystem::exists(config)) GTEST_SKIP() << "source tree not found from __FILE__: " << config;
+  const std::filesystem::path config = std::filesystem::path(PIXYSLAM_CONFIG_DIR) / "slam_sim.yaml";
   YamlReader root = YamlReader::from_file(config.string());
   YamlReader filter = root.child("filter");
   const FilterOptions o = read_filter_options(filter);
