@@ -26,7 +26,7 @@
 #include "pixyslam/config/yaml_text.h"
 #include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/logger_node/logger_node.h"
-#include "pixyslam/logger_node/topic_selection.h"
+#include "pixyslam/dds/topic_selection.h"
 
 int main(int argc, char** argv) {
   using namespace pixyslam;
@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
       const std::vector<std::string> patterns = config::split_comma_list(topics);
       std::vector<std::string> known;
       for (const pixyslam::dds::TopicInfo& t : pixyslam::dds::known_topics()) known.push_back(t.topic);
-      const logger_node::TopicSelection selection = logger_node::select_topics(patterns, known);
+      const pixyslam::dds::TopicSelection selection = pixyslam::dds::select_topics(patterns, known);
       if (patterns.empty() || !selection.error.empty()) {
         throw std::invalid_argument("--topics: " + (patterns.empty() ? std::string("empty list")
                                                                      : "'" + patterns[selection.bad_pattern] +

@@ -213,7 +213,6 @@ int run(const LaunchCommandLine& args, const std::map<std::string, std::string>&
   const std::string& launch_file = args.launch_file;
   const bool show_args = args.show_args;
   const std::string run_dir = args.run_dir.empty() ? default_run_dir() : args.run_dir;
-  if (!show_args) std::filesystem::create_directories(run_dir);
   const std::string bin_dir = own_folder();
   std::map<std::string, std::string> variables{
       {"config_dir", std::filesystem::absolute(app::folder_of(launch_file)).string()},
@@ -226,6 +225,7 @@ int run(const LaunchCommandLine& args, const std::map<std::string, std::string>&
     std::fputs(launcher::arguments_text(plan).c_str(), stdout);
     return 0;
   }
+  std::filesystem::create_directories(run_dir);  // only once the file and its arguments are good
   if (!args.deployment.empty()) {
     const launcher::Deployment deployment = launcher::read_deployment(args.deployment);
     plan = launcher::plan_for_host(plan, deployment, args.host);

@@ -25,7 +25,7 @@
 #include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/logger_node/logger_node.h"
 #include "pixyslam/logger_node/logger_options.h"
-#include "pixyslam/logger_node/topic_selection.h"
+#include "sample_messages.h"
 
 namespace pixyslam::logger_node {
 namespace {
@@ -33,196 +33,12 @@ namespace {
 using log_tool::analyze_sequence;
 using log_tool::describe;
 using log_tool::SequenceReport;
-using dds::decode_header;
-using dds::find_topic;
 using dds::from_cdr;
 using dds::known_topics;
-using dds::SampleHeader;
 using dds::to_cdr;
 using dds::TopicInfo;
 
-// ---------------------------------------------------------------- sequences
-
-TEST(SequenceCheck, OneToNInAnyOrderIsComplete) {
-  const SequenceReport r = analyze_sequence({3, 1, 2, 4, 5});
-  EXPECT_TRUE(r.complete());
-  EXPECT_EQ(r.count, 5u);
-  EXPECT_EQ(r.min, 1u);
-  EXPECT_EQ(r.max, 5u);
-  EXPECT_EQ(r.backwards, 1u);  // 1 after 3
-  EXPECT_EQ(describe(r), "seq 1..5: 1 out of order");
-  EXPECT_EQ(describe(analyze_sequence({1, 2, 3})), "seq 1..3");
-}
-
-TEST(SequenceCheck, EmptyStreamIsComplete) {
-  const SequenceReport r = analyze_sequence({});
-  EXPECT_TRUE(r.complete());
-  EXPECT_EQ(describe(r), "no messages");
-}
-
-TEST(SequenceCheck, GapsAndDuplicatesAreCountedAndListed) {
-  // Missing 1 (a late start), 5-7 and 10; 8 twice, 9 three times.
-  const SequenceReport r = analyze_sequence({2, 3, 4, 8, 8, 9, 9, 9, 11});
-  EXPECT_FALSE(r.complete());
-  EXPECT_EQ(r.missing, 5u);
-  ASSERT_EQ(r.missing_ranges.size(), 3u);
-  EXPECT_EQ(r.missing_ranges[0].first, 1u);
-  EXPECT_EQ(r.missing_ranges[0].last, 1u);
-  EXPECT_EQ(r.missing_ranges[1].first, 5u);
-  EXPECT_EQ(r.missing_ranges[1].last, 7u);
-  EXPECT_EQ(r.duplicates, 3u);
-  EXPECT_EQ(r.duplicated, (std::vector<std::uint64_t>{8, 9}));
-  EXPECT_EQ(r.distinct, 6u);
-  EXPECT_EQ(describe(r), "seq 2..11: 5 missing (1, 5-7, 10), 3 duplicates (8, 9)");
-}
-
-TEST(SequenceCheck, ZeroIsNotAValidSeq) {
-  const SequenceReport r = analyze_sequence({0, 1, 2});
-  EXPECT_FALSE(r.complete());
-  EXPECT_EQ(r.zeros, 1u);
-  EXPECT_EQ(r.missing, 0u);
-  EXPECT_EQ(describe(r), "seq 0..2: 1 with seq 0");
-}
-
-TEST(SequenceCheck, ListsAreBoundedButCountsAreNot) {
-  std::vector<std::uint64_t> seqs;
-  for (std::uint64_t s = 2; s <= 40; s += 2) seqs.push_back(s);  // every odd number missing
-  const SequenceReport r = analyze_sequence(seqs, 3);
-  EXPECT_EQ(r.missing, 20u);
-  EXPECT_EQ(r.missing_ranges.size(), 3u);
-  EXPECT_EQ(describe(r), "seq 2..40: 20 missing (1, 3, 5, ...)");
-}
-
-// ---------------------------------------------------------------- CDR payloads
-
-msg::Odometry odometry(int i) {
-  msg::Odometry m;
-  m.header().stamp_ns(1'700'000'000'000'000'000ull + static_cast<std::uint64_t>(i) * 100'000'000ull);
-  m.header().frame_id("base_link");
-  m.v_mps(0.01 * i);
-  m.w_radps(-0.002 * i);
-  m.period_s(0.1);
-  m.distance_m(0.001 * i);
-  m.rotation_rad(-0.0002 * i);
-  m.encoder_samples(static_cast<std::uint32_t>(i % 7));
-  return m;
-}
-
-TEST(CdrPayload, CarriesTheEncapsulationHeaderAndRoundTrips) {
-  msg::Odometry m = odometry(3);
-  m.header().seq(42);
-  m.header().robot_id("r1");
-  const std::vector<std::uint8_t> bytes = to_cdr(m);
-  ASSERT_GE(bytes.size(), 4u);
-  EXPECT_EQ(bytes[0], 0x00);  // CDR_LE, options 0
-  EXPECT_EQ(bytes[1], 0x01);
-  EXPECT_EQ(bytes[2], 0x00);
-  EXPECT_EQ(bytes[3], 0x00);
-  msg::Odometry back;
-  std::string error;
-  ASSERT_TRUE(from_cdr(bytes, back, error)) << error;
-  EXPECT_EQ(back, m);
-
-  SampleHeader header;
-  ASSERT_TRUE(decode_header("pixyslam::msg::Odometry", bytes.data(), bytes.size(), header, error)) << error;
-  EXPECT_EQ(header.seq, 42u);
-  EXPECT_EQ(header.stamp_ns, m.header().stamp_ns());
-  EXPECT_EQ(header.robot_id, "r1");
-  EXPECT_EQ(header.frame_id, "base_link");
-}
-
-TEST(CdrPayload, StrictDecodingRejectsCutPaddedAndMistypedPayloads) {
-  msg::Odometry m = odometry(5);
-  m.header().robot_id("r1");
-  std::vector<std::uint8_t> bytes = to_cdr(m);
-  SampleHeader header;
-  std::string error;
-
-  std::vector<std::uint8_t> cut(bytes.begin(), bytes.end() - 3);
-  EXPECT_FALSE(decode_header("pixyslam::msg::Odometry", cut.data(), cut.size(), header, error));
-  EXPECT_FALSE(error.empty());
-
-  std::vector<std::uint8_t> padded = bytes;  // alignment padding (zeros) is fine
-  padded.insert(padded.end(), {0, 0});
-  EXPECT_TRUE(decode_header("pixyslam::msg::Odometry", padded.data(), padded.size(), header, error)) << error;
-  std::vector<std::uint8_t> garbage = bytes;  // anything else after the sample is not
-  garbage.insert(garbage.end(), {0xAB, 0xCD, 0xEF, 0x01, 0x02, 0x03, 0x04, 0x05});
-  EXPECT_FALSE(decode_header("pixyslam::msg::Odometry", garbage.data(), garbage.size(), header, error));
-
-  // An Odometry payload is not a MapState.
-  EXPECT_FALSE(decode_header("pixyslam::msg::MapState", bytes.data(), bytes.size(), header, error));
-  EXPECT_FALSE(decode_header("pixyslam::msg::Nope", bytes.data(), bytes.size(), header, error));
-  EXPECT_NE(error.find("unknown type"), std::string::npos) << error;
-  EXPECT_FALSE(decode_header("pixyslam::msg::Odometry", bytes.data(), 2, header, error));
-}
-
-TEST(CdrPayload, KnownTopicsAreTheSystemsTopicsWithTheirDdsTypeNames) {
-  const auto& topics = known_topics();
-  ASSERT_EQ(topics.size(), 6u);
-  EXPECT_EQ(topics[0].topic, dds::kOdometryTopic);
-  EXPECT_EQ(topics[0].type_name, "pixyslam::msg::Odometry");
-  EXPECT_EQ(topics[0].idl_stem, "odometry");
-  EXPECT_EQ(topics[2].type_name, "pixyslam::msg::MapState");
-  ASSERT_NE(find_topic("pixyslam/ground_truth"), nullptr);
-  EXPECT_EQ(find_topic("pixyslam/ground_truth")->type_name, "pixyslam::msg::GroundTruth");
-  EXPECT_EQ(find_topic("odometry"), nullptr);
-  EXPECT_EQ(topics[4].topic, dds::kDiagnosticsTopic);
-  EXPECT_EQ(topics[4].type_name, "pixyslam::msg::Diagnostics");
-  EXPECT_EQ(topics[5].topic, dds::kOptimisedMapTopic);
-  EXPECT_EQ(topics[5].type_name, "pixyslam::msg::OptimisedMap");
-  EXPECT_EQ(topics[5].idl_stem, "optimised_map");
-  ASSERT_NE(find_topic("pixyslam/optimised_map"), nullptr);
-}
-
-// ---------------------------------------------------------------- topic patterns, file names
-
-TEST(TopicSelection, GlobMatchesWholeNames) {
-  EXPECT_TRUE(glob_match("pixyslam/*", "pixyslam/odometry"));
-  EXPECT_TRUE(glob_match("*", "pixyslam/odometry"));
-  EXPECT_TRUE(glob_match("*/odometry", "pixyslam/odometry"));
-  EXPECT_TRUE(glob_match("pixyslam/*_*", "pixyslam/map_state"));
-  EXPECT_TRUE(glob_match("pixyslam/?ap_state", "pixyslam/map_state"));
-  EXPECT_TRUE(glob_match("pixyslam/odometry", "pixyslam/odometry"));
-  EXPECT_FALSE(glob_match("pixyslam/odometr", "pixyslam/odometry"));
-  EXPECT_FALSE(glob_match("pixyslam/*_*", "pixyslam/odometry"));
-  EXPECT_FALSE(glob_match("pixyslam/?", "pixyslam/odometry"));
-  EXPECT_FALSE(glob_match("other/*", "pixyslam/odometry"));
-  EXPECT_TRUE(glob_match("**a*", "a"));
-  EXPECT_FALSE(glob_match("", "a"));
-  EXPECT_TRUE(glob_match("", ""));
-}
-
-const std::vector<std::string> kKnown = {"pixyslam/odometry", "pixyslam/landmark_observation",
-                                         "pixyslam/map_state", "pixyslam/ground_truth"};
-
-TEST(TopicSelection, IncludesExcludesAndKeepsTheKnownOrder) {
-  EXPECT_EQ(select_topics({"pixyslam/*", "!pixyslam/ground_truth"}, kKnown).topics,
-            (std::vector<std::string>{"pixyslam/odometry", "pixyslam/landmark_observation", "pixyslam/map_state"}));
-  EXPECT_EQ(select_topics({"!pixyslam/ground_truth", "!*observation"}, kKnown).topics,
-            (std::vector<std::string>{"pixyslam/odometry", "pixyslam/map_state"}));
-  EXPECT_EQ(select_topics({"pixyslam/map_state", "pixyslam/odometry"}, kKnown).topics,
-            (std::vector<std::string>{"pixyslam/odometry", "pixyslam/map_state"}));
-  EXPECT_EQ(select_topics({"pixyslam/*o*", "pixyslam/odometry"}, kKnown).topics.size(), 3u);  // overlap is fine
-}
-
-TEST(TopicSelection, ErrorsNameThePattern) {
-  TopicSelection s = select_topics({"pixyslam/odometry", "pixyslam/odometri"}, kKnown);
-  EXPECT_EQ(s.bad_pattern, 1u);
-  EXPECT_NE(s.error.find("unknown topic 'pixyslam/odometri'"), std::string::npos) << s.error;
-  s = select_topics({"other/*"}, kKnown);
-  EXPECT_NE(s.error.find("pattern 'other/*' matches no known topic"), std::string::npos) << s.error;
-  s = select_topics({"pixyslam/*", "!pixyslam/*"}, kKnown);
-  EXPECT_EQ(s.error, "the patterns select no topic");
-  EXPECT_TRUE(s.topics.empty());
-  s = select_topics({"!x"}, kKnown);
-  EXPECT_NE(s.error.find("unknown topic 'x'"), std::string::npos) << s.error;
-  s = select_topics({"pixyslam/*", "!"}, kKnown);
-  EXPECT_EQ(s.bad_pattern, 1u);
-  EXPECT_EQ(s.error, "empty topic pattern");
-  s = select_topics({"!pixyslam/map_state", "!pixyslam/map_state"}, kKnown);
-  EXPECT_NE(s.error.find("given twice"), std::string::npos) << s.error;
-  EXPECT_FALSE(select_topics({}, kKnown).error.empty());
-}
+// ---------------------------------------------------------------- file names
 
 TEST(RotatedFileName, IndexGoesBeforeTheExtension) {
   EXPECT_EQ(rotated_file_name("run.mcap", 0), "run_000.mcap");
@@ -578,7 +394,7 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
   std::vector<msg::GroundTruth> truths_sent;
   std::vector<msg::OptimisedMap> optimised_sent;
   for (int i = 0; i < 500; ++i) {
-    odometry_sent.push_back(odometry(i));
+    odometry_sent.push_back(test::sample_odometry(i));
     ASSERT_TRUE(odometry_writer.publish(odometry_sent.back()));  // fills seq and robot_id
     if (i % 10 == 0) {
       observations_sent.push_back(observation(i / 10));
@@ -695,14 +511,14 @@ TEST(LoggerNode, DropsAndCountsSamplesBeyondTheQueueBound) {
   dds::Participant robot(loopback_options(), "test_robot");
   dds::Writer<msg::Odometry> writer(robot);
   // Room for exactly 10 samples of this size (robot_id and frame_id fixed).
-  msg::Odometry probe = odometry(0);
+  msg::Odometry probe = test::sample_odometry(0);
   probe.header().robot_id("test_robot");
   options.queue_max_bytes = 10 * to_cdr(probe).size();
 
   LoggerNode node(options);  // not started: nothing leaves the queue
   ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(10)));
   for (int i = 0; i < 30; ++i) {
-    msg::Odometry m = odometry(i);
+    msg::Odometry m = test::sample_odometry(i);
     ASSERT_TRUE(writer.publish(m));
   }
   ASSERT_TRUE(wait_until([&] { return received(node, "pixyslam/odometry") == 30; }, std::chrono::seconds(10)))
@@ -737,7 +553,7 @@ TEST(LoggerNode, FlushTimerBoundsWhatACrashLoses) {
   dds::Writer<msg::Odometry> writer(robot);
   ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(10)));
   for (int i = 0; i < 50; ++i) {
-    msg::Odometry m = odometry(i);
+    msg::Odometry m = test::sample_odometry(i);
     ASSERT_TRUE(writer.publish(m));
   }
   ASSERT_TRUE(wait_until([&] { return node.counters().topics[0].written == 50; }, std::chrono::seconds(10)))
@@ -811,7 +627,7 @@ TEST(LoggerNode, RotatesBySizeIntoCompleteFiles) {
   ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(10)));
   constexpr int kCount = 2000;
   for (int i = 0; i < kCount; ++i) {
-    msg::Odometry m = odometry(i);
+    msg::Odometry m = test::sample_odometry(i);
     ASSERT_TRUE(writer.publish(m));
   }
   ASSERT_TRUE(wait_until([&] { return received(node, "pixyslam/odometry") == kCount; }, std::chrono::seconds(20)))
@@ -847,7 +663,7 @@ TEST(LoggerNode, RotatesByPeriod) {
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < kCount; ++i) {
     std::this_thread::sleep_until(start + std::chrono::milliseconds(10 * i));
-    msg::Odometry m = odometry(i);
+    msg::Odometry m = test::sample_odometry(i);
     ASSERT_TRUE(writer.publish(m));
   }
   ASSERT_TRUE(wait_until([&] { return received(node, "pixyslam/odometry") == kCount; }, std::chrono::seconds(20)))
@@ -896,7 +712,7 @@ TEST(LoggerNode, WriteFailuresKeepTheFileAndRecordingGoesOnInANewOne) {
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < kCount; ++i) {
     std::this_thread::sleep_until(start + std::chrono::microseconds(1000 * i));
-    msg::Odometry m = odometry(i);
+    msg::Odometry m = test::sample_odometry(i);
     ASSERT_TRUE(writer.publish(m));
   }
   const bool all_received =

@@ -12,7 +12,7 @@
 
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/dds/cdr_payload.h"
-#include "pixyslam/logger_node/topic_selection.h"
+#include "pixyslam/dds/topic_selection.h"
 
 namespace pixyslam::logger_node {
 
@@ -68,7 +68,7 @@ LoggerNode::LoggerNode(const LoggerOptions& options) : options_(options) {
   if (options_.topics.empty()) {
     options_.topics = all;
   } else {
-    const TopicSelection selection = select_topics(options_.topics, all);
+    const dds::TopicSelection selection = dds::select_topics(options_.topics, all);
     if (!selection.error.empty()) {
       throw std::invalid_argument("logger: topics[" + std::to_string(selection.bad_pattern) + "] '" +
                                   options_.topics[selection.bad_pattern] + "': " + selection.error);

@@ -1,11 +1,12 @@
 #include "pixyslam/logger_node/logger_options.h"
 
+#include <cstdio>
 #include <sstream>
 
 #include "pixyslam/app/command_line.h"
 #include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/dds/cdr_payload.h"
-#include "pixyslam/logger_node/topic_selection.h"
+#include "pixyslam/dds/topic_selection.h"
 
 namespace pixyslam::logger_node {
 
@@ -103,7 +104,7 @@ LoggerOptions read_logger_options(config::YamlReader& root, const std::string& c
   if (section.has("topics")) {
     const std::vector<std::string> patterns = section.text_list("topics");
     if (patterns.empty()) section.fail("topics", "empty list (leave the key out to record every topic)");
-    const TopicSelection selection = select_topics(patterns, all_topics());
+    const dds::TopicSelection selection = dds::select_topics(patterns, all_topics());
     if (!selection.error.empty()) {
       section.fail("topics[" + std::to_string(selection.bad_pattern) + "]", selection.error);
     }
@@ -132,6 +133,17 @@ std::string to_yaml(const LoggerOptions& o) {
   std::string topics;
   for (const std::string& t : o.topics) topics += (topics.empty() ? "" : ", ") + t;
   return parameters::to_yaml(o, logger_parameters(), "logger") + "  topics: [" + topics + "]\n" + dds::to_yaml(o.dds);
+}
+
+std::string rotated_file_name(const std::string& base, std::size_t index) {
+  const std::size_t slash = base.find_last_of('/');
+  const std::size_t dot = base.find_last_of('.');
+  const bool has_extension = dot != std::string::npos && (slash == std::string::npos || dot > slash + 1);
+  const std::string stem = has_extension ? base.substr(0, dot) : base;
+  const std::string extension = has_extension ? base.substr(dot) : "";
+  char number[32];
+  std::snprintf(number, sizeof(number), "_%03zu", index);
+  return stem + number + extension;
 }
 
 }  // namespace pixyslam::logger_node

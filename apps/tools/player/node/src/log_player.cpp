@@ -12,7 +12,7 @@
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/dds/cdr_payload.h"
-#include "pixyslam/logger_node/topic_selection.h"
+#include "pixyslam/dds/topic_selection.h"
 
 namespace pixyslam::player {
 
@@ -113,7 +113,7 @@ LogPlayer::LogPlayer(const PlayerOptions& options, std::ostream& log) : options_
   if (in_logs.empty()) throw std::runtime_error("no topic of this project in " + options_.files.front());
   std::vector<std::string> played = in_logs;
   if (!options_.topics.empty()) {
-    const logger_node::TopicSelection selection = logger_node::select_topics(options_.topics, in_logs);
+    const dds::TopicSelection selection = dds::select_topics(options_.topics, in_logs);
     if (!selection.error.empty()) {
       throw std::invalid_argument("--topics '" + options_.topics[selection.bad_pattern] + "': " + selection.error);
     }

@@ -79,4 +79,8 @@ LoggerOptions read_logger_options_file(const std::string& path);
 // The effective configuration, in the layout read_logger_options() reads.
 std::string to_yaml(const LoggerOptions& options);
 
+// The name of rotated file `index` for `base`: "run.mcap", 3 -> "run_003.mcap"
+// (at least three digits; "dir/run" -> "dir/run_003"). Pure.
+std::string rotated_file_name(const std::string& base, std::size_t index);
+
 }  // namespace pixyslam::logger_node

@@ -5,7 +5,7 @@
 #include <string_view>
 #include <vector>
 
-namespace pixyslam::logger_node {
+namespace pixyslam::dds {
 
 // Shell-style match of a whole topic name: `*` any run of characters ('/'
 // included), `?` one character; everything else literal.
@@ -27,8 +27,4 @@ struct TopicSelection {
 // topic, a pattern given twice, an empty list, nothing selected. Pure.
 TopicSelection select_topics(const std::vector<std::string>& patterns, const std::vector<std::string>& known);
 
-// The name of rotated file `index` for `base`: "run.mcap", 3 -> "run_003.mcap"
-// (at least three digits; "dir/run" -> "dir/run_003"). Pure.
-std::string rotated_file_name(const std::string& base, std::size_t index);
-
-}  // namespace pixyslam::logger_node
+}  // namespace pixyslam::dds

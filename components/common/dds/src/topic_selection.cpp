@@ -1,10 +1,9 @@
-#include "pixyslam/logger_node/topic_selection.h"
+#include "pixyslam/dds/topic_selection.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <set>
 
-namespace pixyslam::logger_node {
+namespace pixyslam::dds {
 
 bool glob_match(std::string_view pattern, std::string_view text) {
   // Iterative match with backtracking to the last '*'.
@@ -79,15 +78,4 @@ TopicSelection select_topics(const std::vector<std::string>& patterns, const std
   return out;
 }
 
-std::string rotated_file_name(const std::string& base, std::size_t index) {
-  const std::size_t slash = base.find_last_of('/');
-  const std::size_t dot = base.find_last_of('.');
-  const bool has_extension = dot != std::string::npos && (slash == std::string::npos || dot > slash + 1);
-  const std::string stem = has_extension ? base.substr(0, dot) : base;
-  const std::string extension = has_extension ? base.substr(dot) : "";
-  char number[32];
-  std::snprintf(number, sizeof(number), "_%03zu", index);
-  return stem + number + extension;
-}
-
-}  // namespace pixyslam::logger_node
+}  // namespace pixyslam::dds
