@@ -15,11 +15,12 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "pixyslam/app/cli.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/mrclam/mrclam_dataset.h"
 #include "pixyslam/offline/optimised_run.h"
 #include "pixyslam/config/yaml_reader.h"
@@ -29,16 +30,6 @@
 namespace {
 
 using namespace pixyslam;
-
-constexpr const char* kUsage =
-    "usage: bench_map_optimizer [--dataset DIR --robot N] --config FILE [--window-period S] [--window-keyframes K]\n"
-    "                           [--whole-period S]\n"
-    "  --dataset DIR --robot N   a MRCLAM robot (exit 77 when the folder is absent); without: the simulated\n"
-    "                            world of the config's world: section\n"
-    "  --config FILE             filter: (and mrclam: or world:) options\n"
-    "  --window-period S         data time between window solves, default 1 (as config/map_optimizer.yaml)\n"
-    "  --window-keyframes K      keyframes a window solve frees, default 100\n"
-    "  --whole-period S          data time between whole-problem solves, default 10\n";
 
 void print_solves(const char* label, const std::vector<map_optimizer::SolveSummary>& solves) {
   double sum = 0.0, worst = 0.0;
@@ -51,48 +42,39 @@ void print_solves(const char* label, const std::vector<map_optimizer::SolveSumma
 }
 
 int run(int argc, char** argv) {
-  std::map<std::string, std::string> args;
-  for (int i = 1; i < argc; ++i) {
-    const std::string key = argv[i];
-    if (key == "--help" || key == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-    static const char* known[] = {"--dataset", "--robot", "--config", "--window-period", "--window-keyframes",
-                                  "--whole-period"};
-    if (std::find(std::begin(known), std::end(known), key) == std::end(known)) {
-      throw std::invalid_argument("unknown argument '" + key + "'");
-    }
-    if (i + 1 >= argc) throw std::invalid_argument(key + " needs a value");
-    args[key.substr(2)] = argv[++i];
-  }
-  if (!args.count("config")) throw std::invalid_argument("missing --config");
-  if (args.count("dataset") != args.count("robot")) throw std::invalid_argument("--dataset and --robot go together");
-  const auto number = [&](const char* key, double fallback) {
-    if (!args.count(key)) return fallback;
-    std::size_t used = 0;
-    const double v = std::stod(args[key], &used);
-    if (used != args[key].size() || !(v >= 0.0)) throw std::invalid_argument(std::string("--") + key + ": not a number >= 0");
-    return v;
-  };
+  std::string dataset, config_file;
+  int robot = 0;
+  int window_keyframes = 0;
   map_optimizer::SolveScheduleOptions schedule;  // the live process's defaults
-  schedule.window_period_s = number("window-period", schedule.window_period_s);
-  schedule.window_keyframes =
-      static_cast<std::size_t>(number("window-keyframes", static_cast<double>(schedule.window_keyframes)));
-  schedule.whole_period_s = number("whole-period", schedule.whole_period_s);
+  app::Cli cli{"bench_map_optimizer", "Map optimiser cost over a whole run with the live process's solve schedule."};
+  app::Cli::Option& dataset_option =
+      cli.option("--dataset", dataset, "a MRCLAM data set (exit 77 when the folder is absent); without: the simulated "
+                                       "world of the config's world: section").type("DIR");
+  app::Cli::Option& robot_option = cli.option("--robot", robot, "the MRCLAM robot").range(1, 5).type("N");
+  dataset_option.needs(robot_option);
+  robot_option.needs(dataset_option);
+  app::add_config(cli, config_file, "filter: (and mrclam: or world:) options").required();
+  cli.option("--window-period", schedule.window_period_s, "data time between window solves, default 1 "
+                                                          "(as config/map_optimizer.yaml)").positive().type("S");
+  cli.option("--window-keyframes", window_keyframes, "keyframes a window solve frees, default 100").range(1, 1000000)
+      .type("K");
+  cli.option("--whole-period", schedule.whole_period_s, "data time between whole-problem solves, default 10")
+      .positive().type("S");
+  if (const auto done = cli.parse(argc, argv)) return *done;
+  if (cli.given("--window-keyframes")) schedule.window_keyframes = static_cast<std::size_t>(window_keyframes);
 
-  config::YamlReader root = config::YamlReader::from_file(args["config"]);
+  config::YamlReader root = config::YamlReader::from_file(config_file);
   config::YamlReader filter_yaml = root.child("filter");
   const slam::FilterOptions options = slam::read_filter_options(filter_yaml);
   offline::RunInput input;
-  if (args.count("dataset")) {
-    if (!std::filesystem::is_directory(args["dataset"])) {
-      std::printf("SKIP: dataset folder %s not found\n", args["dataset"].c_str());
+  if (!dataset.empty()) {
+    if (!std::filesystem::is_directory(dataset)) {
+      std::printf("SKIP: dataset folder %s not found\n", dataset.c_str());
       return 77;
     }
     const offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
     root.finish();
-    input = offline::mrclam_input(mrclam::load_robot(args["dataset"], std::stoi(args["robot"])), model);
+    input = offline::mrclam_input(mrclam::load_robot(dataset, robot), model);
   } else {
     config::YamlReader world_yaml = root.child("world");
     const sim::WorldRun run = sim::simulate(sim::read_world_options(world_yaml));
@@ -129,13 +111,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "bench_map_optimizer: %s\n%s", e.what(), kUsage);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_map_optimizer: %s\n", e.what());
-    return 1;
-  }
+  return app::run_main("bench_map_optimizer", [&] { return run(argc, argv); });
 }

@@ -25,12 +25,13 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
-#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "pixyslam/app/cli.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/mrclam/mrclam_dataset.h"
 #include "pixyslam/offline/offline_run.h"
 #include "pixyslam/config/yaml_reader.h"
@@ -39,13 +40,6 @@
 namespace {
 
 using namespace pixyslam;
-
-long parse_long(const std::string& text, const std::string& what) {
-  char* end = nullptr;
-  const long v = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0') throw std::invalid_argument(what + ": not an integer: '" + text + "'");
-  return v;
-}
 
 std::vector<int> parse_list(const std::string& text) {
   std::vector<int> out;
@@ -56,11 +50,14 @@ std::vector<int> parse_list(const std::string& text) {
     for (char c : item) {
       if (c != '_' && c != ' ') digits += c;  // allow 10_000
     }
-    const long v = parse_long(digits, "--particles");
-    if (v < 1) throw std::invalid_argument("--particles: need values >= 1");
+    char* end = nullptr;
+    const long v = std::strtol(digits.c_str(), &end, 10);
+    if (digits.empty() || *end != '\0' || v < 1) {
+      throw app::UsageError("--particles: '" + item + "' is not an integer >= 1");
+    }
     out.push_back(static_cast<int>(v));
   }
-  if (out.empty()) throw std::invalid_argument("--particles: empty list");
+  if (out.empty()) throw app::UsageError("--particles: empty list");
   return out;
 }
 
@@ -83,56 +80,28 @@ offline::RunInput first_frames(offline::RunInput input, std::size_t frames) {
   return input;
 }
 
-int usage(const char* why) {
-  std::fprintf(stderr,
-               "bench_mrclam_frame: %s\n"
-               "usage: bench_mrclam_frame --dataset DIR --robot N --config FILE --particles M1,M2,... "
-               "[--frames F] [--seed S]\n",
-               why);
-  return 2;
-}
-
-}  // namespace
-
-int main(int argc, char** argv) {
-  std::map<std::string, std::string> args;
-  for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
-      std::printf("usage: bench_mrclam_frame --dataset DIR --robot N --config FILE --particles M1,M2,... "
-                  "[--frames F] [--seed S]\n");
-      return 0;
-    }
-    const std::string key = argv[i];
-    if (key.rfind("--", 0) != 0 || i + 1 >= argc) return usage(("bad argument '" + key + "'").c_str());
-    args[key.substr(2)] = argv[++i];
-  }
-  for (const char* required : {"dataset", "robot", "config", "particles"}) {
-    if (!args.count(required)) return usage((std::string("missing --") + required).c_str());
-  }
-  for (const auto& kv : args) {
-    if (kv.first != "dataset" && kv.first != "robot" && kv.first != "config" && kv.first != "particles" &&
-        kv.first != "frames" && kv.first != "seed") {
-      return usage(("unknown option --" + kv.first).c_str());
-    }
-  }
-  const std::string dataset = args["dataset"];
+int run(int argc, char** argv) {
+  std::string dataset, config_file, particles_text;
+  int robot = 0, frames_limit = -1, seed = 0;
+  app::Cli cli{"bench_mrclam_frame", "Filter speed on real data: one MRCLAM robot through the offline runner per "
+                                     "particle count. Exit 77 when the data set folder is absent."};
+  cli.option("--dataset", dataset, "the MRCLAM data set folder").required().type("DIR");
+  cli.option("--robot", robot, "the robot").required().range(1, 5).type("N");
+  app::add_config(cli, config_file, "filter: and mrclam: options").required();
+  cli.option("--particles", particles_text, "particle counts, one run each").required().type("M1,M2,...");
+  cli.option("--frames", frames_limit, "only the first F camera frames").range(1, 100000000).type("F");
+  cli.option("--seed", seed, "the filter's seed (default: the config's)").range(0, 2147483647).type("S");
+  if (const auto done = cli.parse(argc, argv)) return *done;
   if (!std::filesystem::is_directory(dataset)) {
     std::printf("SKIP: MRCLAM dataset folder %s not found\n", dataset.c_str());
     return 77;
   }
-  try {
-    const int robot = static_cast<int>(parse_long(args["robot"], "--robot"));
-    const std::vector<int> particles = parse_list(args["particles"]);
-    long frames_limit = -1;
-    if (args.count("frames")) {
-      frames_limit = parse_long(args["frames"], "--frames");
-      if (frames_limit < 1) throw std::invalid_argument("--frames: need F >= 1");
-    }
-
-    config::YamlReader root = config::YamlReader::from_file(args["config"]);
+  {
+    const std::vector<int> particles = parse_list(particles_text);
+    config::YamlReader root = config::YamlReader::from_file(config_file);
     config::YamlReader filter_yaml = root.child("filter");
     slam::FilterOptions options = slam::read_filter_options(filter_yaml);
-    if (args.count("seed")) options.seed = static_cast<std::uint64_t>(parse_long(args["seed"], "--seed"));
+    if (cli.given("--seed")) options.seed = static_cast<std::uint64_t>(seed);
     const offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
     root.finish();
 
@@ -146,7 +115,7 @@ int main(int argc, char** argv) {
     for (const auto& s : input.odometry) odometry += s.t_s >= input.start_time_s ? 1 : 0;
 
     std::printf("MRCLAM %s robot %d, config %s, seed %llu: %zu of %zu camera frames%s, %zu odometry samples\n",
-                dataset.c_str(), robot, args["config"].c_str(), static_cast<unsigned long long>(options.seed),
+                dataset.c_str(), robot, config_file.c_str(), static_cast<unsigned long long>(options.seed),
                 frames, frames_all, frames_limit > 0 ? " (--frames)" : " (whole run)", odometry);
     std::printf("%8s %8s %9s %12s %10s %14s %10s %9s\n", "M", "frames", "odometry", "filter_s", "cpu_s",
                 "us_per_frame", "ATE_m", "ratio");
@@ -167,8 +136,11 @@ int main(int argc, char** argv) {
       previous_s = t;
     }
     return 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_mrclam_frame: %s\n", e.what());
-    return 1;
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return app::run_main("bench_mrclam_frame", [&] { return run(argc, argv); });
 }

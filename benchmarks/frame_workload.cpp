@@ -3,27 +3,17 @@
 //     build/benchmarks/frame_workload M K FRAMES
 // Instructions per frame = Ir of the collected part / FRAMES.
 #include <cstdio>
-#include <string>
-#include <cstdlib>
 
 #include "frame_setup.h"
+#include "pixyslam/app/cli.h"
 
 int main(int argc, char** argv) {
-  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
-    std::printf("usage: frame_workload PARTICLES LANDMARKS FRAMES\n");
-    return 0;
-  }
-  if (argc != 4) {
-    std::fprintf(stderr, "usage: frame_workload PARTICLES LANDMARKS FRAMES\n");
-    return 2;
-  }
-  const int m = std::atoi(argv[1]);
-  const int k = std::atoi(argv[2]);
-  const int frames = std::atoi(argv[3]);
-  if (m < 1 || k < 4 || frames < 1) {
-    std::fprintf(stderr, "frame_workload: need PARTICLES >= 1, LANDMARKS >= 4, FRAMES >= 1\n");
-    return 2;
-  }
+  int m = 0, k = 0, frames = 0;
+  pixyslam::app::Cli cli{"frame_workload", "A fixed filter workload for instruction counts under callgrind."};
+  cli.option("particles", m, "M").required().range(1, 1000000).type("PARTICLES");
+  cli.option("landmarks", k, "K (at least 4)").required().range(4, 1000000).type("LANDMARKS");
+  cli.option("frames", frames, "frames to run").required().range(1, 100000000).type("FRAMES");
+  if (const auto done = cli.parse(argc, argv)) return *done;
   pixyslam::bench::FrameWorkload w(m, k);
   for (int i = 0; i < frames; ++i) w.step();
   const auto e = w.filter().pose_estimate();

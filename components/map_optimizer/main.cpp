@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "pixyslam/app/cli.h"
-#include "pixyslam/app/command_line.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/eval/csv_io.h"

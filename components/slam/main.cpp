@@ -11,7 +11,6 @@
 #include <vector>
 
 #include "pixyslam/app/cli.h"
-#include "pixyslam/app/command_line.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/slam/slam_options.h"

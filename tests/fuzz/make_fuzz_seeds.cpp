@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "pixyslam/app/cli.h"
 #include "pixyslam/encoder/arduino_line_parser.h"
 #include "pixyslam/mcap/mcap_reader.h"
 #include "pixyslam/mcap/mcap_writer.h"
@@ -73,12 +74,14 @@ pixyslam::msg::LandmarkObservation observation(std::uint64_t seq) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::cerr << "usage: make_fuzz_seeds CORPUS_DIR CONFIG_DIR\n";
-    return 2;
-  }
-  const fs::path root = argv[1];
-  const fs::path config_dir = argv[2];
+  std::string corpus, configs;
+  pixyslam::app::Cli cli{"make_fuzz_seeds", "Writes the fuzz targets' seed inputs (built from the project's own "
+                                            "encoders and the shipped configs) into CORPUS_DIR."};
+  cli.option("corpus_dir", corpus, "one folder per fuzz target is made in it").required().type("CORPUS_DIR");
+  cli.option("config_dir", configs, "the shipped config/ folder").required().type("CONFIG_DIR");
+  if (const auto done = cli.parse(argc, argv)) return *done;
+  const fs::path root = corpus;
+  const fs::path config_dir = configs;
   using namespace pixyslam;
 
   // Arduino lines (first byte: chunk size).

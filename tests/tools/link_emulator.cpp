@@ -27,6 +27,8 @@
 #include <string>
 #include <vector>
 
+#include "pixyslam/app/cli.h"
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -100,31 +102,16 @@ std::vector<Phase> parse_schedule(const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::string a, b, schedule = "0:0:0";
+  int seed = 1;
+  pixyslam::app::Cli cli{"link_emulator", "Forwards frames between two TAP devices with scheduled loss and delay."};
+  cli.option("--a", a, "one end").required().type("NETNS:DEV");
+  cli.option("--b", b, "the other end").required().type("NETNS:DEV");
+  cli.option("--schedule", schedule, "from T seconds on, drop LOSS of the frames and delay them DELAY_MS")
+      .type("T:LOSS:DELAY_MS,...");
+  cli.option("--seed", seed, "random seed of the losses").range(0, 2147483647).type("S");
+  if (const auto done = cli.parse(argc, argv)) return *done;
   try {
-    std::string a, b, schedule = "0:0:0";
-    unsigned seed = 1;
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      if (arg == "--help" || arg == "-h") {
-        std::printf("usage: link_emulator --a NETNS:DEV --b NETNS:DEV [--schedule T:LOSS:DELAY_MS,...] [--seed S]\n"
-                    "  forwards frames between two TAP devices with scheduled loss and delay\n");
-        return 0;
-      }
-      if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
-      const std::string value = argv[++i];
-      if (arg == "--a") {
-        a = value;
-      } else if (arg == "--b") {
-        b = value;
-      } else if (arg == "--schedule") {
-        schedule = value;
-      } else if (arg == "--seed") {
-        seed = static_cast<unsigned>(std::stoul(value));
-      } else {
-        throw std::invalid_argument("unknown option '" + arg + "'");
-      }
-    }
-    if (a.empty() || b.empty()) throw std::invalid_argument("usage: link_emulator --a NETNS:DEV --b NETNS:DEV ...");
     std::vector<Phase> phases = parse_schedule(schedule);
     const auto [netns_a, dev_a] = split_endpoint(a);
     const auto [netns_b, dev_b] = split_endpoint(b);
@@ -134,7 +121,7 @@ int main(int argc, char** argv) {
     std::printf("ready\n");
     std::fflush(stdout);
 
-    std::mt19937_64 rng(seed);
+    std::mt19937_64 rng(static_cast<unsigned>(seed));
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
     std::deque<Frame> queues[2];  // queues[d]: frames read from fds[d], to write to fds[1 - d]
     std::vector<std::uint8_t> buffer(65536);

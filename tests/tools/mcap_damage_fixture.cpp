@@ -13,13 +13,14 @@
 // Exit 0, or 1 with a message on stderr.
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <fstream>
 #include <iterator>
 #include <string>
 #include <vector>
 
+#include "pixyslam/app/cli.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/dds/topics.h"
 #include "pixyslam/mcap/mcap_reader.h"
 #include "pixyslam/mcap/mcap_writer.h"
@@ -134,22 +135,12 @@ int run(const std::string& dir, int count) {
 }  // namespace pixyslam
 
 int main(int argc, char** argv) {
-  constexpr const char* kUsage =
-      "usage: mcap_damage_fixture DIR [MESSAGES]\n"
-      "  writes closed, not closed and damaged MCAP files of MESSAGES odometry samples\n"
-      "  (default 4436) into DIR, and DIR/expected.cmake with their offsets and counts\n";
-  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
-    std::fputs(kUsage, stdout);
-    return 0;
-  }
-  if (argc < 2 || argc > 3 || argv[1][0] == '-') {
-    std::fputs(kUsage, stderr);
-    return 2;
-  }
-  try {
-    return pixyslam::run(argv[1], argc == 3 ? std::atoi(argv[2]) : 4436);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mcap_damage_fixture: %s\n", e.what());
-    return 1;
-  }
+  std::string dir;
+  int messages = 4436;
+  pixyslam::app::Cli cli{"mcap_damage_fixture", "Writes closed, not closed and damaged MCAP files of MESSAGES odometry "
+                                                "samples into DIR, and DIR/expected.cmake with their offsets and counts."};
+  cli.option("dir", dir, "the output folder").required().type("DIR");
+  cli.option("messages", messages, "odometry samples per file (default 4436)").range(1, 10000000).type("MESSAGES");
+  if (const auto done = cli.parse(argc, argv)) return *done;
+  return pixyslam::app::run_main("mcap_damage_fixture", [&] { return pixyslam::run(dir, messages); });
 }

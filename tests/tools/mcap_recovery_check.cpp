@@ -14,7 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/cli.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/log_tool/sequence_check.h"
 #include "pixyslam/mcap/mcap_reader.h"
 
@@ -22,16 +23,20 @@ namespace pixyslam {
 namespace {
 
 int run(int argc, char** argv) {
-  constexpr const char* kUsage =
-      "usage: mcap_recovery_check FILE --topic T [--sent S --max-loss L] [--expect-footer 0|1]\n";
-  if (const std::optional<int> exit = app::usage_exit({argv + 1, argv + argc}, kUsage)) return *exit;
-  if (argv[1][0] == '-') {
-    std::fputs(kUsage, stderr);
-    return 2;
-  }
-  const std::string path = argv[1];
-  const app::CommandLine args(argc - 1, argv + 1, {"topic", "sent", "max-loss", "expect-footer"});
-  const std::string topic = args.get("topic");
+  std::string path, topic, expect_footer;
+  double sent = 0.0, max_loss = 0.0;
+  app::Cli cli{"mcap_recovery_check", "Checks one topic of an MCAP file left by a killed logger: seq 1..K in order, "
+                                      "no chunk rejected; exit 0 when every check passes, 1 otherwise."};
+  cli.option("file", path, "the MCAP file").required().existing_file().type("FILE");
+  cli.option("--topic", topic, "the topic to check").required().type("T");
+  app::Cli::Option& sent_option =
+      cli.option("--sent", sent, "messages published before the writer died").non_negative().type("S");
+  app::Cli::Option& loss_option =
+      cli.option("--max-loss", max_loss, "what the open chunk and the queue may hold").non_negative().type("L");
+  sent_option.needs(loss_option);
+  loss_option.needs(sent_option);
+  cli.option("--expect-footer", expect_footer, "whether the file must end with a footer").choices({"0", "1"});
+  if (const auto done = cli.parse(argc, argv)) return *done;
   const mcap::McapReader reader(path);
   const mcap::McapRecovery& r = reader.recovery();
   std::printf("file %s: %llu bytes, valid %llu, ignored at end %llu\n", path.c_str(),
@@ -51,7 +56,7 @@ int run(int argc, char** argv) {
   };
   if (!r.header_present) fail("no Header");
   if (r.rejected_chunks != 0) fail(std::to_string(r.rejected_chunks) + " chunk(s) rejected");
-  if (args.has("expect-footer") && (args.get("expect-footer") == "1") != r.footer_present) {
+  if (cli.given("--expect-footer") && (expect_footer == "1") != r.footer_present) {
     fail(std::string("footer ") + (r.footer_present ? "present" : "missing"));
   }
   std::uint64_t in_chunks = 0;
@@ -83,14 +88,12 @@ int run(int argc, char** argv) {
   if (!seq.complete() || seq.backwards != 0) fail(topic + ": not seq 1..K in order");
   const std::uint64_t recovered = seqs.size();
   std::printf("recovered %s %llu\n", topic.c_str(), static_cast<unsigned long long>(recovered));
-  if (args.has("sent")) {
-    const auto sent = static_cast<std::uint64_t>(args.number("sent", 0));
-    const auto max_loss = static_cast<std::uint64_t>(args.number("max-loss", 0));
+  if (cli.given("--sent")) {
     std::printf("sent before the kill %llu, recovered %llu, lost %lld (bound %llu)\n",
                 static_cast<unsigned long long>(sent), static_cast<unsigned long long>(recovered),
                 static_cast<long long>(sent) - static_cast<long long>(recovered),
                 static_cast<unsigned long long>(max_loss));
-    if (recovered + max_loss < sent) fail("lost more than the bound");
+    if (static_cast<double>(recovered) + max_loss < sent) fail("lost more than the bound");
     if (recovered == 0) fail("nothing recovered");
   }
   std::printf("%s\n", ok ? "OK" : "FAILED");
@@ -101,13 +104,5 @@ int run(int argc, char** argv) {
 }  // namespace pixyslam
 
 int main(int argc, char** argv) {
-  try {
-    return pixyslam::run(argc, argv);
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "mcap_recovery_check: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mcap_recovery_check: %s\n", e.what());
-    return 1;
-  }
+  return pixyslam::app::run_main("mcap_recovery_check", [&] { return pixyslam::run(argc, argv); });
 }

@@ -6,16 +6,19 @@
 // "progress N" (rounds published) every 10 rounds, line-buffered, so that a
 // test knows how far it got; then waits for the readers' acknowledgments and
 // prints "published TOPIC N" per topic. Exit status: 0 when everything was
-// published and acknowledged, 3 when not (e.g. the reader was killed), 1 on
+// published and acknowledged, 1 when not (e.g. the reader was killed) or on
 // DDS errors, 2 on usage errors. SIGINT/SIGTERM end the run early.
 #include <chrono>
 #include <cstdio>
 #include <exception>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <thread>
+#include <vector>
 
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/cli.h"
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/dds/endpoints.h"
 
@@ -115,34 +118,24 @@ msg::OptimisedMap optimised_map(std::uint64_t i) {
 }
 
 int run(int argc, char** argv) {
-  constexpr const char* kUsage =
-      "usage: mcap_sample_publisher --profiles FILE --domain D --count N [--rate HZ] [--topics all|odometry] "
-      "[--wait-readers S]";
   dds::DdsOptions options;
-  std::uint64_t count = 0;
+  int count = 0;
   double rate_hz = 500.0;
-  bool all_topics = true;
+  std::string topics = "all";
   double wait_s = 20.0;
-  try {
-    const app::CommandLine args(argc, argv, {"profiles", "domain", "count", "rate", "topics", "wait-readers"});
-    if (args.help()) {
-      std::puts(kUsage);
-      return 0;
-    }
-    options.profiles_file = args.get("profiles");
-    options.domain_id = static_cast<int>(args.number("domain", 0));
-    options.robot_id = "sample_publisher";
-    count = static_cast<std::uint64_t>(args.number("count", 0));
-    rate_hz = args.number("rate", rate_hz);
-    const std::string topics = args.get("topics", "all");
-    if (topics != "all" && topics != "odometry") throw std::invalid_argument("--topics: all or odometry");
-    all_topics = topics == "all";
-    wait_s = args.number("wait-readers", wait_s);
-    if (count == 0 || rate_hz <= 0.0) throw std::invalid_argument("--count and --rate must be positive");
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "mcap_sample_publisher: %s\n%s\n", e.what(), kUsage);
-    return 2;
-  }
+  app::Cli cli{"mcap_sample_publisher", "Publishes N messages of every topic (or Odometry only) for the logger tests."};
+  cli.option("--profiles", options.profiles_file, "the Fast DDS profiles XML").required().existing_file().type("FILE");
+  std::vector<std::string> dds_overrides;
+  app::add_domain(cli, dds_overrides);
+  cli.option("--count", count, "messages per topic").required().range(1, 100000000).type("N");
+  cli.option("--rate", rate_hz, "rounds per second").positive().type("HZ");
+  cli.option("--topics", topics, "every topic, or Odometry only").choices({"all", "odometry"});
+  cli.option("--wait-readers", wait_s, "seconds to wait for the readers").non_negative().type("S");
+  if (const auto done = cli.parse(argc, argv)) return *done;
+  dds::resolve_settings(options, dds_overrides);
+  options.robot_id = "sample_publisher";
+  const auto total = static_cast<std::uint64_t>(count);
+  const bool all_topics = topics == "all";
 
   dds::Participant participant(options, "mcap_sample_publisher");
   dds::Writer<msg::Odometry> odometry_writer(participant);
@@ -173,7 +166,7 @@ int run(int argc, char** argv) {
   const auto period = std::chrono::duration<double>(1.0 / rate_hz);
   bool ok = true;
   std::uint64_t round = 0;
-  for (std::uint64_t i = 1; i <= count && !app::StopSignal::requested(); ++i) {
+  for (std::uint64_t i = 1; i <= total && !app::StopSignal::requested(); ++i) {
     std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(period * static_cast<double>(i - 1)));
     msg::Odometry o = odometry(i);
     ok = odometry_writer.publish(o) && ok;
@@ -188,7 +181,7 @@ int run(int argc, char** argv) {
       ok = optimised_writer->publish(m) && ok;
     }
     round = i;
-    if (i % 10 == 0 || i == count) std::printf("progress %llu\n", static_cast<unsigned long long>(i));
+    if (i % 10 == 0 || i == total) std::printf("progress %llu\n", static_cast<unsigned long long>(i));
   }
   // Stopped early: the reader may be gone, nothing to wait for.
   const auto ack = app::StopSignal::requested() ? std::chrono::seconds(0) : std::chrono::seconds(10);
@@ -209,7 +202,7 @@ int run(int argc, char** argv) {
     std::printf("published %s %llu\n", dds::kOptimisedMapTopic.data(),
                 static_cast<unsigned long long>(optimised_writer->published()));
   }
-  return ok && round == count ? 0 : 3;
+  return ok && round == total ? 0 : 1;
 }
 
 }  // namespace
@@ -218,10 +211,5 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   pixyslam::app::StopSignal::install();
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  try {
-    return pixyslam::run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mcap_sample_publisher: %s\n", e.what());
-    return 1;
-  }
+  return pixyslam::app::run_main("mcap_sample_publisher", [&] { return pixyslam::run(argc, argv); });
 }

@@ -16,45 +16,28 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "pixyslam/app/cli.h"
 #include "pixyslam/pixy/pixy_block_parser.h"
 #include "pixyslam/serial/pseudo_terminal.h"
-
-namespace {
-
-constexpr const char* kUsage =
-    "usage: pixy_flood LINK sync|frames RATE SECONDS [START_DELAY_S]\n"
-    "  plays a hostile Pixy on a pty linked at LINK: the sync word at RATE bytes/s\n"
-    "  (sync) or valid one-block frames at RATE frames/s (frames) for SECONDS\n";
-
-int usage() {
-  std::fputs(kUsage, stderr);
-  return 2;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   using namespace pixyslam;
   using Clock = std::chrono::steady_clock;
-  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
-    std::fputs(kUsage, stdout);
-    return 0;
-  }
-  if (argc < 5 || argc > 6) return usage();
-  const std::string link = argv[1];
-  const std::string pattern = argv[2];
-  const double rate = std::atof(argv[3]);
-  const double seconds = std::atof(argv[4]);
-  const double delay_s = argc > 5 ? std::atof(argv[5]) : 0.0;
-  if ((pattern != "sync" && pattern != "frames") || !(rate > 0.0) || !(seconds > 0.0) || !(delay_s >= 0.0)) {
-    return usage();
-  }
+  std::string link, pattern;
+  double rate = 0.0, seconds = 0.0, delay_s = 0.0;
+  app::Cli cli{"pixy_flood", "Plays a hostile Pixy on a pty linked at LINK: the sync word at RATE bytes/s (sync) or "
+                             "valid one-block frames at RATE frames/s (frames) for SECONDS."};
+  cli.option("link", link, "the pty's symbolic link").required().type("LINK");
+  cli.option("pattern", pattern, "what to write").required().choices({"sync", "frames"});
+  cli.option("rate", rate, "bytes/s (sync) or frames/s (frames)").required().positive().type("RATE");
+  cli.option("seconds", seconds, "how long").required().positive().type("SECONDS");
+  cli.option("start_delay", delay_s, "seconds before the first byte (default 0)").non_negative().type("START_DELAY_S");
+  if (const auto done = cli.parse(argc, argv)) return *done;
   try {
     // One write's bytes and how many of them a second.
     std::vector<std::uint8_t> unit;

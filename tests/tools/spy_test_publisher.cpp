@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <exception>
 
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/cli.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
@@ -18,24 +18,25 @@ namespace pixyslam {
 namespace {
 
 int run(int argc, char** argv) {
-    const app::CommandLine args(argc, argv, {"config", "rate-hz", "map-states"});
-    if (args.help()) {
-      std::printf("usage: spy_test_publisher --config FILE [--rate-hz HZ] [--map-states N]\n"
-                  "  --map-states N  first publish N MapStates (seq 1..N, transient local: kept for late readers)\n");
-      return 0;
-    }
-    const std::string file = args.get("config");
+    std::string file;
+    double rate_hz = 20.0;
+    int map_states = 0;
+    app::Cli cli{"spy_test_publisher", "Publishes Odometry whose values follow from header.seq (tests/spy_echo_test.sh)."};
+    app::add_config(cli, file, "a YAML with a dds: mapping").required();
+    cli.option("--rate-hz", rate_hz, "Odometry samples per second").positive().type("HZ");
+    cli.option("--map-states", map_states, "first publish N MapStates (seq 1..N, transient local: kept for late readers)")
+        .range(0, 100000)
+        .type("N");
+    if (const auto done = cli.parse(argc, argv)) return *done;
     config::YamlReader root = config::YamlReader::from_file(file);
     config::YamlReader dds_yaml = root.child("dds");
-    dds::DdsOptions options = dds::read_dds_options(dds_yaml, app::folder_of(file));
+    dds::DdsOptions options = dds::read_dds_options(dds_yaml, config::folder_of(file));
     dds::resolve_settings(options);
-    const double rate_hz = args.number("rate-hz", 20.0);
 
     dds::Participant participant(options, "spy_test_publisher");
     dds::Writer<msg::Odometry> writer(participant);
     dds::Writer<msg::MapState> maps(participant);
-    const auto map_states = static_cast<std::uint64_t>(args.number("map-states", 0.0));
-    for (std::uint64_t n = 1; n <= map_states; ++n) {
+    for (std::uint64_t n = 1; n <= static_cast<std::uint64_t>(map_states); ++n) {
       msg::MapState m;
       m.header().stamp_ns(1000000000000000000ull + n);
       m.header().frame_id("map");

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "pixyslam/app/cli.h"
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/robot_sim/robot_sim_node.h"
@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
   if (const auto done = cli.parse(argc, argv)) return *done;
   robot_sim::RobotSimProcessConfig c;
   if (const auto failed = app::configure("robot_sim", [&] {
-        const std::string folder = app::folder_of(config);
+        const std::string folder = config::folder_of(config);
         c = robot_sim::read_robot_sim_process_config(
             config, cli.given("--pixy-config") ? pixy_config : folder + "/pixy_bridge.yaml",
             cli.given("--encoder-config") ? encoder_config : folder + "/encoder_bridge.yaml");

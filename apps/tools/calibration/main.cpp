@@ -29,7 +29,6 @@
 #include <vector>
 
 #include "pixyslam/app/cli.h"
-#include "pixyslam/app/command_line.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/mrclam/mrclam_dataset.h"
 #include "pixyslam/offline/offline_run.h"
@@ -115,7 +114,7 @@ std::vector<calibration::PoleSample> camera_samples(const Flags& args, config::Y
     detector = camera::read_camera_source_options(section, pixy.camera.image_width_px, pixy.camera.image_height_px)
                    .detector;
   }
-  const auto images = calibration::parse_pole_images(read_file(source), source, app::folder_of(source));
+  const auto images = calibration::parse_pole_images(read_file(source), source, config::folder_of(source));
   return calibration::pole_samples_from_images(images, detector, pixy.camera, source);
 #else
   (void)root;

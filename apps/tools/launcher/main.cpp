@@ -33,7 +33,6 @@
 #include "pixyslam/launcher/health_monitor.h"
 #include "pixyslam/launcher/launch_plan.h"
 #include "pixyslam/app/cli.h"
-#include "pixyslam/app/command_line.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/launcher/process_group.h"
@@ -215,7 +214,7 @@ int run(const LaunchCommandLine& args, const std::map<std::string, std::string>&
   const std::string run_dir = args.run_dir.empty() ? default_run_dir() : args.run_dir;
   const std::string bin_dir = own_folder();
   std::map<std::string, std::string> variables{
-      {"config_dir", std::filesystem::absolute(app::folder_of(launch_file)).string()},
+      {"config_dir", std::filesystem::absolute(config::folder_of(launch_file)).string()},
       {"bin_dir", bin_dir},
       {"run_dir", std::filesystem::absolute(run_dir).string()}};
   if (!args.input.empty()) variables["input"] = std::filesystem::absolute(args.input).string();

@@ -27,7 +27,6 @@
 
 #include "pixyslam/log_tool/log_commands.h"
 #include "pixyslam/app/cli.h"
-#include "pixyslam/app/command_line.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"

@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   app::Cli cli{"pixyslam_play", "Replays MCAP logs written by the logger onto DDS, with the recorded timing."};
   cli.option("logs", o.files, "the MCAP files, played in the order given (a rotated log: LOG_000.mcap LOG_001.mcap ...)")
       .required()
+      .existing_file()
       .type("LOG.mcap");
   cli.option("--rate", o.playback.rate, "playback speed factor (1: the recorded timing)").type("R");
   cli.option("--start", o.playback.start_offset_s, "skip the first S seconds of the log").type("S");
@@ -54,7 +55,6 @@ int main(int argc, char** argv) {
           if (o.topics.empty()) throw std::invalid_argument("--topics needs at least one topic");
         }
         if (quiet) o.progress_period_s = 0.0;
-        app::require_files(o.files);
         player::validate(o.playback);
         o.dds = dds::read_dds_options_file(dds_config, PIXYSLAM_DEFAULT_PROFILES_FILE);
         dds::resolve_settings(o.dds, dds_overrides);

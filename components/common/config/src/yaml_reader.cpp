@@ -125,6 +125,12 @@ YamlReader parse(const std::string& origin, const Load& load) {
 
 }  // namespace
 
+std::string folder_of(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
 std::string read_config_text(const std::string& path, std::size_t max_bytes) {
   // stat() first: a directory, FIFO or device is never opened (opening a FIFO
   // would wait for a writer); fstat() of the open file closes the race.

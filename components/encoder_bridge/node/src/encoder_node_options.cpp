@@ -1,6 +1,6 @@
 #include "pixyslam/encoder_node/encoder_node_options.h"
 
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/config/yaml_reader.h"
 
 namespace pixyslam::encoder_node {
 
@@ -24,7 +24,7 @@ EncoderNodeOptions read_encoder_node_options(config::YamlReader& root, const std
 
 EncoderNodeOptions read_encoder_node_options_file(const std::string& path) {
   config::YamlReader root = config::YamlReader::from_file(path);
-  return read_encoder_node_options(root, app::folder_of(path));
+  return read_encoder_node_options(root, config::folder_of(path));
 }
 
 std::string to_yaml(const EncoderNodeOptions& o) {

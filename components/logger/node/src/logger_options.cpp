@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/dds/topic_selection.h"
@@ -126,7 +126,7 @@ LoggerOptions read_logger_options(config::YamlReader& root, const std::string& c
 
 LoggerOptions read_logger_options_file(const std::string& path) {
   config::YamlReader root = config::YamlReader::from_file(path);
-  return read_logger_options(root, app::folder_of(path));
+  return read_logger_options(root, config::folder_of(path));
 }
 
 std::string to_yaml(const LoggerOptions& o) {

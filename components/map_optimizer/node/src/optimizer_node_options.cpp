@@ -1,6 +1,5 @@
 #include <cmath>
 
-#include "pixyslam/app/command_line.h"
 #include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/map_optimizer_node/optimizer_node.h"
@@ -55,7 +54,7 @@ OptimizerNodeOptions read_optimizer_node_options_file(const std::string& path) {
   config::YamlReader root = config::YamlReader::from_file(path);
   OptimizerNodeOptions o;
   std::string filter_config = root.text("filter_config");
-  if (!filter_config.empty() && filter_config.front() != '/') filter_config = app::folder_of(path) + "/" + filter_config;
+  if (!filter_config.empty() && filter_config.front() != '/') filter_config = config::folder_of(path) + "/" + filter_config;
   // The estimator's own reader: the same keys, checks and defaults as the filter's.
   const slam_node::EstimatorOptions estimator = slam_node::read_estimator_options_file(filter_config);
   o.optimizer = map_optimizer::MapOptimizerOptions::from_filter(estimator.filter);
@@ -71,7 +70,7 @@ OptimizerNodeOptions read_optimizer_node_options_file(const std::string& path) {
 
   if (root.has("dds")) {
     config::YamlReader dds = root.child("dds");
-    o.dds = dds::read_dds_options(dds, app::folder_of(path));
+    o.dds = dds::read_dds_options(dds, config::folder_of(path));
   } else {
     o.dds = estimator.dds;  // the estimator's domain and profiles
   }

@@ -2,7 +2,7 @@
 
 #include <sstream>
 
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/serial/serial_port.h"
 
 namespace pixyslam::pixy_node {
@@ -56,7 +56,7 @@ PixyNodeOptions read_pixy_node_options(config::YamlReader& root, const std::stri
 
 PixyNodeOptions read_pixy_node_options_file(const std::string& path, const CameraSectionReader& read_camera) {
   config::YamlReader root = config::YamlReader::from_file(path);
-  return read_pixy_node_options(root, app::folder_of(path), read_camera);
+  return read_pixy_node_options(root, config::folder_of(path), read_camera);
 }
 
 std::string to_yaml(const PixyNodeOptions& o) {

@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include "pixyslam/app/command_line.h"
 #include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/slam/slam_options_yaml.h"
@@ -81,12 +80,12 @@ EstimatorOptions read_estimator_options_file(const std::string& path) {
   config::YamlReader estimator = root.child("estimator");
   config::read_parameters(estimator, estimator_parameters(), o);
   CheckpointOptions& k = o.checkpoint;
-  if (!k.file.empty() && k.file.front() != '/') k.file = app::folder_of(path) + "/" + k.file;
+  if (!k.file.empty() && k.file.front() != '/') k.file = config::folder_of(path) + "/" + k.file;
   estimator.finish();
 
   if (root.has("dds")) {
     config::YamlReader dds = root.child("dds");
-    o.dds = dds::read_dds_options(dds, app::folder_of(path));
+    o.dds = dds::read_dds_options(dds, config::folder_of(path));
   }
   root.finish();
   return o;

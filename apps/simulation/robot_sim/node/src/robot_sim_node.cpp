@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <thread>
 
-#include "pixyslam/app/command_line.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/dds/endpoints.h"
@@ -49,7 +48,7 @@ RobotSimProcessConfig read_robot_sim_process_config(const std::string& sim_yaml,
   run.finish();
   if (root.has("dds")) {
     config::YamlReader dds = root.child("dds");
-    c.dds = dds::read_dds_options(dds, app::folder_of(sim_yaml));
+    c.dds = dds::read_dds_options(dds, config::folder_of(sim_yaml));
   }
   root.finish();
   return c;

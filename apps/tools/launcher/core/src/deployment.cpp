@@ -6,7 +6,6 @@
 #include <set>
 #include <stdexcept>
 
-#include "pixyslam/app/command_line.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/dds/dds_options.h"
 
@@ -54,7 +53,7 @@ Deployment read_deployment(const std::string& path) {
   d.security_dir = y.text("security_dir", "");
   d.type_information = y.choice("type_information", {"auto", "true", "false"}, d.type_information);
   if (!d.security_dir.empty() && d.security_dir.front() != '/') {
-    d.security_dir = app::folder_of(path) + "/" + d.security_dir;
+    d.security_dir = config::folder_of(path) + "/" + d.security_dir;
   }
   config::YamlReader hosts = y.child("hosts");
   std::set<std::string> processes;

@@ -3,7 +3,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/parameters_yaml.h"
 
 namespace pixyslam::map_view {
@@ -46,7 +46,7 @@ MapViewOptions read_map_view_options(config::YamlReader& root, const std::string
 
 MapViewOptions read_map_view_options_file(const std::string& path, const std::string& default_profiles_file) {
   config::YamlReader root = config::YamlReader::from_file(path);
-  return read_map_view_options(root, app::folder_of(path), default_profiles_file);
+  return read_map_view_options(root, config::folder_of(path), default_profiles_file);
 }
 
 std::string to_yaml(const MapViewOptions& o) {

@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,13 @@ class Option;
 }  // namespace CLI
 
 namespace pixyslam::app {
+
+// A command-line mistake (unknown or repeated flag, missing value, not a
+// number): run_main() exits with 2, as for a config error.
+class UsageError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
 
 class Cli {
  public:

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "pixyslam/app/command_line.h"
+#include "pixyslam/app/cli.h"
 #include "pixyslam/config/yaml_reader.h"
 
 namespace pixyslam::app {

@@ -31,6 +31,10 @@ inline constexpr std::size_t kMaxConfigFileBytes = std::size_t{1} << 20;
 // `max_bytes`. Nothing but ConfigError escapes.
 std::string read_config_text(const std::string& path, std::size_t max_bytes = kMaxConfigFileBytes);
 
+// Folder of a file path ("." for a bare file name), for resolving paths that a
+// config file gives relative to itself.
+std::string folder_of(const std::string& path);
+
 // Typed, validated access to one YAML mapping. Every key read is remembered;
 // finish() rejects keys that were never read, so a typo is an error, not a
 // silently ignored setting. Children share the file name and extend the key path.
