@@ -4,7 +4,8 @@
 # `echo --json --count 3` must print exactly those values (every field),
 # `echo` (YAML) one document, `echo` of a topic with a kept history (30
 # MapStates) the newest, `participants` the publisher with its pid and
-# host, `topics` its writer with the QoS of the profile, `hz` a rate.
+# host, `topics` its writer with the QoS of the profile, `hz` a rate; with
+# --json the same facts as JSON lines (parsed with python3's json).
 #   spy_echo_test.sh SPY PUBLISHER CONFIG_DIR
 set -euo pipefail
 spy=$1 publisher=$2 config=$3
@@ -39,6 +40,13 @@ echo "== participants"
 grep -Eq "^spy_test_publisher +[0-9a-f.]+ +$(hostname | cut -c1-15)[^ ]* +$pub_pid +spy_test_publis" \
   "$work/participants.txt" || fail "participants does not show spy_test_publisher with pid $pub_pid"
 
+echo "== participants --json"
+"$spy" participants --config "$cfg" --duration 3 --json | tee "$work/participants.json"
+python3 -c 'import json, sys
+rows = [json.loads(l) for l in open(sys.argv[1])]
+assert any(r["name"] == "spy_test_publisher" and r["pid"] == sys.argv[2] for r in rows), rows' \
+  "$work/participants.json" "$pub_pid" || fail "participants --json does not list spy_test_publisher with pid $pub_pid"
+
 echo "== echo --json --count 3"
 "$spy" echo pixyslam/odometry --config "$cfg" --json --count 3 --duration 20 | tee "$work/echo.json"
 [[ $(wc -l < "$work/echo.json") -eq 3 ]] || fail "expected 3 JSON lines"
@@ -71,6 +79,24 @@ echo "== topics"
 grep -q "^pixyslam/odometry  \[pixyslam::msg::Odometry\]" "$work/topics.txt" || fail "topics: no odometry topic"
 grep -Eq "^  writer +spy_test_publisher \(pid $pub_pid\) +reliable +volatile +history keep_all" "$work/topics.txt" \
   || fail "topics: no writer line of the publisher"
+
+echo "== topics --json"
+"$spy" topics --config "$cfg" --duration 3 --json | tee "$work/topics.json"
+python3 -c 'import json, sys
+rows = [json.loads(l) for l in open(sys.argv[1])]
+odo = [r for r in rows if r["topic"] == "pixyslam/odometry"]
+assert odo and odo[0]["type"] == "pixyslam::msg::Odometry" and odo[0]["writers"] >= 1, rows
+w = [e for e in odo[0]["endpoints"] if e["kind"] == "writer" and "spy_test_publisher" in e["participant"]]
+assert w and w[0]["reliability"] == "reliable" and w[0]["durability"] == "volatile", odo' \
+  "$work/topics.json" || fail "topics --json: no odometry writer of the publisher"
+
+echo "== hz --json"
+"$spy" hz pixyslam/odometry --config "$cfg" --duration 2.5 --json | tee "$work/hz.json"
+python3 -c 'import json, sys
+rows = [json.loads(l) for l in open(sys.argv[1])]
+assert len(rows) >= 2 and "last_second" in rows[0], rows
+assert rows[-1]["topic"] == "pixyslam/odometry" and 5 < rows[-1]["rate_hz"] < 40, rows[-1]' \
+  "$work/hz.json" || fail "hz --json: no per-second line or no rate near 20 Hz"
 
 echo "== hz"
 "$spy" hz pixyslam/odometry --config "$cfg" --duration 2 | tee "$work/hz.txt"

@@ -1,10 +1,10 @@
 // pixyslam_spy: one inspection tool for the live system and its recordings,
 // decoding with the project's own types (no XTypes needed).
-//   pixyslam_spy participants | topics                     [DDS options] [--duration S]
+//   pixyslam_spy participants | topics [--json]            [DDS options] [--duration S]
 //   pixyslam_spy echo TOPIC [--json] [--count N] [--duration S] [DDS options]
-//   pixyslam_spy hz TOPIC [--duration S]                    [DDS options]
-//   pixyslam_spy diagnostics [--duration S]                 [DDS options]
-//   pixyslam_spy info FILE.mcap
+//   pixyslam_spy hz TOPIC [--json] [--duration S]           [DDS options]
+//   pixyslam_spy diagnostics [--json] [--duration S]        [DDS options]
+//   pixyslam_spy info FILE.mcap [--json]
 //   pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]
 //   pixyslam_spy print FILE.mcap [--topic T] [--json]
 //   pixyslam_spy compare A.mcap B.mcap --topic T [--ignore F,...] [--tolerance X]
@@ -92,6 +92,8 @@ int main(int argc, char** argv) {
   cli.footer(std::string(kTopics) + "\nExit status: 0 ok, 1 check failed / too few samples / file unreadable or "
                                     "damaged, 2 command-line or config error.");
   DdsArguments dds_args;
+  bool json = false;  // --json of participants, topics, diagnostics, hz, info
+  const char* json_help = "JSON lines (one object per line) instead of the table";
   double seconds = -1.0;  // -1: the command's default
   auto add_duration = [&](app::Cli& command, const char* default_s) {
     command.option("--duration", seconds, std::string("listen S seconds (default ") + default_s + ")")
@@ -100,12 +102,15 @@ int main(int argc, char** argv) {
   };
   app::Cli& participants = cli.subcommand("participants", "the participants on the domain: process, host, pid");
   add_duration(participants, "4");
+  participants.flag("--json", json, json_help);
   dds_args.add_to(participants);
   app::Cli& topics = cli.subcommand("topics", "the topics on the domain with their types, writers and readers");
   add_duration(topics, "4");
+  topics.flag("--json", json, json_help);
   dds_args.add_to(topics);
   app::Cli& diagnostics = cli.subcommand("diagnostics", "each process's counters (the diagnostics topic)");
   add_duration(diagnostics, "3");
+  diagnostics.flag("--json", json, json_help);
   dds_args.add_to(diagnostics);
 
   log_tool::EchoRequest echo_request;
@@ -120,12 +125,14 @@ int main(int argc, char** argv) {
   std::string hz_topic;
   app::Cli& hz = cli.subcommand("hz", "a topic's rate, updated every second like ros2 topic hz");
   hz.option("topic", hz_topic, "the topic").required().type("TOPIC");
+  hz.flag("--json", json, "a JSON line every second and one for the summary");
   add_duration(hz, "5");
   dds_args.add_to(hz);
 
   std::string info_file;
   app::Cli& info = cli.subcommand("info", "a recording's topics, counts, rates and times");
   info.option("file", info_file, "the MCAP file").required().existing_file().type("FILE.mcap");
+  info.flag("--json", json, "one JSON object instead of the text");
 
   log_tool::CheckRequest check_request;
   app::Cli& check = cli.subcommand("check", "a recording is whole: every sequence 1..N, no damage");
@@ -161,7 +168,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   return app::run_main(PIXYSLAM_TOOL_NAME, [&]() -> int {
-    if (info.chosen()) return log_tool::run_info(info_file, std::cout, std::cerr);
+    if (info.chosen()) return log_tool::run_info(info_file, json, std::cout, std::cerr);
     if (print.chosen()) return log_tool::run_print(print_request, std::cout, std::cerr);
     if (check.chosen()) return log_tool::run_check(check_request, std::cout, std::cerr);
     if (compare.chosen()) {
@@ -172,10 +179,10 @@ int main(int argc, char** argv) {
       return log_tool::run_compare(compare_request, std::cout);
     }
     const dds::DdsOptions options = dds_args.resolve();
-    if (participants.chosen()) return log_tool::run_participants(options, seconds < 0 ? 4.0 : seconds, std::cout);
-    if (topics.chosen()) return log_tool::run_topics(options, seconds < 0 ? 4.0 : seconds, std::cout);
-    if (diagnostics.chosen()) return log_tool::run_diagnostics(options, seconds < 0 ? 3.0 : seconds, std::cout);
-    if (hz.chosen()) return log_tool::run_hz(options, hz_topic, seconds < 0 ? 5.0 : seconds, std::cout);
+    if (participants.chosen()) return log_tool::run_participants(options, seconds < 0 ? 4.0 : seconds, json, std::cout);
+    if (topics.chosen()) return log_tool::run_topics(options, seconds < 0 ? 4.0 : seconds, json, std::cout);
+    if (diagnostics.chosen()) return log_tool::run_diagnostics(options, seconds < 0 ? 3.0 : seconds, json, std::cout);
+    if (hz.chosen()) return log_tool::run_hz(options, hz_topic, seconds < 0 ? 5.0 : seconds, json, std::cout);
     echo_request.count = static_cast<std::size_t>(count);
     echo_request.seconds = seconds < 0 ? 0.0 : seconds;
     return log_tool::run_echo(options, echo_request, std::cout);

@@ -110,8 +110,87 @@ void report_damage(const mcap::McapReader& reader, std::ostream& err, std::size_
 
 }  // namespace
 
-int run_info(const std::string& path, std::ostream& out, std::ostream& err) {
+namespace {
+
+const char* state_name(mcap::McapFileState state) {
+  switch (state) {
+    case mcap::McapFileState::kComplete: return "complete";
+    case mcap::McapFileState::kNotClosed: return "not_closed";
+    case mcap::McapFileState::kDamaged: break;
+  }
+  return "damaged";
+}
+
+// `info --json`: the file's facts as one JSON object.
+Value info_value(const mcap::McapReader& reader, const std::string& path) {
+  const mcap::McapRecovery& rec = reader.recovery();
+  std::map<std::uint16_t, std::uint64_t> count;
+  std::map<std::uint16_t, std::pair<std::uint64_t, std::uint64_t>> span;  // first, last log time
+  for (const mcap::McapMessage& m : reader.messages()) {
+    ++count[m.channel_id];
+    auto [it, inserted] = span.try_emplace(m.channel_id, m.log_time_ns, m.log_time_ns);
+    it->second.first = std::min(it->second.first, m.log_time_ns);
+    it->second.second = std::max(it->second.second, m.log_time_ns);
+  }
+  std::uint64_t first = std::numeric_limits<std::uint64_t>::max(), last = 0;
+  for (const auto& [id, times] : span) {
+    first = std::min(first, times.first);
+    last = std::max(last, times.second);
+  }
+  Value topics = Value::list();
+  for (const mcap::McapChannel& c : reader.channels()) {
+    const mcap::McapSchema* schema = reader.find_schema(c.schema_id);
+    Value topic = Value::structure()
+                      .add("topic", Value::string(c.topic))
+                      .add("messages", Value::unsigned_integer(count[c.id]))
+                      .add("schema", Value::string(schema ? schema->name : ""))
+                      .add("message_encoding", Value::string(c.message_encoding));
+    const auto s = span.find(c.id);
+    if (s != span.end() && s->second.second > s->second.first) {
+      topic.add("rate_hz", Value::number(static_cast<double>(count[c.id] - 1) /
+                                         (static_cast<double>(s->second.second - s->second.first) * 1e-9)));
+    }
+    topics.push(std::move(topic));
+  }
+  std::uint64_t compressed = 0, uncompressed = 0;
+  for (const mcap::McapChunkInfo& c : reader.chunks()) {
+    compressed += c.compressed_size;
+    uncompressed += c.uncompressed_size;
+  }
+  Value info = Value::structure()
+                   .add("file", Value::string(path))
+                   .add("size_bytes", Value::unsigned_integer(rec.file_size))
+                   .add("state", Value::string(state_name(reader.state())))
+                   .add("status", Value::string(status_text(reader)))
+                   .add("messages", Value::unsigned_integer(reader.messages().size()));
+  if (!reader.messages().empty()) {
+    info.add("first_log_time_ns", Value::unsigned_integer(first))
+        .add("last_log_time_ns", Value::unsigned_integer(last))
+        .add("first_utc", Value::string(utc_time(first)))
+        .add("last_utc", Value::string(utc_time(last)));
+  }
+  info.add("chunks", Value::unsigned_integer(reader.chunks().size()))
+      .add("bytes_stored", Value::unsigned_integer(compressed))
+      .add("bytes_uncompressed", Value::unsigned_integer(uncompressed))
+      .add("topics", std::move(topics));
+  if (!reader.clean()) {
+    info.add("valid_bytes", Value::unsigned_integer(rec.valid_bytes))
+        .add("bytes_ignored_at_end", Value::unsigned_integer(rec.bytes_ignored_at_end))
+        .add("diagnostics", Value::unsigned_integer(reader.diagnostics().size()));
+  }
+  return info;
+}
+
+}  // namespace
+
+int run_info(const std::string& path, bool json, std::ostream& out, std::ostream& err) {
   const mcap::McapReader reader(path);
+  if (json) {
+    out << to_json_line(info_value(reader, path)) << "\n";
+    if (reader.state() != mcap::McapFileState::kDamaged) return 0;
+    report_damage(reader, err, 0);
+    return 1;
+  }
   const mcap::McapRecovery& rec = reader.recovery();
   const auto& messages = reader.messages();
 

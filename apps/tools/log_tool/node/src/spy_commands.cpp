@@ -244,13 +244,35 @@ int with_topic_type(const std::string& topic, Function f) {
   return 2;
 }
 
+// mean/min/max/std of a gap statistic in milliseconds.
+Value gap_value(const GapStats& g) {
+  return Value::structure()
+      .add("mean", Value::number(g.mean_s * 1e3))
+      .add("min", Value::number(g.min_s * 1e3))
+      .add("max", Value::number(g.max_s * 1e3))
+      .add("std", Value::number(g.std_s * 1e3));
+}
+
 }  // namespace
 
-int run_participants(const dds::DdsOptions& dds, double seconds, std::ostream& out) {
+int run_participants(const dds::DdsOptions& dds, double seconds, bool json, std::ostream& out) {
   DiscoveryListener listener;
   DiscoveryParticipant participant(dds, listener);
   wait(seconds, [] { return false; });
   const auto participants = listener.participants();
+  if (json) {
+    for (const auto& [prefix, p] : participants) {
+      if (!p.alive) continue;
+      out << to_json_line(Value::structure()
+                              .add("name", Value::string(p.name))
+                              .add("guid_prefix", Value::string(prefix))
+                              .add("host", Value::string(property(p, "pixyslam.host")))
+                              .add("pid", Value::string(property(p, "pixyslam.pid")))
+                              .add("process", Value::string(property(p, "pixyslam.process"))))
+          << "\n";
+    }
+    return 0;
+  }
   std::size_t alive = 0;
   for (const auto& [prefix, p] : participants) alive += p.alive ? 1 : 0;
   out << "participants on domain " << dds.domain_id << ": " << alive << " (discovery for " << seconds << " s)\n";
@@ -264,7 +286,7 @@ int run_participants(const dds::DdsOptions& dds, double seconds, std::ostream& o
   return 0;
 }
 
-int run_topics(const dds::DdsOptions& dds, double seconds, std::ostream& out) {
+int run_topics(const dds::DdsOptions& dds, double seconds, bool json, std::ostream& out) {
   DiscoveryListener listener;
   DiscoveryParticipant participant(dds, listener);
   wait(seconds, [] { return false; });
@@ -274,7 +296,9 @@ int run_topics(const dds::DdsOptions& dds, double seconds, std::ostream& out) {
   for (const auto& [guid, e] : listener.endpoints()) {
     if (e.alive) topics[e.topic][e.type].push_back(e);
   }
-  out << "topics on domain " << dds.domain_id << ": " << topics.size() << " (discovery for " << seconds << " s)\n";
+  if (!json) {
+    out << "topics on domain " << dds.domain_id << ": " << topics.size() << " (discovery for " << seconds << " s)\n";
+  }
   for (auto& [topic, types] : topics) {
     for (auto& [type, endpoints] : types) {
       std::stable_sort(endpoints.begin(), endpoints.end(), [&](const EndpointEntry& a, const EndpointEntry& b) {
@@ -284,6 +308,26 @@ int run_topics(const dds::DdsOptions& dds, double seconds, std::ostream& out) {
       });
       std::size_t writers = 0;
       for (const EndpointEntry& e : endpoints) writers += e.writer ? 1 : 0;
+      if (json) {
+        Value list = Value::list();
+        for (const EndpointEntry& e : endpoints) {
+          list.push(Value::structure()
+                        .add("kind", Value::string(e.writer ? "writer" : "reader"))
+                        .add("participant", Value::string(participant_label(participants, e.participant_prefix)))
+                        .add("reliability", Value::string(e.reliability))
+                        .add("durability", Value::string(e.durability))
+                        .add("history", Value::string(participant.profile_history(topic, e.writer)))
+                        .add("type_information", Value::boolean(e.type_information)));
+        }
+        out << to_json_line(Value::structure()
+                                .add("topic", Value::string(topic))
+                                .add("type", Value::string(type))
+                                .add("writers", Value::unsigned_integer(writers))
+                                .add("readers", Value::unsigned_integer(endpoints.size() - writers))
+                                .add("endpoints", std::move(list)))
+            << "\n";
+        continue;
+      }
       out << topic << "  [" << type << "]  " << writers << " writer(s), " << endpoints.size() - writers
           << " reader(s)\n";
       std::vector<std::vector<std::string>> rows;
@@ -384,7 +428,7 @@ int run_echo(const dds::DdsOptions& options, const EchoRequest& request, std::os
   });
 }
 
-int run_diagnostics(const dds::DdsOptions& options, double seconds, std::ostream& out) {
+int run_diagnostics(const dds::DdsOptions& options, double seconds, bool json, std::ostream& out) {
   std::mutex mutex;
   std::map<std::tuple<std::string, std::string, std::uint32_t>, msg::Diagnostics> latest;
   dds::Participant participant(options, "pixyslam_spy");
@@ -400,11 +444,15 @@ int run_diagnostics(const dds::DdsOptions& options, double seconds, std::ostream
   }
   std::vector<msg::Diagnostics> reports;
   for (const auto& [key, report] : latest) reports.push_back(report);
+  if (json) {
+    for (const msg::Diagnostics& report : reports) out << to_json_line(to_value(report)) << "\n";
+    return 0;
+  }
   out << diagnostics_table(reports);
   return 0;
 }
 
-int run_hz(const dds::DdsOptions& options, const std::string& topic, double seconds, std::ostream& out) {
+int run_hz(const dds::DdsOptions& options, const std::string& topic, double seconds, bool json, std::ostream& out) {
   return with_topic_type(topic, [&](auto tag) {
     using Message = decltype(tag);
     std::mutex mutex;
@@ -435,15 +483,37 @@ int run_hz(const dds::DdsOptions& options, const std::string& topic, double seco
       const GapStats so_far = gap_stats(arrivals_s);
       const std::size_t last_second = arrivals_s.size() - reported;
       reported = arrivals_s.size();
+      const double rate_hz = so_far.messages >= 2 ? so_far.rate_hz : 0.0;
+      if (json) {
+        out << to_json_line(Value::structure()
+                                .add("t_s", Value::number(next_report_s))
+                                .add("last_second", Value::unsigned_integer(last_second))
+                                .add("rate_hz", Value::number(rate_hz)))
+            << "\n" << std::flush;
+        continue;
+      }
       char line[160];
       std::snprintf(line, sizeof(line), "  %4.0f s: %zu messages in the last second, %.3f Hz since the start\n",
-                    next_report_s, last_second, so_far.messages >= 2 ? so_far.rate_hz : 0.0);
+                    next_report_s, last_second, rate_hz);
       out << line << std::flush;
     }
     const double listened_s = std::chrono::duration<double>(Clock::now() - start).count();
     std::lock_guard<std::mutex> lock(mutex);
     const GapStats arrival = gap_stats(arrivals_s);
     const GapStats stamp = gap_stats(stamps_s);  // not sorted: a reordering shows as a negative min
+    if (json) {
+      Value summary = Value::structure()
+                          .add("topic", Value::string(topic))
+                          .add("messages", Value::unsigned_integer(arrival.messages))
+                          .add("listened_s", Value::number(std::round(listened_s * 100) / 100));
+      if (arrival.messages >= 2) {
+        summary.add("rate_hz", Value::number(arrival.rate_hz))
+            .add("arrival_gap_ms", gap_value(arrival))
+            .add("stamp_gap_ms", gap_value(stamp));
+      }
+      out << to_json_line(summary) << "\n";
+      return 0;
+    }
     char line[256];
     out << topic << ": " << arrival.messages << " messages in " << format_double(std::round(listened_s * 100) / 100)
         << " s\n";

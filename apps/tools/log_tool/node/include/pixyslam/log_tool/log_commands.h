@@ -12,8 +12,9 @@ namespace pixyslam::log_tool {
 // status complete, not closed (a writer that did not close it: every record up
 // to the cut intact) or damaged (records, offsets, bytes skipped). Returns the
 // exit status: 0 when complete or not closed, 1 when damaged (then every
-// diagnostic with its byte offset goes to `err`).
-int run_info(const std::string& path, std::ostream& out, std::ostream& err);
+// diagnostic with its byte offset goes to `err`). `json`: the same facts as one
+// JSON object on one line.
+int run_info(const std::string& path, bool json, std::ostream& out, std::ostream& err);
 
 struct CheckRequest {
   std::string path;

@@ -13,13 +13,16 @@ namespace pixyslam::log_tool {
 // through app::StopSignal) and returns the exit status: 0 ok, 1 failure
 // (e.g. fewer samples than --count before the time limit), 2 unknown topic.
 
+// `json`: every command prints JSON lines (one object per line) instead of its
+// table, with the same content.
+
 // Every other DomainParticipant seen within `seconds`: name, GUID prefix and
 // the pixyslam.host / pixyslam.pid / pixyslam.process properties.
-int run_participants(const dds::DdsOptions& dds, double seconds, std::ostream& out);
+int run_participants(const dds::DdsOptions& dds, double seconds, bool json, std::ostream& out);
 
 // Every topic with its type and each writer/reader (participant, reliability,
 // durability; history from the local XML profile: DDS does not announce it).
-int run_topics(const dds::DdsOptions& dds, double seconds, std::ostream& out);
+int run_topics(const dds::DdsOptions& dds, double seconds, bool json, std::ostream& out);
 
 struct EchoRequest {
   std::string topic;
@@ -32,7 +35,7 @@ int run_echo(const dds::DdsOptions& dds, const EchoRequest& request, std::ostrea
 // Message rate and inter-arrival gap statistics over `seconds` (0: until a signal).
 // The latest pixyslam/diagnostics report of every process heard within `seconds`
 // (diagnostics_table); exit status 1 if none.
-int run_diagnostics(const dds::DdsOptions& dds, double seconds, std::ostream& out);
-int run_hz(const dds::DdsOptions& dds, const std::string& topic, double seconds, std::ostream& out);
+int run_diagnostics(const dds::DdsOptions& dds, double seconds, bool json, std::ostream& out);
+int run_hz(const dds::DdsOptions& dds, const std::string& topic, double seconds, bool json, std::ostream& out);
 
 }  // namespace pixyslam::log_tool
