@@ -3,6 +3,7 @@
 //   robot_sim --config config/robot_sim.yaml [--pixy-config config/pixy_bridge.yaml]
 //             [--encoder-config config/encoder_bridge.yaml] [--duration S]
 //             [--arduino-link PATH] [--pixy-link PATH] [--camera-video FIFO] [--domain N]
+//             [--set world.KEY=V,hardware.KEY=V,run.KEY=V,dds.KEY=V ...]
 // The bridge configs default to the files beside --config. Exits 0 when the
 // run's duration is over (or on SIGINT/SIGTERM).
 #include <string>
@@ -19,7 +20,7 @@ int main(int argc, char** argv) {
   app::StopSignal::install();
   std::string config, pixy_config, encoder_config, arduino_link, pixy_link, camera_video;
   double duration_s = 0.0;
-  std::vector<std::string> dds_overrides;
+  std::vector<std::string> dds_overrides, overrides;
   app::Cli cli{"robot_sim",
                "The simulated robot's hardware: Arduino encoder lines and Pixy UART bytes into two pseudo-terminals "
                "(the bridges read them as the real devices), GroundTruth on DDS."};
@@ -35,6 +36,8 @@ int main(int argc, char** argv) {
   cli.option("--pixy-link", pixy_link, "a symlink to the Pixy's pseudo-terminal at PATH").type("PATH");
   cli.option("--camera-video", camera_video, "also write the synthetic camera's frames to FIFO").type("FIFO");
   app::add_domain(cli, dds_overrides);
+  app::add_set(cli, overrides, "world.speed_mps=0.3");
+  cli.footer(robot_sim::help_text());
   if (const auto done = cli.parse(argc, argv)) return *done;
   robot_sim::RobotSimProcessConfig c;
   if (const auto failed = app::configure("robot_sim", [&] {
@@ -46,7 +49,8 @@ int main(int argc, char** argv) {
         if (cli.given("--arduino-link")) c.run.arduino_link = arduino_link;
         if (cli.given("--pixy-link")) c.run.pixy_link = pixy_link;
         if (cli.given("--camera-video")) c.run.camera_video = camera_video;
-        dds::resolve_settings(c.dds, dds_overrides);
+        overrides.insert(overrides.end(), dds_overrides.begin(), dds_overrides.end());  // --domain last: it wins
+        robot_sim::apply_overrides(c, overrides);
       })) {
     return *failed;
   }

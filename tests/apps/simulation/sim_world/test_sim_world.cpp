@@ -3,6 +3,8 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -71,6 +73,31 @@ TEST(SimWorld, BadScriptedWorldsNameTheKey) {
     EXPECT_NE(std::string(e.what()).find("poles[1].id"), std::string::npos) << e.what();
   }
   EXPECT_THROW(read("world:\n  detection_probability: 1.5\n"), config::ConfigError);
+}
+
+TEST(SimWorld, OptionsTableReadsKeysAndOverridesWithOneSetOfRanges) {
+  // A key read through the table and the same key set as an override agree.
+  const WorldOptions from_yaml = read("world:\n  speed_mps: 0.35\n  inner_poles: false\n  seed: 42\n");
+  WorldOptions overridden;
+  parameters::apply_override(overridden, world_parameters(), "world", "world.speed_mps=0.35");
+  parameters::apply_override(overridden, world_parameters(), "world", "world.inner_poles=false");
+  parameters::apply_override(overridden, world_parameters(), "world", "world.seed=42");
+  EXPECT_EQ(from_yaml.speed_mps, overridden.speed_mps);
+  EXPECT_EQ(from_yaml.inner_poles, overridden.inner_poles);
+  EXPECT_EQ(from_yaml.seed, overridden.seed);
+  // The range is the table's in both ways in.
+  EXPECT_THROW(read("world:\n  speed_mps: 6\n"), config::ConfigError);
+  EXPECT_THROW(parameters::apply_override(overridden, world_parameters(), "world", "world.speed_mps=6"),
+               std::invalid_argument);
+  // The rule between two keys names the key.
+  try {
+    read("world:\n  min_range_m: 2\n  max_range_m: 1\n");
+    ADD_FAILURE();
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("max_range_m"), std::string::npos) << e.what();
+  }
+  overridden.max_range_m = overridden.min_range_m;
+  EXPECT_THROW(validate(overridden), parameters::RuleError);
 }
 
 // The range and bearing errors of every sighting, against the true geometry at its frame.

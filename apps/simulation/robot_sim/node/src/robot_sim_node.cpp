@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "pixyslam/app/stop_signal.h"
+#include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/serial/pseudo_terminal.h"
@@ -19,6 +20,44 @@
 
 namespace pixyslam::robot_sim {
 
+const parameters::Table<RunOptions>& run_parameters() {
+  using O = RunOptions;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::real<O>("duration_s", 0.0, 1e6, "s", "hardware time simulated (0: until stopped)",
+                 [](O& o) -> double& { return o.duration_s; }),
+      P::real<O>("power_on_delay_s", 0.0, 60.0, "s", "pseudo-terminals up, hardware silent (the bridges open them)",
+                 [](O& o) -> double& { return o.power_on_delay_s; }),
+      P::text<O>("arduino_link", "symlink to the Arduino's pseudo-terminal", [](O& o) -> std::string& { return o.arduino_link; }),
+      P::text<O>("pixy_link", "symlink to the Pixy's pseudo-terminal", [](O& o) -> std::string& { return o.pixy_link; }),
+      P::real<O>("ground_truth_rate_hz", 0.1, 1000.0, "Hz", "GroundTruth messages per second",
+                 [](O& o) -> double& { return o.ground_truth_rate_hz; }),
+      P::real<O>("tick_s", 0.0005, 0.1, "s", "wall-clock step of the emulation loop", [](O& o) -> double& { return o.tick_s; }),
+      P::real<O>("speed_factor", 0.1, 10.0, "", "hardware seconds per wall second",
+                 [](O& o) -> double& { return o.speed_factor; }),
+      P::real<O>("unplug_at_s", 0.0, 1e6, "s", "fault test: both serial devices vanish at this time (0: never)",
+                 [](O& o) -> double& { return o.unplug_at_s; }),
+      P::real<O>("unplug_for_s", 0.01, 3600.0, "s", "... and come back this much later",
+                 [](O& o) -> double& { return o.unplug_for_s; }),
+      P::text<O>("camera_video", "also write the synthetic camera's frames (YUV4MPEG2) into this FIFO (empty: off)",
+                 [](O& o) -> std::string& { return o.camera_video; }),
+  };
+  return table;
+}
+
+void validate(const RunOptions& o) {
+  parameters::check_ranges(o, run_parameters(), "run");
+  if (o.arduino_link.empty() || o.arduino_link == o.pixy_link) {
+    throw parameters::RuleError("run", "arduino_link", "must be a path different from pixy_link");
+  }
+#ifndef PIXYSLAM_HAS_CAMERA
+  if (!o.camera_video.empty()) {
+    throw parameters::RuleError("run", "camera_video",
+                                "this robot_sim was built without the camera backend (PIXYSLAM_BUILD_CAMERA)");
+  }
+#endif
+}
+
 RobotSimProcessConfig read_robot_sim_process_config(const std::string& sim_yaml,
                                                     const std::string& pixy_yaml,
                                                     const std::string& encoder_yaml) {
@@ -26,25 +65,8 @@ RobotSimProcessConfig read_robot_sim_process_config(const std::string& sim_yaml,
   config::YamlReader root = config::YamlReader::from_file(sim_yaml);
   c.sim = read_robot_sim_config(root, pixy_yaml, encoder_yaml);
   config::YamlReader run = root.child("run");
-  RunOptions& r = c.run;
-  r.duration_s = run.number("duration_s", 0.0, 1e6, r.duration_s);
-  r.power_on_delay_s = run.number("power_on_delay_s", 0.0, 60.0, r.power_on_delay_s);
-  r.arduino_link = run.text("arduino_link", r.arduino_link);
-  r.pixy_link = run.text("pixy_link", r.pixy_link);
-  if (r.arduino_link.empty() || r.arduino_link == r.pixy_link) {
-    run.fail("arduino_link", "must be a path different from pixy_link");
-  }
-  r.ground_truth_rate_hz = run.number("ground_truth_rate_hz", 0.1, 1000.0, r.ground_truth_rate_hz);
-  r.tick_s = run.number("tick_s", 0.0005, 0.1, r.tick_s);
-  r.speed_factor = run.number("speed_factor", 0.1, 10.0, r.speed_factor);
-  r.unplug_at_s = run.number("unplug_at_s", 0.0, 1e6, r.unplug_at_s);
-  r.unplug_for_s = run.number("unplug_for_s", 0.01, 3600.0, r.unplug_for_s);
-  r.camera_video = run.text("camera_video", r.camera_video);
-#ifndef PIXYSLAM_HAS_CAMERA
-  if (!r.camera_video.empty()) {
-    run.fail("camera_video", "this robot_sim was built without the camera backend (PIXYSLAM_BUILD_CAMERA)");
-  }
-#endif
+  config::read_parameters(run, run_parameters(), c.run);
+  config::check_rules(run, [&] { validate(c.run); });
   run.finish();
   if (root.has("dds")) {
     config::YamlReader dds = root.child("dds");
@@ -52,6 +74,31 @@ RobotSimProcessConfig read_robot_sim_process_config(const std::string& sim_yaml,
   }
   root.finish();
   return c;
+}
+
+void apply_overrides(RobotSimProcessConfig& c, const std::vector<std::string>& assignments) {
+  std::vector<std::string> rest = assignments;
+  for (const std::string& a : parameters::take_section(rest, "world")) {
+    parameters::apply_override(c.sim.world, sim::world_parameters(), "world", a);
+  }
+  sim::validate(c.sim.world);
+  for (const std::string& a : parameters::take_section(rest, "hardware")) {
+    parameters::apply_override(c.sim.hardware, hardware_parameters(), "hardware", a);
+  }
+  validate(c.sim.hardware);
+  for (const std::string& a : parameters::take_section(rest, "run")) {
+    parameters::apply_override(c.run, run_parameters(), "run", a);
+  }
+  validate(c.run);
+  dds::resolve_settings(c.dds, rest);  // dds.KEY=V; anything else is an error there
+}
+
+std::string help_text() {
+  return "world (world:):\n" + parameters::help_text(sim::world_parameters(), "world") +
+         "hardware (hardware:):\n" + parameters::help_text(hardware_parameters(), "hardware") +
+         "the process (run:):\n" + parameters::help_text(run_parameters(), "run") +
+         "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
+         parameters::help_text(dds::dds_parameters(), "dds");
 }
 
 struct RobotSimNode::Impl {

@@ -3,38 +3,71 @@
 #include <cmath>
 #include <random>
 
+#include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/slam/motion_model.h"
 #include "pixyslam/slam/observation_model.h"
 
 namespace pixyslam::sim {
 
+const parameters::Table<WorldOptions>& world_parameters() {
+  using O = WorldOptions;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::integer<O, std::uint64_t>("seed", 0, std::uint64_t{1} << 53, "", "odometry and camera noise; same seed = same run",
+                                   [](O& o) -> std::uint64_t& { return o.seed; }),
+      P::real<O>("duration_s", 1.0, 1e6, "s", "simulated time", [](O& o) -> double& { return o.duration_s; }),
+      P::real<O>("length_m", 0.0, 1000.0, "m", "the loop's long sides", [](O& o) -> double& { return o.length_m; }),
+      P::real<O>("width_m", 0.0, 1000.0, "m", "the loop's short sides", [](O& o) -> double& { return o.width_m; }),
+      P::real<O>("corner_radius_m", 0.05, 100.0, "m", "quarter circles joining the sides",
+                 [](O& o) -> double& { return o.corner_radius_m; }),
+      P::real<O>("speed_mps", 0.01, 5.0, "m/s", "driving speed", [](O& o) -> double& { return o.speed_mps; }),
+      P::integer<O, int>("poles_per_long_side", 0, 100, "", "poles beside each long side",
+                         [](O& o) -> int& { return o.poles_per_long_side; }),
+      P::integer<O, int>("poles_per_short_side", 0, 100, "", "poles beside each short side",
+                         [](O& o) -> int& { return o.poles_per_short_side; }),
+      P::real<O>("pole_offset_m", 0.05, 100.0, "m", "poles' distance from the path",
+                 [](O& o) -> double& { return o.pole_offset_m; }),
+      P::boolean<O>("inner_poles", "as many poles inside the loop", [](O& o) -> bool& { return o.inner_poles; }),
+      P::integer<O, int>("first_landmark_id", 0, 1000000, "", "id of the first generated pole",
+                         [](O& o) -> int& { return o.first_landmark_id; }),
+      P::real<O>("odometry_rate_hz", 0.1, 1000.0, "Hz", "odometry samples per second",
+                 [](O& o) -> double& { return o.odometry_rate_hz; }),
+      P::real<O>("camera_rate_hz", 0.1, 100.0, "Hz", "camera frames per second",
+                 [](O& o) -> double& { return o.camera_rate_hz; }),
+      P::real<O>("v_sigma_mps", 0.0, 10.0, "m/s", "odometry speed noise per sample",
+                 [](O& o) -> double& { return o.v_sigma_mps; }),
+      P::real<O>("w_sigma_radps", 0.0, 10.0, "rad/s", "odometry turn-rate noise per sample",
+                 [](O& o) -> double& { return o.w_sigma_radps; }),
+      P::real<O>("range_sigma_m", 0.0, 10.0, "m", "camera range noise", [](O& o) -> double& { return o.range_sigma_m; }),
+      P::real<O>("bearing_sigma_rad", 0.0, 1.0, "rad", "camera bearing noise",
+                 [](O& o) -> double& { return o.bearing_sigma_rad; }),
+      P::real<O>("range_bias_m", -10.0, 10.0, "m", "constant range error", [](O& o) -> double& { return o.range_bias_m; }),
+      P::real<O>("error_correlation_s", 0.0, 1e4, "s",
+                 "per pole range and bearing errors persist with this time constant (0: white)",
+                 [](O& o) -> double& { return o.error_correlation_s; }),
+      P::real<O>("odometry_lead_s", 0.0, 10.0, "s", "odometry stamped this long before the motion it reports",
+                 [](O& o) -> double& { return o.odometry_lead_s; }),
+      P::real<O>("field_of_view_rad", 0.01, 2.0 * M_PI, "rad", "the camera's horizontal field of view",
+                 [](O& o) -> double& { return o.field_of_view_rad; }),
+      P::real<O>("min_range_m", 0.0, 100.0, "m", "the camera sees poles from here", [](O& o) -> double& { return o.min_range_m; }),
+      P::real<O>("max_range_m", 0.01, 1000.0, "m", "... to here", [](O& o) -> double& { return o.max_range_m; }),
+      P::real<O>("detection_probability", 0.0, 1.0, "", "chance that a pole in view is reported",
+                 [](O& o) -> double& { return o.detection_probability; }),
+  };
+  return table;
+}
+
+void validate(const WorldOptions& o) {
+  parameters::check_ranges(o, world_parameters(), "world");
+  if (o.max_range_m <= o.min_range_m) {
+    throw parameters::RuleError("world", "max_range_m", "must be greater than min_range_m");
+  }
+}
+
 WorldOptions read_world_options(config::YamlReader& w) {
   WorldOptions o;
-  o.seed = static_cast<std::uint64_t>(w.integer("seed", 0, INT64_MAX, static_cast<std::int64_t>(o.seed)));
-  o.duration_s = w.number("duration_s", 1.0, 1e6, o.duration_s);
-  o.length_m = w.number("length_m", 0.0, 1000.0, o.length_m);
-  o.width_m = w.number("width_m", 0.0, 1000.0, o.width_m);
-  o.corner_radius_m = w.number("corner_radius_m", 0.05, 100.0, o.corner_radius_m);
-  o.speed_mps = w.number("speed_mps", 0.01, 5.0, o.speed_mps);
-  o.poles_per_long_side = static_cast<int>(w.integer("poles_per_long_side", 0, 100, o.poles_per_long_side));
-  o.poles_per_short_side = static_cast<int>(w.integer("poles_per_short_side", 0, 100, o.poles_per_short_side));
-  o.pole_offset_m = w.number("pole_offset_m", 0.05, 100.0, o.pole_offset_m);
-  o.inner_poles = w.boolean("inner_poles", o.inner_poles);
-  o.first_landmark_id = static_cast<int>(w.integer("first_landmark_id", 0, 1000000, o.first_landmark_id));
-  o.odometry_rate_hz = w.number("odometry_rate_hz", 0.1, 1000.0, o.odometry_rate_hz);
-  o.camera_rate_hz = w.number("camera_rate_hz", 0.1, 100.0, o.camera_rate_hz);
-  o.v_sigma_mps = w.number("v_sigma_mps", 0.0, 10.0, o.v_sigma_mps);
-  o.w_sigma_radps = w.number("w_sigma_radps", 0.0, 10.0, o.w_sigma_radps);
-  o.range_sigma_m = w.number("range_sigma_m", 0.0, 10.0, o.range_sigma_m);
-  o.bearing_sigma_rad = w.number("bearing_sigma_rad", 0.0, 1.0, o.bearing_sigma_rad);
-  o.range_bias_m = w.number("range_bias_m", -10.0, 10.0, o.range_bias_m);
-  o.error_correlation_s = w.number("error_correlation_s", 0.0, 1e4, o.error_correlation_s);
-  o.odometry_lead_s = w.number("odometry_lead_s", 0.0, 10.0, o.odometry_lead_s);
-  o.field_of_view_rad = w.number("field_of_view_rad", 0.01, 2.0 * M_PI, o.field_of_view_rad);
-  o.min_range_m = w.number("min_range_m", 0.0, 100.0, o.min_range_m);
-  o.max_range_m = w.number("max_range_m", 0.01, 1000.0, o.max_range_m);
-  if (o.max_range_m <= o.min_range_m) w.fail("max_range_m", "must be greater than min_range_m");
-  o.detection_probability = w.number("detection_probability", 0.0, 1.0, o.detection_probability);
+  config::read_parameters(w, world_parameters(), o);
+  config::check_rules(w, [&] { validate(o); });
   if (w.has("path")) {
     for (config::YamlReader& leg : w.mapping_list("path")) {
       PathLeg l;

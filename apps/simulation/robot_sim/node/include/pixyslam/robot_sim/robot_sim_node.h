@@ -3,8 +3,10 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "pixyslam/dds/participant.h"
+#include "pixyslam/parameters/parameters.h"
 #include "pixyslam/robot_sim/robot_sim_config.h"
 
 namespace pixyslam::robot_sim {
@@ -30,6 +32,11 @@ struct RunOptions {
   std::string camera_video;
 };
 
+// The keys of `run:` (ranges, units, help); validate() adds the rules between
+// them (two different links; the camera video only with the camera backend).
+const parameters::Table<RunOptions>& run_parameters();
+void validate(const RunOptions& options);
+
 struct RobotSimProcessConfig {
   RobotSimConfig sim;
   RunOptions run;
@@ -41,6 +48,13 @@ struct RobotSimProcessConfig {
 RobotSimProcessConfig read_robot_sim_process_config(const std::string& sim_yaml,
                                                     const std::string& pixy_yaml,
                                                     const std::string& encoder_yaml);
+
+// `--set world.KEY=V`, `hardware.KEY=V`, `run.KEY=V`, `dds.KEY=V` (then the
+// DDS settings resolved); std::invalid_argument naming a bad one.
+void apply_overrides(RobotSimProcessConfig& config, const std::vector<std::string>& assignments);
+
+// Every parameter --set reaches, for --help.
+std::string help_text();
 
 // The simulator process: runs the HardwareEmulator in real time, writes the
 // Arduino's lines and the Pixy's UART bytes into two pseudo-terminals (the

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/parameters/parameters.h"
 #include "pixyslam/eval/trajectory_metrics.h"
 #include "pixyslam/slam/types.h"
 
@@ -70,6 +71,12 @@ struct WorldOptions {
   double min_range_m = 0.2;
   double max_range_m = 3.0;
 };
+
+// The scalar keys of `world:` (path, poles and initial_pose are lists and a
+// mapping, read by read_world_options).
+const parameters::Table<WorldOptions>& world_parameters();
+// Ranges and rules (max_range_m > min_range_m); std::invalid_argument naming the key.
+void validate(const WorldOptions& options);
 
 // Reads a `world:` mapping; unknown keys and bad values throw config::ConfigError.
 WorldOptions read_world_options(config::YamlReader& world);
