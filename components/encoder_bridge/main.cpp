@@ -1,8 +1,8 @@
 // encoder_bridge: the Arduino's wheel-encoder lines (serial) -> Odometry over
 // DDS at publish_rate_hz, until SIGINT/SIGTERM.
 //   encoder_bridge --config config/encoder_bridge.yaml [--device PATH] [--set KEY=VALUE ...] [--verbose]
-// --device overrides encoder_bridge.serial_device; --set encoder_bridge.KEY=V
-// or dds.KEY=V a parameter. --verbose prints the effective configuration to
+// --device overrides encoder_bridge.serial_device; --set encoder_bridge.KEY=V,
+// node.KEY=V or dds.KEY=V a parameter. --verbose prints the effective configuration to
 // stdout; logs go to stderr. Exit status: 0 after a clean stop, 2 for a
 // configuration or command-line error, 1 for any other failure.
 #include <chrono>
@@ -22,19 +22,13 @@ int main(int argc, char** argv) {
   app::Cli cli{"encoder_bridge", "The Arduino's wheel-encoder lines (serial) -> Odometry over DDS, until SIGINT/SIGTERM."};
   bridge::add_bridge_flags(cli, args, "config/encoder_bridge.yaml: encoder_bridge:, node:, dds:",
                            "encoder_bridge.publish_rate_hz=20");
-  cli.footer("encoder parameters (encoder_bridge:):\n" +
-             parameters::help_text(encoder::encoder_parameters(), "encoder_bridge") +
-             "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
-             parameters::help_text(pixyslam::dds::dds_parameters(), "dds"));
+  cli.footer(encoder_node::help_text());
   if (const auto done = cli.parse(argc, argv)) return *done;
 
   encoder_node::EncoderNodeOptions options;
   const std::optional<int> bad = app::configure("encoder_bridge", [&] {
     options = encoder_node::read_encoder_node_options_file(args.config);
-    for (const std::string& a : parameters::take_section(args.overrides, "encoder_bridge")) {
-      parameters::apply_override(options.encoder, encoder::encoder_parameters(), "encoder_bridge", a);
-    }
-    encoder::validate(options.encoder);
+    encoder_node::apply_overrides(options, args.overrides);
     bridge::apply_command_line(args, options.encoder.serial_device, options.dds);
   });
   if (bad) return *bad;

@@ -36,11 +36,7 @@ int main(int argc, char** argv) {
                            "pixy.frame_rate_hz=30");
   cli.option("--camera", camera_input, "read this camera, video file or y4m stream instead of the Pixy")
       .type("INPUT");
-  cli.footer("Pixy parameters (pixy:; landmarks apart):\n" +
-             parameters::help_text(pixy::camera_parameters(), "pixy") +
-             parameters::help_text(pixy::frame_rate_parameters(), "pixy") +
-             "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
-             parameters::help_text(pixyslam::dds::dds_parameters(), "dds"));
+  cli.footer(pixy_node::help_text());
   if (const auto done = cli.parse(argc, argv)) return *done;
 
   pixy_node::PixyNodeOptions options;
@@ -54,16 +50,7 @@ int main(int argc, char** argv) {
 #endif
   const std::optional<int> bad = app::configure("pixy_bridge", [&] {
     options = pixy_node::read_pixy_node_options_file(args.config, read_camera);
-    for (const std::string& a : parameters::take_section(args.overrides, "pixy")) {
-      const std::string key = a.substr(0, a.find('=')).substr(5);
-      if (parameters::find(pixy::frame_rate_parameters(), key) != nullptr) {
-        parameters::apply_override(options.pixy.rate, pixy::frame_rate_parameters(), "pixy", a);
-      } else {
-        parameters::apply_override(options.pixy.camera, pixy::camera_parameters(), "pixy", a);
-      }
-    }
-    pixy::validate(options.pixy.camera);
-    pixy::validate(options.pixy.rate);
+    pixy_node::apply_overrides(options, args.overrides);
 #ifdef PIXYSLAM_HAS_CAMERA
     if (!camera_input.empty() && !camera_options) {
       camera_options = camera::CameraSourceOptions{};

@@ -9,6 +9,7 @@
 
 #include "fuzz_common.h"
 #include "pixyslam/bridge/process_options.h"
+#include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/encoder/encoder_options.h"
 #include "pixyslam/pixy/pixy_options.h"
@@ -42,6 +43,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   read_section(text, "encoder_bridge", [](auto& r) { pixyslam::encoder::read_encoder_options(r); });
   read_section(text, "pixy", [](auto& r) { pixyslam::pixy::read_pixy_options(r); });
   read_section(text, "world", [](auto& r) { pixyslam::sim::read_world_options(r); });
-  read_section(text, "node", [](auto& r) { pixyslam::bridge::read_bridge_process_options(r); });
+  read_section(text, "node", [](auto& r) {
+    using pixyslam::bridge::BridgeProcessOptions;
+    BridgeProcessOptions o;
+    pixyslam::config::read_parameters(
+        r, pixyslam::bridge::process_parameters<BridgeProcessOptions>([](BridgeProcessOptions& x) -> BridgeProcessOptions& { return x; }), o);
+  });
   return 0;
 }

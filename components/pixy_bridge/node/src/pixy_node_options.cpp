@@ -1,7 +1,9 @@
 #include "pixyslam/pixy_node/pixy_node_options.h"
 
 #include <sstream>
+#include <stdexcept>
 
+#include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/serial/serial_port.h"
 
@@ -16,24 +18,70 @@ std::string baud_list() {
 
 }  // namespace
 
+const parameters::Table<PixyNodeOptions>& node_parameters() {
+  using O = PixyNodeOptions;
+  namespace P = parameters;
+  static const P::Table<O> table = [] {
+    P::Table<O> t = {
+        P::text<O>("serial_device", "the Pixy's UART (an absolute path)", [](O& o) -> std::string& { return o.serial_device; },
+                   [](const std::string& v) {
+                     if (v.empty() || v.front() != '/') throw std::invalid_argument("not an absolute path (e.g. /dev/serial0)");
+                   }),
+        P::integer<O, long>("baud", 1, 4000000, "bit/s", "the Pixy's UART rate (one of: " + baud_list() + ")",
+                            [](O& o) -> long& { return o.baud; }),
+        P::real<O>("camera_latency_s", 0.0, 1.0, "s", "subtracted from the host time a frame was read (exposure to UART)",
+                   [](O& o) -> double& { return o.camera_latency_s; }),
+        P::real<O>("frame_timeout_s", 0.005, 10.0, "s", "an open frame without new data this long is complete",
+                   [](O& o) -> double& { return o.frame_timeout_s; }),
+    };
+    for (P::Parameter<O>& p : bridge::process_parameters<O>([](O& o) -> bridge::BridgeProcessOptions& { return o.process; })) {
+      t.push_back(std::move(p));
+    }
+    return t;
+  }();
+  return table;
+}
+
+void validate_node(const PixyNodeOptions& o) {
+  parameters::check_ranges(o, node_parameters(), "node");
+  if (!serial::is_supported_baud(o.baud)) {
+    throw parameters::RuleError("node", "baud", "value " + std::to_string(o.baud) + " is not a supported serial rate (" +
+                                                    baud_list() + ")");
+  }
+}
+
+void apply_overrides(PixyNodeOptions& o, std::vector<std::string>& assignments) {
+  for (const std::string& a : parameters::take_section(assignments, "pixy")) {
+    const std::string key = a.substr(0, a.find('=')).substr(5);
+    if (parameters::find(pixy::frame_rate_parameters(), key) != nullptr) {
+      parameters::apply_override(o.pixy.rate, pixy::frame_rate_parameters(), "pixy", a);
+    } else {
+      parameters::apply_override(o.pixy.camera, pixy::camera_parameters(), "pixy", a);
+    }
+  }
+  pixy::validate(o.pixy.camera);
+  pixy::validate(o.pixy.rate);
+  for (const std::string& a : parameters::take_section(assignments, "node")) {
+    parameters::apply_override(o, node_parameters(), "node", a);
+  }
+  validate_node(o);
+}
+
+std::string help_text() {
+  return "Pixy parameters (pixy:; landmarks apart):\n" + parameters::help_text(pixy::camera_parameters(), "pixy") +
+         parameters::help_text(pixy::frame_rate_parameters(), "pixy") + "the link and the process (node:):\n" +
+         parameters::help_text(node_parameters(), "node") +
+         "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
+         parameters::help_text(dds::dds_parameters(), "dds");
+}
+
 PixyNodeOptions read_pixy_node_options(config::YamlReader& root, const std::string& config_dir,
                                        const CameraSectionReader& read_camera) {
   PixyNodeOptions o;
   if (root.has("node")) {
     config::YamlReader node = root.child("node");
-    o.serial_device = node.text("serial_device", o.serial_device);
-    if (o.serial_device.empty() || o.serial_device.front() != '/') {
-      node.fail("serial_device",
-                "value '" + o.serial_device + "' is not an absolute path (e.g. /dev/serial0)");
-    }
-    o.baud = static_cast<long>(node.integer("baud", 1, 4000000, o.baud));
-    if (!serial::is_supported_baud(o.baud)) {
-      node.fail("baud", "value " + std::to_string(o.baud) + " is not a supported serial rate (" +
-                            baud_list() + ")");
-    }
-    o.camera_latency_s = node.number("camera_latency_s", 0.0, 1.0, o.camera_latency_s);
-    o.frame_timeout_s = node.number("frame_timeout_s", 0.005, 10.0, o.frame_timeout_s);
-    o.process = bridge::read_bridge_process_options(node);
+    config::read_parameters(node, node_parameters(), o);
+    config::check_rules(node, [&] { validate_node(o); });
     node.finish();
   }
   config::YamlReader pixy = root.child("pixy");
@@ -60,14 +108,8 @@ PixyNodeOptions read_pixy_node_options_file(const std::string& path, const Camer
 }
 
 std::string to_yaml(const PixyNodeOptions& o) {
-  using bridge::yaml_number;
   std::ostringstream os;
-  os << "node:\n"
-     << "  serial_device: " << bridge::yaml_quoted(o.serial_device) << "\n"
-     << "  baud: " << o.baud << "\n"
-     << "  camera_latency_s: " << yaml_number(o.camera_latency_s) << "\n"
-     << "  frame_timeout_s: " << yaml_number(o.frame_timeout_s) << "\n"
-     << bridge::to_yaml_lines(o.process)
+  os << parameters::to_yaml(o, node_parameters(), "node")
      << parameters::to_yaml(o.pixy.camera, pixy::camera_parameters(), "pixy")
      << parameters::to_yaml(o.pixy.rate, pixy::frame_rate_parameters(), "pixy").substr(6)  // the same mapping
      << "  landmarks:" << (o.pixy.signatures.size() == 0 ? " {}" : "") << "\n";

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "pixyslam/bridge/bridge_options.h"
 #include "pixyslam/config/yaml_reader.h"
@@ -23,6 +24,17 @@ struct EncoderNodeOptions {
 // dds.profiles_file. Throws config::ConfigError naming the file and key path.
 EncoderNodeOptions read_encoder_node_options(config::YamlReader& root, const std::string& config_dir);
 EncoderNodeOptions read_encoder_node_options_file(const std::string& path);
+
+// The `node:` keys (reopen_period_s, status_period_s, clock_window_s).
+const parameters::Table<EncoderNodeOptions>& node_parameters();
+void validate_node(const EncoderNodeOptions& options);
+
+// `--set encoder_bridge.KEY=V` and `node.KEY=V` applied and checked, taken out
+// of `assignments` (the dds. ones stay for dds::resolve_settings).
+void apply_overrides(EncoderNodeOptions& options, std::vector<std::string>& assignments);
+
+// Every parameter --set reaches, for --help.
+std::string help_text();
 
 // The effective configuration, in the layout read_encoder_node_options() reads.
 std::string to_yaml(const EncoderNodeOptions& options);

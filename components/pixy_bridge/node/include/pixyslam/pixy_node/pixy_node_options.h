@@ -2,6 +2,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "pixyslam/bridge/bridge_options.h"
 #include "pixyslam/config/yaml_reader.h"
@@ -34,6 +35,18 @@ using CameraSectionReader = std::function<void(config::YamlReader& camera, const
 PixyNodeOptions read_pixy_node_options(config::YamlReader& root, const std::string& config_dir,
                                        const CameraSectionReader& read_camera = {});
 PixyNodeOptions read_pixy_node_options_file(const std::string& path, const CameraSectionReader& read_camera = {});
+
+// The `node:` keys (serial link, frame timing, reopen_period_s, status_period_s)
+// and their rules (a supported baud rate).
+const parameters::Table<PixyNodeOptions>& node_parameters();
+void validate_node(const PixyNodeOptions& options);
+
+// `--set pixy.KEY=V` and `node.KEY=V` applied and checked, taken out of
+// `assignments` (the dds. ones stay for dds::resolve_settings).
+void apply_overrides(PixyNodeOptions& options, std::vector<std::string>& assignments);
+
+// Every parameter --set reaches, for --help.
+std::string help_text();
 
 // The effective configuration, in the layout read_pixy_node_options() reads.
 std::string to_yaml(const PixyNodeOptions& options);
