@@ -35,6 +35,7 @@ struct ViewArguments {
   std::string config;
   std::string width, height;  // as given (checked by the render table)
   bool no_truth = false;
+  std::vector<std::string> overrides;  // --set
 
   void add_to(pixyslam::app::Cli& command, bool truth_switch) {
     command
@@ -46,13 +47,22 @@ struct ViewArguments {
     command.option("--width", width, "image width in pixels (default: the config's)").type("N");
     command.option("--height", height, "image height in pixels (default: the config's)").type("N");
     if (truth_switch) command.flag("--no-truth", no_truth, "leave out the ground truth");
+    pixyslam::app::add_set(command, overrides, "map_view.sigma_scale=3");
   }
 
-  pixyslam::map_view::MapViewOptions load(const pixyslam::app::Cli& command) const {
+  // The options: --config, then --set (map_view. keys; the dds. ones are
+  // left in `dds_overrides`), then --width/--height/--no-truth.
+  pixyslam::map_view::MapViewOptions load(const pixyslam::app::Cli& command, std::vector<std::string>& dds_overrides) const {
     using namespace pixyslam::map_view;
     MapViewOptions o;
     o.dds.profiles_file = PIXYSLAM_DEFAULT_PROFILES_FILE;
     if (command.given("--config")) o = read_map_view_options_file(config, PIXYSLAM_DEFAULT_PROFILES_FILE);
+    dds_overrides = overrides;
+    try {
+      apply_overrides(o, dds_overrides);
+    } catch (const std::invalid_argument& e) {
+      throw pixyslam::app::UsageError(std::string("--set ") + e.what());
+    }
     for (const auto& [flag, key, text] :
          {std::tuple{"--width", "width_px", width}, std::tuple{"--height", "height_px", height}}) {
       if (!command.given(flag)) continue;
@@ -81,7 +91,7 @@ int main(int argc, char** argv) {
   app::Cli cli{"map_view",
                "The estimator's map as an image (seed paper Fig. 6b): particles, mean trajectory, landmarks with "
                "n-sigma ellipses and ids, ground truth, the map optimiser's solution."};
-  cli.footer("Exit status: 0 done, 2 a bad command line, config or output path, 1 a log it cannot read (unreadable, "
+  cli.footer(help_text() + "Exit status: 0 done, 2 a bad command line, config or output path, 1 a log it cannot read (unreadable, "
              "not MCAP, no MapState) or any other failure.");
 
   ViewArguments render_view;
@@ -121,7 +131,15 @@ int main(int argc, char** argv) {
   if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("map_view", [&]() -> int {
     try {
-      if (render.chosen()) return run_render(render_view.load(render), render_request);
+      std::vector<std::string> left;  // render and video join no DDS domain: only map_view. keys
+      const auto no_dds = [&left] {
+        if (!left.empty()) throw app::UsageError("--set " + left.front() + ": not a map_view. parameter");
+      };
+      if (render.chosen()) {
+        MapViewOptions o = render_view.load(render, left);
+        no_dds();
+        return run_render(o, render_request);
+      }
       if (video.chosen()) {
         if (!video.given("--out") && !video.given("--out-dir")) throw app::UsageError("--out FILE.avi or --out-dir DIR is required");
         if (video.given("--out") && !is_video_path(video_request.out)) {
@@ -131,9 +149,12 @@ int main(int argc, char** argv) {
           if (is_video_path(video_out_dir)) throw app::UsageError("--out-dir " + video_out_dir + ": a folder, not a .avi file");
           video_request.out = video_out_dir;
         }
-        return run_video(video_view.load(video), video_request);
+        MapViewOptions o = video_view.load(video, left);
+        no_dds();
+        return run_video(o, video_request);
       }
-      MapViewOptions o = live_view.load(live);
+      std::vector<std::string> set_dds;
+      MapViewOptions o = live_view.load(live, set_dds);
       if (live.given("--period")) {
         try {
           parameters::set_from_text(o, map_view_parameters(), "map_view", "snapshot_period_s", period);
@@ -141,7 +162,8 @@ int main(int argc, char** argv) {
           throw app::UsageError(std::string("--period: ") + e.what());
         }
       }
-      dds::resolve_settings(o.dds, dds_overrides);
+      set_dds.insert(set_dds.end(), dds_overrides.begin(), dds_overrides.end());  // --domain last: it wins
+      dds::resolve_settings(o.dds, set_dds);
       live_request.out_given = live.given("--out-dir");
       if (verbose) app::print_effective_configuration("map_view", to_yaml(o));
       return run_live(o, live_request);

@@ -2,6 +2,8 @@
 
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/parameters_yaml.h"
@@ -23,6 +25,26 @@ const parameters::Table<MapViewOptions>& map_view_parameters() {
       P::boolean<O>("window", "open a window when a display is available", [](O& o) -> bool& { return o.window; }),
   };
   return table;
+}
+
+void apply_overrides(MapViewOptions& o, std::vector<std::string>& assignments) {
+  for (const std::string& a : parameters::take_section(assignments, "map_view")) {
+    const std::string key = a.substr(0, a.find('=')).substr(9);
+    if (parameters::find(render_parameters(), key) != nullptr) {
+      parameters::apply_override(o.render, render_parameters(), "map_view", a);
+    } else {
+      parameters::apply_override(o, map_view_parameters(), "map_view", a);
+    }
+  }
+  validate(o.render);
+  parameters::check_ranges(o, map_view_parameters(), "map_view");
+}
+
+std::string help_text() {
+  return "map_view parameters (map_view:):\n" + parameters::help_text(render_parameters(), "map_view") +
+         parameters::help_text(map_view_parameters(), "map_view") +
+         "DDS settings of live (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
+         parameters::help_text(dds::dds_parameters(), "dds");
 }
 
 MapViewOptions read_map_view_options(config::YamlReader& root, const std::string& config_dir,

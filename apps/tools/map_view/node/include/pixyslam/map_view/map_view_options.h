@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/dds/participant.h"
@@ -40,5 +41,12 @@ MapViewOptions read_map_view_options_file(const std::string& path, const std::st
 
 // The effective configuration, in the layout read_map_view_options() reads.
 std::string to_yaml(const MapViewOptions& options);
+
+// `--set map_view.KEY=V` applied and checked, taken out of `assignments`
+// (dds. ones stay for dds::resolve_settings).
+void apply_overrides(MapViewOptions& options, std::vector<std::string>& assignments);
+
+// Every parameter --set reaches, for --help.
+std::string help_text();
 
 }  // namespace pixyslam::map_view
