@@ -36,7 +36,12 @@ int main(int argc, char** argv) {
                            "pixy.frame_rate_hz=30");
   cli.option("--camera", camera_input, "read this camera, video file or y4m stream instead of the Pixy")
       .type("INPUT");
+#ifdef PIXYSLAM_HAS_CAMERA
+  cli.footer(pixy_node::help_text() + "the camera backend (camera:; --camera or a camera: section):\n" +
+             parameters::help_text(camera::camera_source_parameters(), "camera"));
+#else
   cli.footer(pixy_node::help_text());
+#endif
   if (const auto done = cli.parse(argc, argv)) return *done;
 
   pixy_node::PixyNodeOptions options;
@@ -59,6 +64,10 @@ int main(int argc, char** argv) {
     }
     if (camera_options) {
       if (!camera_input.empty()) camera_options->input = camera_input;
+      for (const std::string& a : parameters::take_section(args.overrides, "camera")) {
+        parameters::apply_override(*camera_options, camera::camera_source_parameters(), "camera", a);
+      }
+      camera::validate(*camera_options);
       bridge::apply_command_line(args, camera_options->input, options.dds);
       return;
     }

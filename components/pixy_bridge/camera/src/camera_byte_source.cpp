@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/pixy/pixy_block_parser.h"
 
 namespace pixyslam::camera {
@@ -32,19 +33,39 @@ void read_range(config::YamlReader& r, const std::string& key, int& min, int& ma
 
 }  // namespace
 
+const parameters::Table<CameraSourceOptions>& camera_source_parameters() {
+  using O = CameraSourceOptions;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::required(P::text<O>("input", "a /dev/videoN camera, a y4m file or FIFO, or a video file",
+                             [](O& o) -> std::string& { return o.input; },
+                             [](const std::string& v) {
+                               if (v.empty()) throw std::invalid_argument("empty (a camera, a y4m file or FIFO, or a video file)");
+                             })),
+      P::real<O>("file_fps", 0.1, 1000.0, "Hz", "frames per second read from a file (a FIFO or camera sets its own pace)",
+                 [](O& o) -> double& { return o.file_fps; }),
+      P::integer<O, int>("min_blob_area_px", 1, 100000, "px", "smaller blobs of a colour are noise",
+                         [](O& o) -> int& { return o.detector.min_blob_area_px; }),
+      P::integer<O, int>("max_gap_px", 0, 100, "px", "most rows between the two bands of a code",
+                         [](O& o) -> int& { return o.detector.max_gap_px; }),
+      P::real<O>("min_overlap", 0.0, 1.0, "", "horizontal overlap of the bands, fraction of the narrower",
+                 [](O& o) -> double& { return o.detector.min_overlap; }),
+      P::real<O>("horizon_row_fraction", -1.0, 1.0, "", "a code's centre lies on this row (fraction of the height; < 0: off)",
+                 [](O& o) -> double& { return o.detector.horizon_row_fraction; }),
+      P::real<O>("max_horizon_offset", 0.0, 10.0, "", "... within this many code heights",
+                 [](O& o) -> double& { return o.detector.max_horizon_offset; }),
+  };
+  return table;
+}
+
+void validate(const CameraSourceOptions& o) { parameters::check_ranges(o, camera_source_parameters(), "camera"); }
+
 CameraSourceOptions read_camera_source_options(config::YamlReader& camera, int image_width_px, int image_height_px) {
   CameraSourceOptions o;
   o.image_width_px = image_width_px;
   o.image_height_px = image_height_px;
-  o.input = camera.text("input");
-  if (o.input.empty()) camera.fail("input", "is empty (a /dev/videoN camera, a y4m file or FIFO, or a video file)");
-  o.file_fps = camera.number("file_fps", 0.1, 1000.0, o.file_fps);
+  config::read_parameters(camera, camera_source_parameters(), o);
   DetectorOptions& d = o.detector;
-  d.min_blob_area_px = static_cast<int>(camera.integer("min_blob_area_px", 1, 100000, d.min_blob_area_px));
-  d.max_gap_px = static_cast<int>(camera.integer("max_gap_px", 0, 100, d.max_gap_px));
-  d.min_overlap = camera.number("min_overlap", 0.0, 1.0, d.min_overlap);
-  d.horizon_row_fraction = camera.number("horizon_row_fraction", -1.0, 1.0, d.horizon_row_fraction);
-  d.max_horizon_offset = camera.number("max_horizon_offset", 0.0, 10.0, d.max_horizon_offset);
   if (camera.has("signatures")) {
     config::YamlReader sigs = camera.child("signatures");
     for (int k = 1; k <= 7; ++k) {
@@ -66,10 +87,7 @@ CameraSourceOptions read_camera_source_options(config::YamlReader& camera, int i
 std::string to_yaml(const CameraSourceOptions& o) {
   std::ostringstream os;
   const DetectorOptions& d = o.detector;
-  os << "camera:\n  input: \"" << o.input << "\"\n  file_fps: " << o.file_fps
-     << "\n  min_blob_area_px: " << d.min_blob_area_px << "\n  max_gap_px: " << d.max_gap_px
-     << "\n  min_overlap: " << d.min_overlap << "\n  horizon_row_fraction: " << d.horizon_row_fraction
-     << "\n  max_horizon_offset: " << d.max_horizon_offset << "\n  signatures:\n";
+  os << parameters::to_yaml(o, camera_source_parameters(), "camera") << "  signatures:\n";
   for (std::size_t k = 0; k < d.signatures.size(); ++k) {
     const HsvRange& h = d.signatures[k];
     if (h.s_min > h.s_max) continue;

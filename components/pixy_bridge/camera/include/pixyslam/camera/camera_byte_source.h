@@ -12,6 +12,7 @@
 #include "pixyslam/camera/colour_code_detector.h"
 #include "pixyslam/camera/y4m_stream.h"
 #include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/parameters/parameters.h"
 
 namespace cv {
 class VideoCapture;
@@ -30,6 +31,10 @@ struct CameraSourceOptions {
   int image_height_px = 200;
   DetectorOptions detector = default_detector_options();
 };
+
+// The scalar keys of `camera:` (the signatures' HSV ranges apart).
+const parameters::Table<CameraSourceOptions>& camera_source_parameters();
+void validate(const CameraSourceOptions& options);
 
 // Reads `camera:` (input required; `signatures:` maps 1..7 to {h: [min, max],
 // s: [min, max], v: [min, max]}, OpenCV scales; absent ones keep the defaults)
