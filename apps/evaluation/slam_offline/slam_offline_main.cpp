@@ -99,10 +99,18 @@ int run(const Args& args) {
   std::vector<std::string> overrides;
   if (!args.seed.empty()) overrides.push_back("filter.seed=" + args.seed);
   overrides.insert(overrides.end(), args.sets.begin(), args.sets.end());
+  // world. (sim) and mrclam. (mrclam) apply to those sections; the rest to filter:.
+  const std::vector<std::string> world_sets = parameters::take_section(overrides, "world");
+  const std::vector<std::string> mrclam_sets = parameters::take_section(overrides, "mrclam");
+  const auto set_error = [](const std::invalid_argument& e) { return app::UsageError(std::string("--seed/--set: ") + e.what()); };
   try {
     slam::apply_overrides(options, overrides);
+    if (!world_sets.empty() && args.mode != "sim") throw std::invalid_argument(world_sets.front() + ": world. is for slam_offline sim");
+    if (!mrclam_sets.empty() && args.mode != "mrclam") {
+      throw std::invalid_argument(mrclam_sets.front() + ": mrclam. is for slam_offline mrclam");
+    }
   } catch (const std::invalid_argument& e) {
-    throw app::UsageError(std::string("--seed/--set: ") + e.what());
+    throw set_error(e);
   }
 
   offline::RunInput input;
@@ -120,8 +128,14 @@ int run(const Args& args) {
             std::to_string(input.frames.size()) + " frames with detections";
   } else if (args.mode == "sim") {
     config::YamlReader world_yaml = root.child("world");
-    const sim::WorldOptions world = sim::read_world_options(world_yaml);
+    sim::WorldOptions world = sim::read_world_options(world_yaml);
     root.finish();
+    try {
+      for (const std::string& a : world_sets) parameters::apply_override(world, sim::world_parameters(), "world", a);
+      sim::validate(world);
+    } catch (const std::invalid_argument& e) {
+      throw set_error(e);
+    }
     const sim::WorldRun run = sim::simulate(world);
     input = sim_input(run);
     if (!args.write_dataset.empty()) {
@@ -131,8 +145,15 @@ int run(const Args& args) {
     title = "simulated world, " + std::to_string(run.poles.size()) + " poles, " +
             std::to_string(run.frames.size()) + " camera frames";
   } else {
-    const offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
+    offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
     root.finish();
+    try {
+      for (const std::string& a : mrclam_sets) {
+        parameters::apply_override(model, offline::mrclam_sensor_parameters(), "mrclam", a);
+      }
+    } catch (const std::invalid_argument& e) {
+      throw set_error(e);
+    }
     const std::string& dataset = args.dataset;
     const int robot = args.robot;
     const mrclam::RobotData data = mrclam::load_robot(dataset, robot);
@@ -184,7 +205,8 @@ int main(int argc, char** argv) {
     app::add_config(mode, args.config, "the YAML with the filter: section (and world: in sim mode)");
     mode.option("--out-dir", args.out_dir, "write trajectory.csv and landmarks.csv into DIR").required().type("DIR");
     mode.option("--seed", args.seed, "the filter's seed (filter.seed)").type("S");
-    app::add_set(mode, args.sets, "filter.particles=300 (slam_estimator --help lists them)");
+    app::add_set(mode, args.sets, "filter.particles=300 (slam_estimator --help lists them; sim also world.KEY=V, "
+                                  "mrclam also mrclam.KEY=V, both listed below)");
     mode.flag("--optimise",
               args.optimise,
               "also solve the whole run with the map optimiser (Ceres): its solution goes to trajectory.csv and "
@@ -192,11 +214,14 @@ int main(int argc, char** argv) {
   };
   app::Cli& sim = cli.subcommand("sim", "the simulated world of the config's world: section");
   common(sim);
+  sim.footer("world parameters (world:; path, poles and initial_pose apart):\n" +
+             parameters::help_text(sim::world_parameters(), "world"));
   sim.option("--write-dataset", args.write_dataset,
              "also write the recording as robot 1 of an MRCLAM data set in DIR, with its ground truth")
       .type("DIR");
   app::Cli& mrclam = cli.subcommand("mrclam", "one robot of an MRCLAM data set");
   common(mrclam);
+  mrclam.footer("MRCLAM sensor model (mrclam:):\n" + parameters::help_text(offline::mrclam_sensor_parameters(), "mrclam"));
   mrclam.option("--dataset", args.dataset, "the data set's folder (e.g. ../shared/data/mrclam/Dataset6)")
       .required()
       .type("DIR");

@@ -276,7 +276,7 @@ int main(int argc, char** argv) {
       .type("NAME:=VALUE");
   cli.option("--run-dir", args.run_dir, "the run's folder (${run_dir}; default ./pixyslam_runs/<time>)")
       .type("DIR");
-  cli.option("--duration", args.duration_s, "the same as duration:=S").type("S").range(0.0, 1e6);
+  cli.option("--duration", args.duration_s, "the same as duration:=S").type("S").range(0.0, launcher::kMaxDurationS);
   cli.option("--input", args.input, "defines ${input} (e.g. the log launch_replay.yaml plays)").type("FILE");
   app::Cli::Option& deployment = cli.option("--deployment", args.deployment,
                                     "a deployment file: run one host's share with its DDS settings "

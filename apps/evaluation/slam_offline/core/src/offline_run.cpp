@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "pixyslam/mrclam/mrclam_dataset.h"
+#include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/eval/rigid_alignment.h"
 
@@ -236,15 +237,28 @@ RunInput restart_at_truth(const RunInput& input, double start_s) {
 
 namespace pixyslam::offline {
 
+const parameters::Table<MrclamSensorModel>& mrclam_sensor_parameters() {
+  using O = MrclamSensorModel;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::real<O>("range_scale", 0.5, 2.0, "", "range_true = range / (range_scale * cos(bearing)^exponent)",
+                 [](O& o) -> double& { return o.range_scale; }),
+      P::real<O>("range_cos_bearing_exponent", 0.0, 3.0, "", "... the exponent (off-axis shortening)",
+                 [](O& o) -> double& { return o.range_cos_bearing_exponent; }),
+      P::real<O>("odometry_delay_s", -2.0, 2.0, "s", "command-to-motion lag", [](O& o) -> double& { return o.odometry_delay_s; }),
+      P::real<O>("speed_scale", 0.5, 2.0, "", "forward speed = commanded * max(0, speed_scale - loss * |turn rate|)",
+                 [](O& o) -> double& { return o.speed_scale; }),
+      P::real<O>("speed_loss_per_radps", 0.0, 10.0, "s/rad", "... the loss per rad/s of commanded turn rate",
+                 [](O& o) -> double& { return o.speed_loss_per_radps; }),
+  };
+  return table;
+}
+
 MrclamSensorModel read_mrclam_sensor_model(config::YamlReader& root) {
   MrclamSensorModel m;
   if (!root.has("mrclam")) return m;
   config::YamlReader y = root.child("mrclam");
-  m.range_scale = y.number("range_scale", 0.5, 2.0, m.range_scale);
-  m.range_cos_bearing_exponent = y.number("range_cos_bearing_exponent", 0.0, 3.0, m.range_cos_bearing_exponent);
-  m.odometry_delay_s = y.number("odometry_delay_s", -2.0, 2.0, m.odometry_delay_s);
-  m.speed_scale = y.number("speed_scale", 0.5, 2.0, m.speed_scale);
-  m.speed_loss_per_radps = y.number("speed_loss_per_radps", 0.0, 10.0, m.speed_loss_per_radps);
+  config::read_parameters(y, mrclam_sensor_parameters(), m);
   y.finish();
   return m;
 }

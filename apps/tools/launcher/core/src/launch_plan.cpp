@@ -93,7 +93,7 @@ LaunchPlan read_launch_plan(const std::string& path, const std::map<std::string,
   config::YamlReader root = config::YamlReader::from_file(path);
   config::YamlReader launch = root.child("launch");
   LaunchPlan plan;
-  plan.duration_s = launch.number("duration_s", 0.0, 1e6, plan.duration_s);
+  plan.duration_s = launch.number("duration_s", 0.0, kMaxDurationS, plan.duration_s);
   plan.stop_timeout_s = launch.number("stop_timeout_s", 0.1, 600.0, plan.stop_timeout_s);
   std::map<std::string, std::string> values = variables;
   if (launch.has("arguments")) {
@@ -115,8 +115,9 @@ LaunchPlan read_launch_plan(const std::string& path, const std::map<std::string,
   for (const auto& [name, value] : given) {
     if (name == kDurationArgument) {
       const std::optional<double> seconds = parameters::parse_number(value);
-      if (!seconds || !(*seconds >= 0.0 && *seconds <= 1e6)) {
-        throw config::ConfigError("duration:=" + value + ": must be seconds in [0, 1e6] (0: no limit)");
+      if (!seconds || !(*seconds >= 0.0 && *seconds <= kMaxDurationS)) {
+        throw config::ConfigError("duration:=" + value + ": must be seconds in [0, " +
+                                  parameters::number_text(kMaxDurationS) + "] (0: no limit)");
       }
       plan.duration_s = *seconds;
     } else if (values.count(name) == 0 || variables.count(name) != 0) {

@@ -6,6 +6,7 @@
 
 #include "pixyslam/eval/csv_io.h"
 #include "pixyslam/eval/trajectory_metrics.h"
+#include "pixyslam/parameters/parameters.h"
 #include "pixyslam/slam/fastslam2.h"
 #include "pixyslam/offline/segment_eval.h"
 
@@ -107,6 +108,8 @@ struct MrclamSensorModel {
   double speed_scale = 1.0;
   double speed_loss_per_radps = 0.0;
 };
+// The keys of `mrclam:` (ranges, units, help).
+const parameters::Table<MrclamSensorModel>& mrclam_sensor_parameters();
 // Reads the optional `mrclam:` mapping of a config file's root (defaults: ideal sensors).
 MrclamSensorModel read_mrclam_sensor_model(config::YamlReader& root);
 

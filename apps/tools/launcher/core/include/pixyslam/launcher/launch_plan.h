@@ -32,10 +32,13 @@ struct LaunchArgument {
   std::string help;
 };
 
+// The longest run a launch file, duration:= or --duration may ask for.
+inline constexpr double kMaxDurationS = 1e6;
+
 // A run as a launch file describes it (config/launch_*.yaml).
 struct LaunchPlan {
   std::vector<LaunchArgument> arguments;  // as declared, in file order
-  double duration_s = 0.0;      // stop after this long; 0 = until Ctrl-C or ends_run
+  double duration_s = 0.0;      // stop after this long; 0 = until Ctrl-C or ends_run (at most kMaxDurationS)
   double stop_timeout_s = 5.0;  // SIGINT, then SIGKILL after this
   std::vector<ProcessSpec> processes;
   std::vector<ProcessSpec> after_run;  // run one after another once all have stopped
