@@ -2,18 +2,35 @@
 # as /etc/pixyslam (conffiles), systemd units for the robot and station sides,
 # /etc/default/pixyslam for their DDS deployment. Runtime dependencies come
 # from dpkg-shlibdeps.
+#
+# The programs keep their build names in one private folder, lib/pixyslam/bin
+# (the launcher starts its siblings from its own folder), and are on the PATH
+# as bin/pixyslam-NAME symlinks: no name can clash with another package's
+# (a plain /usr/bin/logger is bsdutils', an Essential package).
 include(GNUInstallDirs)
 
 set(pixyslam_programs
   encoder_bridge pixy_bridge slam_estimator logger robot_sim sim_evaluator slam_offline
-  pixyslam_launch pixyslam_spy pixyslam_log pixyslam_play)
+  pixyslam_launch pixyslam_spy pixyslam_log pixyslam_play pixyslam_calibrate)
 if(TARGET map_view)
   list(APPEND pixyslam_programs map_view)
 endif()
 if(TARGET map_optimizer)
   list(APPEND pixyslam_programs map_optimizer)
 endif()
-install(TARGETS ${pixyslam_programs} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+set(PIXYSLAM_PROGRAM_DIR lib/pixyslam/bin)
+install(TARGETS ${pixyslam_programs} RUNTIME DESTINATION ${PIXYSLAM_PROGRAM_DIR})
+# bin/pixyslam-NAME -> ../lib/pixyslam/bin/NAME, '_' as '-', without a doubled
+# prefix (pixyslam_launch -> pixyslam-launch, slam_estimator -> pixyslam-slam-estimator).
+foreach(program IN LISTS pixyslam_programs)
+  string(REGEX REPLACE "^pixyslam_" "" short ${program})
+  string(REPLACE "_" "-" short ${short})
+  install(CODE "
+    set(link \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_BINDIR}/pixyslam-${short}\")
+    file(MAKE_DIRECTORY \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_BINDIR}\")
+    file(CREATE_LINK ../${PIXYSLAM_PROGRAM_DIR}/${program} \"\${link}\" SYMBOLIC)
+    message(STATUS \"Installing: \${link} -> ../${PIXYSLAM_PROGRAM_DIR}/${program}\")")
+endforeach()
 # Configuration lives in /etc whatever the prefix (the systemd units read it there).
 set(PIXYSLAM_SYSCONFDIR /etc CACHE PATH "Where config/ is installed (as pixyslam/)")
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/ DESTINATION ${PIXYSLAM_SYSCONFDIR}/pixyslam)

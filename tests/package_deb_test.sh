@@ -1,10 +1,14 @@
 #!/usr/bin/env bash
 # The Debian package (cpack -G DEB from this build): its control data (runtime
-# dependencies found by dpkg-shlibdeps, conffiles), its files (programs,
-# /etc/pixyslam, systemd units whose ExecStart exists in the package), and the
-# unpacked robot side running: the packaged launcher starts the packaged
-# bridges from the packaged launch_robot.yaml (no serial devices here: they
-# wait for them) and stops them cleanly. Nothing is installed on the machine.
+# dependencies found by dpkg-shlibdeps, conffiles), its files (programs in
+# /usr/lib/pixyslam/bin with /usr/bin/pixyslam-NAME links, /etc/pixyslam,
+# systemd units whose ExecStart exists in the package), no file that another
+# package of this Debian system owns (dpkg refuses to overwrite those: a
+# /usr/bin/logger made the package uninstallable), and the unpacked robot side
+# running: the packaged launcher, started through its /usr/bin link, starts
+# the packaged bridges from the packaged launch_robot.yaml (no serial devices
+# here: they wait for them) and stops them cleanly. Nothing is installed on
+# the machine.
 #   package_deb_test.sh BUILD_DIR
 set -euo pipefail
 build=$1
@@ -22,12 +26,27 @@ for dep in libfastrtps2.9 libyaml-cpp0.7 libzstd1; do
 done
 dpkg-deb -x "$deb" "$work/root"
 dpkg-deb -e "$deb" "$work/control"
-for f in usr/bin/slam_estimator usr/bin/encoder_bridge usr/bin/pixy_bridge usr/bin/logger usr/bin/pixyslam_launch \
+for f in usr/lib/pixyslam/bin/slam_estimator usr/lib/pixyslam/bin/encoder_bridge usr/lib/pixyslam/bin/pixy_bridge \
+         usr/lib/pixyslam/bin/logger usr/lib/pixyslam/bin/pixyslam_launch usr/lib/pixyslam/bin/pixyslam_calibrate \
+         usr/bin/pixyslam-launch usr/bin/pixyslam-logger usr/bin/pixyslam-slam-estimator usr/bin/pixyslam-calibrate \
          etc/pixyslam/dds/profiles.xml etc/pixyslam/launch_robot.yaml etc/default/pixyslam \
          usr/lib/systemd/system/pixyslam-robot.service usr/lib/systemd/system/pixyslam-station.service; do
   [[ -e $work/root/$f ]] || fail "$f is not in the package"
 done
 grep -qx "/etc/pixyslam/slam_estimator.yaml" "$work/control/conffiles" || fail "config files are not conffiles"
+# Every /usr/bin entry is a pixyslam-NAME link to a program of the package.
+for link in "$work"/root/usr/bin/*; do
+  [[ $(basename "$link") == pixyslam-* && -L $link && -x $link ]] || fail "/usr/bin/$(basename "$link") is not a pixyslam-NAME link to a program"
+done
+# No file of the package belongs to an installed Debian package (dpkg would
+# refuse to unpack it over that package's file).
+while IFS= read -r path; do
+  path=${path#.}
+  [[ -z $path || -d $work/root$path && ! -L $work/root$path ]] && continue
+  if owner=$(dpkg-query -S "$path" 2>/dev/null); then
+    fail "$path is also in the installed package ${owner%%:*}"
+  fi
+done < <(cd "$work/root" && find . -mindepth 1)
 for unit in "$work"/root/usr/lib/systemd/system/*.service; do
   exe=$(sed -n 's/^ExecStart=\([^ ]*\).*/\1/p' "$unit")
   [[ -x $work/root$exe ]] || fail "$(basename "$unit"): ExecStart $exe is not in the package"
@@ -38,10 +57,10 @@ done
 domain=$((40 + $$ % 100))
 sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/root/etc/pixyslam/*.yaml
 status=0
-"$work/root/usr/bin/pixyslam_launch" "$work/root/etc/pixyslam/launch_robot.yaml" --run-dir "$work/run" \
+"$work/root/usr/bin/pixyslam-launch" "$work/root/etc/pixyslam/launch_robot.yaml" --run-dir "$work/run" \
   --duration 3 > "$work/run.log" 2>&1 || status=$?
 grep "\[launch\]" "$work/run.log"
 [[ $status -eq 0 ]] || fail "the packaged robot side exited with $status"
-grep -q "started encoder_bridge (pid [0-9]*): $work/root/usr/bin/encoder_bridge" "$work/run.log" ||
+grep -q "started encoder_bridge (pid [0-9]*): $work/root/usr/lib/pixyslam/bin/encoder_bridge" "$work/run.log" ||
   fail "the launcher did not start the packaged encoder_bridge"
 echo "PASS: $(basename "$deb"), $(stat -c %s "$deb") bytes"
