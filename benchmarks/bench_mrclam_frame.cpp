@@ -25,7 +25,6 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -40,26 +39,6 @@
 namespace {
 
 using namespace pixyslam;
-
-std::vector<int> parse_list(const std::string& text) {
-  std::vector<int> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    std::string digits;
-    for (char c : item) {
-      if (c != '_' && c != ' ') digits += c;  // allow 10_000
-    }
-    char* end = nullptr;
-    const long v = std::strtol(digits.c_str(), &end, 10);
-    if (digits.empty() || *end != '\0' || v < 1) {
-      throw app::UsageError("--particles: '" + item + "' is not an integer >= 1");
-    }
-    out.push_back(static_cast<int>(v));
-  }
-  if (out.empty()) throw app::UsageError("--particles: empty list");
-  return out;
-}
 
 // The first `frames` camera frames at or after the start, and the odometry up to
 // the last of them (the filter's time ends there).
@@ -97,7 +76,7 @@ int run(int argc, char** argv) {
     return 77;
   }
   {
-    const std::vector<int> particles = parse_list(particles_text);
+    const std::vector<int> particles = app::parse_int_list(particles_text, "--particles", 1);
     config::YamlReader root = config::YamlReader::from_file(config_file);
     config::YamlReader filter_yaml = root.child("filter");
     slam::FilterOptions options = slam::read_filter_options(filter_yaml);

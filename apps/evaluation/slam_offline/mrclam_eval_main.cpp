@@ -36,7 +36,6 @@
 #include <filesystem>
 #include <map>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -58,19 +57,6 @@
 namespace {
 
 using namespace pixyslam;
-
-std::vector<int> parse_list(const std::string& text) {
-  std::vector<int> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    char* end = nullptr;
-    const long v = std::strtol(item.c_str(), &end, 10);
-    if (item.empty() || *end != '\0') throw std::invalid_argument("not an integer list: '" + text + "'");
-    out.push_back(static_cast<int>(v));
-  }
-  return out;
-}
 
 // The map optimiser's solution of a filter run, when asked for (--optimise).
 std::optional<offline::RunResult> optimised(bool optimise, const slam::FilterOptions& options,
@@ -612,12 +598,8 @@ int main(int argc, char** argv) {
              "command line or config, 77 the data set folder is absent (skip).");
   if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("mrclam_eval", [&] {
-    try {
-      if (cli.given("--robots")) a.robots = parse_list(robots);
-      if (cli.given("--seeds")) a.seeds = parse_list(seeds);
-    } catch (const std::invalid_argument& e) {
-      throw app::UsageError(e.what());
-    }
+    if (cli.given("--robots")) a.robots = app::parse_int_list(robots, "--robots", 1);
+    if (cli.given("--seeds")) a.seeds = app::parse_int_list(seeds, "--seeds", 0);
     return run(a);
   });
 }

@@ -1,7 +1,10 @@
 #include "pixyslam/app/cli.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <limits>
 
 #include <CLI/CLI.hpp>
 
@@ -196,6 +199,27 @@ Cli::Option& add_domain(Cli& cli, std::vector<std::string>& dds_overrides) {
 
 void add_verbose(Cli& cli, bool& verbose) {
   cli.flag("--verbose", verbose, "print the whole effective configuration at start");
+}
+
+std::vector<int> parse_int_list(const std::string& text, const std::string& flag, int min) {
+  std::vector<int> out;
+  std::string::size_type start = 0;
+  while (start <= text.size()) {
+    const auto comma = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, comma - start);
+    std::string digits;
+    for (const char c : item) {
+      if (c != '_' && c != ' ') digits += c;  // 10_000
+    }
+    char* end = nullptr;
+    const long v = std::strtol(digits.c_str(), &end, 10);
+    if (digits.empty() || *end != '\0' || v < min || v > std::numeric_limits<int>::max()) {
+      throw UsageError(flag + ": '" + item + "' is not an integer >= " + std::to_string(min));
+    }
+    out.push_back(static_cast<int>(v));
+    start = comma + 1;
+  }
+  return out;
 }
 
 }  // namespace pixyslam::app

@@ -111,33 +111,30 @@ class DiscoveryListener : public fdds::DomainParticipantListener {
   }
 
   void on_publisher_discovery(fdds::DomainParticipant*, rtps::WriterDiscoveryInfo&& info) override {
-    const bool alive = info.status == rtps::WriterDiscoveryInfo::DISCOVERED_WRITER ||
-                       info.status == rtps::WriterDiscoveryInfo::CHANGED_QOS_WRITER;
-    EndpointEntry e;
-    e.writer = true;
-    e.topic = info.info.topicName().to_string();
-    e.type = info.info.typeName().to_string();
-    e.participant_prefix = to_text(info.info.guid().guidPrefix);
-    e.reliability = reliability_name(info.info.m_qos.m_reliability.kind);
-    e.durability = durability_name(info.info.m_qos.m_durability.kind);
-    e.type_information = info.info.has_type_information();
-    e.alive = alive;
-    store(to_text(info.info.guid()), std::move(e));
+    on_endpoint(info.info, true,
+                info.status == rtps::WriterDiscoveryInfo::DISCOVERED_WRITER ||
+                    info.status == rtps::WriterDiscoveryInfo::CHANGED_QOS_WRITER);
   }
 
   void on_subscriber_discovery(fdds::DomainParticipant*, rtps::ReaderDiscoveryInfo&& info) override {
-    const bool alive = info.status == rtps::ReaderDiscoveryInfo::DISCOVERED_READER ||
-                       info.status == rtps::ReaderDiscoveryInfo::CHANGED_QOS_READER;
+    on_endpoint(info.info, false,
+                info.status == rtps::ReaderDiscoveryInfo::DISCOVERED_READER ||
+                    info.status == rtps::ReaderDiscoveryInfo::CHANGED_QOS_READER);
+  }
+
+  // A writer's or reader's announcement (WriterProxyData / ReaderProxyData).
+  template <class ProxyData>
+  void on_endpoint(const ProxyData& data, bool writer, bool alive) {
     EndpointEntry e;
-    e.writer = false;
-    e.topic = info.info.topicName().to_string();
-    e.type = info.info.typeName().to_string();
-    e.participant_prefix = to_text(info.info.guid().guidPrefix);
-    e.reliability = reliability_name(info.info.m_qos.m_reliability.kind);
-    e.durability = durability_name(info.info.m_qos.m_durability.kind);
-    e.type_information = info.info.has_type_information();
+    e.writer = writer;
+    e.topic = data.topicName().to_string();
+    e.type = data.typeName().to_string();
+    e.participant_prefix = to_text(data.guid().guidPrefix);
+    e.reliability = reliability_name(data.m_qos.m_reliability.kind);
+    e.durability = durability_name(data.m_qos.m_durability.kind);
+    e.type_information = data.has_type_information();
     e.alive = alive;
-    store(to_text(info.info.guid()), std::move(e));
+    store(to_text(data.guid()), std::move(e));
   }
 
   std::map<std::string, ParticipantEntry> participants() const {
