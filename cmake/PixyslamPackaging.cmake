@@ -50,7 +50,6 @@ set(CPACK_PACKAGE_CONTACT "pixyslam maintainers <pixyslam@localhost>")
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
-set(CPACK_DEBIAN_PACKAGE_DEPENDS "fastdds-tools")
 # Every file under /etc is a conffile: an upgrade keeps the user's edits.
 file(GLOB_RECURSE pixyslam_config_files RELATIVE ${PROJECT_SOURCE_DIR}/config ${PROJECT_SOURCE_DIR}/config/*)
 set(pixyslam_conffiles "${PIXYSLAM_SYSCONFDIR}/default/pixyslam\n")
@@ -58,5 +57,11 @@ foreach(f IN LISTS pixyslam_config_files)
   string(APPEND pixyslam_conffiles "${PIXYSLAM_SYSCONFDIR}/pixyslam/${f}\n")
 endforeach()
 file(WRITE ${PROJECT_BINARY_DIR}/debian/conffiles "${pixyslam_conffiles}")
-set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA ${PROJECT_BINARY_DIR}/debian/conffiles)
+# Maintainer scripts: the pixyslam system user (postinst), services stopped
+# before removal (prerm), state and user gone on purge (postrm).
+set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA ${PROJECT_BINARY_DIR}/debian/conffiles
+  ${PROJECT_SOURCE_DIR}/packaging/debian/postinst ${PROJECT_SOURCE_DIR}/packaging/debian/prerm
+  ${PROJECT_SOURCE_DIR}/packaging/debian/postrm)
+set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
+set(CPACK_DEBIAN_PACKAGE_DEPENDS "fastdds-tools, adduser")
 include(CPack)
