@@ -68,7 +68,7 @@ struct Arguments {
 };
 
 int run(const Arguments& args) {
-  dds::DdsOptions dds_options = dds::read_dds_options_file(args.config, PIXYSLAM_DEFAULT_PROFILES_FILE);
+  dds::DdsOptions dds_options = dds::read_dds_options_file(args.config, dds::default_profiles_file());
   dds::resolve_settings(dds_options, args.dds_overrides);
 
   Received r;

@@ -232,7 +232,7 @@ int run(const LaunchCommandLine& args, const std::map<std::string, std::string>&
     // processes: this process's environment, then the host's deployment settings.
     dds::DdsOptions options;
     const std::string profiles = variables["config_dir"] + "/dds/profiles.xml";
-    options.profiles_file = std::filesystem::exists(profiles) ? profiles : PIXYSLAM_DEFAULT_PROFILES_FILE;
+    options.profiles_file = std::filesystem::exists(profiles) ? profiles : dds::default_profiles_file();
     dds::resolve_settings(options);
     const auto host_env = launcher::host_environment(deployment, args.host);
     dds::apply_environment(options, [&](const char* name) -> const char* {

@@ -36,9 +36,6 @@
 #ifndef PIXYSLAM_TOOL_NAME  // pixyslam_spy or pixyslam_log: the same program
 #define PIXYSLAM_TOOL_NAME "pixyslam_spy"
 #endif
-#ifndef PIXYSLAM_DEFAULT_PROFILES_FILE
-#define PIXYSLAM_DEFAULT_PROFILES_FILE ""
-#endif
 
 namespace {
 
@@ -69,13 +66,13 @@ struct DdsArguments {
   void add_to(pixyslam::app::Cli& command) {
     command
         .option("--config", config,
-                std::string("a YAML with a dds: mapping (default ") + PIXYSLAM_DEFAULT_PROFILES_FILE + ", domain 0)")
+                std::string("a YAML with a dds: mapping (default ") + pixyslam::dds::default_profiles_file() + ", domain 0)")
         .existing_file()
         .type("FILE");
     pixyslam::app::add_domain(command, overrides);
   }
   pixyslam::dds::DdsOptions resolve() const {
-    pixyslam::dds::DdsOptions o = pixyslam::dds::read_dds_options_file(config, PIXYSLAM_DEFAULT_PROFILES_FILE);
+    pixyslam::dds::DdsOptions o = pixyslam::dds::read_dds_options_file(config, pixyslam::dds::default_profiles_file());
     pixyslam::dds::resolve_settings(o, overrides);
     return o;
   }

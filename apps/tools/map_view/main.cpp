@@ -24,9 +24,6 @@
 #include "pixyslam/map_view/map_log.h"
 #include "pixyslam/map_view/map_view_commands.h"
 
-#ifndef PIXYSLAM_DEFAULT_PROFILES_FILE
-#define PIXYSLAM_DEFAULT_PROFILES_FILE ""
-#endif
 
 namespace {
 
@@ -41,7 +38,7 @@ struct ViewArguments {
     command
         .option("--config", config,
                 std::string("a map_view.yaml (e.g. config/map_view.yaml); live default: ") +
-                    PIXYSLAM_DEFAULT_PROFILES_FILE + ", domain 0")
+                    pixyslam::dds::default_profiles_file() + ", domain 0")
         .existing_file()
         .type("FILE");
     command.option("--width", width, "image width in pixels (default: the config's)").type("N");
@@ -55,8 +52,8 @@ struct ViewArguments {
   pixyslam::map_view::MapViewOptions load(const pixyslam::app::Cli& command, std::vector<std::string>& dds_overrides) const {
     using namespace pixyslam::map_view;
     MapViewOptions o;
-    o.dds.profiles_file = PIXYSLAM_DEFAULT_PROFILES_FILE;
-    if (command.given("--config")) o = read_map_view_options_file(config, PIXYSLAM_DEFAULT_PROFILES_FILE);
+    o.dds.profiles_file = pixyslam::dds::default_profiles_file();
+    if (command.given("--config")) o = read_map_view_options_file(config, pixyslam::dds::default_profiles_file());
     dds_overrides = overrides;
     try {
       apply_overrides(o, dds_overrides);

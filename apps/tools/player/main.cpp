@@ -15,9 +15,6 @@
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_text.h"
 
-#ifndef PIXYSLAM_DEFAULT_PROFILES_FILE
-#define PIXYSLAM_DEFAULT_PROFILES_FILE ""
-#endif
 
 int main(int argc, char** argv) {
   using namespace pixyslam;
@@ -43,7 +40,7 @@ int main(int argc, char** argv) {
       .type("N");
   cli.option("--wait-timeout", o.wait_timeout_s, "then play anyway after S seconds").non_negative().type("S");
   cli.option("--config", dds_config,
-             std::string("YAML with a dds: mapping (default ") + PIXYSLAM_DEFAULT_PROFILES_FILE + ", domain 0)")
+             std::string("YAML with a dds: mapping (default ") + dds::default_profiles_file() + ", domain 0)")
       .existing_file()
       .type("FILE");
   app::add_domain(cli, dds_overrides);
@@ -56,7 +53,7 @@ int main(int argc, char** argv) {
         }
         if (quiet) o.progress_period_s = 0.0;
         player::validate(o.playback);
-        o.dds = dds::read_dds_options_file(dds_config, PIXYSLAM_DEFAULT_PROFILES_FILE);
+        o.dds = dds::read_dds_options_file(dds_config, dds::default_profiles_file());
         dds::resolve_settings(o.dds, dds_overrides);
       })) {
     return *failed;

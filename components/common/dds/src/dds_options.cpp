@@ -135,6 +135,12 @@ DdsOptions read_dds_options(config::YamlReader& reader, const std::string& confi
   return o;
 }
 
+std::string default_profiles_file() {
+  std::error_code error;
+  if (std::filesystem::exists(PIXYSLAM_SOURCE_PROFILES_FILE, error)) return PIXYSLAM_SOURCE_PROFILES_FILE;
+  return PIXYSLAM_INSTALLED_PROFILES_FILE;
+}
+
 DdsOptions read_dds_options_file(const std::string& yaml_path, const std::string& default_profiles_file) {
   if (yaml_path.empty()) {
     DdsOptions o;
