@@ -63,10 +63,10 @@ int main(int argc, char** argv) {
       camera_options->image_height_px = options.pixy.camera.image_height_px;
     }
     if (camera_options) {
-      if (!camera_input.empty()) camera_options->input = camera_input;
       for (const std::string& a : parameters::take_section(args.overrides, "camera")) {
         parameters::apply_override(*camera_options, camera::camera_source_parameters(), "camera", a);
       }
+      if (!camera_input.empty()) camera_options->input = camera_input;  // the flag after --set
       camera::validate(*camera_options);
       bridge::apply_command_line(args, camera_options->input, options.dds);
       return;
@@ -76,6 +76,9 @@ int main(int argc, char** argv) {
       throw std::invalid_argument("--camera: this pixy_bridge was built without the camera backend");
     }
 #endif
+    if (!parameters::take_section(args.overrides, "camera").empty()) {
+      throw std::invalid_argument("--set camera.KEY=V needs the camera backend: --camera INPUT or a camera: section");
+    }
     bridge::apply_command_line(args, options.serial_device, options.dds);
   });
   if (bad) return *bad;

@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
   if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("slam_estimator", [&] {
     slam_node::EstimatorOptions options = slam_node::read_estimator_options_file(config);
-    if (!seed.empty()) overrides.insert(overrides.begin(), "filter.seed=" + seed);
+    if (!seed.empty()) overrides.push_back("filter.seed=" + seed);  // after --set: the flag wins
     try {
       slam_node::apply_overrides(options, overrides);
     } catch (const std::invalid_argument& e) {

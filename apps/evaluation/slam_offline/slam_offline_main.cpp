@@ -97,8 +97,8 @@ int run(const Args& args) {
   config::YamlReader filter_yaml = root.child("filter");
   slam::FilterOptions options = slam::read_filter_options(filter_yaml);
   std::vector<std::string> overrides;
-  if (!args.seed.empty()) overrides.push_back("filter.seed=" + args.seed);
   overrides.insert(overrides.end(), args.sets.begin(), args.sets.end());
+  if (!args.seed.empty()) overrides.push_back("filter.seed=" + args.seed);  // after --set: the flag wins
   // world. (sim) and mrclam. (mrclam) apply to those sections; the rest to filter:.
   const std::vector<std::string> world_sets = parameters::take_section(overrides, "world");
   const std::vector<std::string> mrclam_sets = parameters::take_section(overrides, "mrclam");

@@ -45,12 +45,14 @@ int main(int argc, char** argv) {
         c = robot_sim::read_robot_sim_process_config(
             config, cli.given("--pixy-config") ? pixy_config : folder + "/pixy_bridge.yaml",
             cli.given("--encoder-config") ? encoder_config : folder + "/encoder_bridge.yaml");
+        overrides.insert(overrides.end(), dds_overrides.begin(), dds_overrides.end());  // --domain last: it wins
+        robot_sim::apply_overrides(c, overrides);
+        // The dedicated flags after --set, as everywhere: the narrower statement wins.
         if (cli.given("--duration")) c.run.duration_s = duration_s;
         if (cli.given("--arduino-link")) c.run.arduino_link = arduino_link;
         if (cli.given("--pixy-link")) c.run.pixy_link = pixy_link;
         if (cli.given("--camera-video")) c.run.camera_video = camera_video;
-        overrides.insert(overrides.end(), dds_overrides.begin(), dds_overrides.end());  // --domain last: it wins
-        robot_sim::apply_overrides(c, overrides);
+        robot_sim::validate(c.run);
       })) {
     return *failed;
   }

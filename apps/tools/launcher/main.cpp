@@ -224,7 +224,6 @@ int run(const LaunchCommandLine& args, const std::map<std::string, std::string>&
     std::fputs(launcher::arguments_text(plan).c_str(), stdout);
     return 0;
   }
-  std::filesystem::create_directories(run_dir);  // only once the file and its arguments are good
   if (!args.deployment.empty()) {
     const launcher::Deployment deployment = launcher::read_deployment(args.deployment);
     plan = launcher::plan_for_host(plan, deployment, args.host);
@@ -250,6 +249,7 @@ int run(const LaunchCommandLine& args, const std::map<std::string, std::string>&
                 args.deployment.c_str(), plan.processes.size(), plan.after_run.size());
   }
   if (args.duration_s >= 0.0) plan.duration_s = args.duration_s;
+  std::filesystem::create_directories(run_dir);  // only once the files and arguments are good
   char duration[48] = "";
   if (plan.duration_s > 0) std::snprintf(duration, sizeof(duration), ", for %.1f s", plan.duration_s);
   std::printf("[launch] %zu processes from %s, run folder %s%s\n", plan.processes.size(), launch_file.c_str(),

@@ -1,6 +1,7 @@
 #include "pixyslam/app/cli.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -206,19 +207,31 @@ std::vector<int> parse_int_list(const std::string& text, const std::string& flag
   std::string::size_type start = 0;
   while (start <= text.size()) {
     const auto comma = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, comma - start);
+    std::string item = text.substr(start, comma - start);
+    start = comma + 1;
+    const auto first = item.find_first_not_of(" \t");
+    if (first == std::string::npos) continue;  // "1,2," and "1,,2": no item there
+    item = item.substr(first, item.find_last_not_of(" \t") - first + 1);
+    // Digits, '_' only between two digits (10_000).
     std::string digits;
-    for (const char c : item) {
-      if (c != '_' && c != ' ') digits += c;  // 10_000
+    bool ok = true;
+    for (std::size_t i = 0; i < item.size(); ++i) {
+      const char c = item[i];
+      if (c == '_' && i > 0 && i + 1 < item.size() && std::isdigit(static_cast<unsigned char>(item[i - 1])) &&
+          std::isdigit(static_cast<unsigned char>(item[i + 1]))) {
+        continue;
+      }
+      if (!std::isdigit(static_cast<unsigned char>(c)) && !(i == 0 && c == '-')) ok = false;
+      digits += c;
     }
     char* end = nullptr;
-    const long v = std::strtol(digits.c_str(), &end, 10);
-    if (digits.empty() || *end != '\0' || v < min || v > std::numeric_limits<int>::max()) {
+    const long v = ok ? std::strtol(digits.c_str(), &end, 10) : 0;
+    if (!ok || digits.empty() || *end != '\0' || v < min || v > std::numeric_limits<int>::max()) {
       throw UsageError(flag + ": '" + item + "' is not an integer >= " + std::to_string(min));
     }
     out.push_back(static_cast<int>(v));
-    start = comma + 1;
   }
+  if (out.empty()) throw UsageError(flag + ": no value in '" + text + "'");
   return out;
 }
 

@@ -136,9 +136,15 @@ DdsOptions read_dds_options(config::YamlReader& reader, const std::string& confi
 }
 
 std::string default_profiles_file() {
+  // A program of the build tree uses its checkout's file; an installed one the
+  // package's (/etc/pixyslam/dds/profiles.xml, the file the services use).
   std::error_code error;
-  if (std::filesystem::exists(PIXYSLAM_SOURCE_PROFILES_FILE, error)) return PIXYSLAM_SOURCE_PROFILES_FILE;
-  return PIXYSLAM_INSTALLED_PROFILES_FILE;
+  const std::string exe = std::filesystem::read_symlink("/proc/self/exe", error).string();
+  const bool in_build_tree = !error && exe.rfind(std::string(PIXYSLAM_BUILD_TREE) + "/", 0) == 0;
+  if (!in_build_tree && std::filesystem::exists(PIXYSLAM_INSTALLED_PROFILES_FILE, error)) {
+    return PIXYSLAM_INSTALLED_PROFILES_FILE;
+  }
+  return PIXYSLAM_SOURCE_PROFILES_FILE;
 }
 
 DdsOptions read_dds_options_file(const std::string& yaml_path, const std::string& default_profiles_file) {

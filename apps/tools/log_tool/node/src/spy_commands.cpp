@@ -6,6 +6,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <deque>
+#include <iostream>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -436,7 +437,7 @@ int run_diagnostics(const dds::DdsOptions& options, double seconds, bool json, s
   wait(seconds, [] { return false; });
   std::lock_guard<std::mutex> lock(mutex);
   if (latest.empty()) {
-    out << "no diagnostics received in " << format_double(seconds) << " s\n";
+    (json ? std::cerr : out) << "no diagnostics received in " << format_double(seconds) << " s\n";  // JSON: stdout stays JSON
     return 1;
   }
   std::vector<msg::Diagnostics> reports;

@@ -96,8 +96,9 @@ Cli::Option& add_domain(Cli& cli, std::vector<std::string>& dds_overrides);
 // --verbose: the long form of what a process prints at start (the effective configuration).
 void add_verbose(Cli& cli, bool& verbose);
 
-// "1,2,10_000": comma-separated integers (blanks and '_' between digits
-// ignored), each at least `min`; UsageError naming `flag` for a bad or empty list.
+// "1, 2,10_000": comma-separated integers (blanks around an item and '_'
+// between two digits allowed, empty items skipped), each at least `min`;
+// UsageError naming `flag` for a bad item ("1 2") or an empty list.
 std::vector<int> parse_int_list(const std::string& text, const std::string& flag, int min);
 
 // "a=1,b=2,c" split into assignments at commas followed by KEY=.

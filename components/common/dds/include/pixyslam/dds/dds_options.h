@@ -52,9 +52,9 @@ bool announces_identity(const DdsOptions& options, bool secure);
 // `config_dir` resolves a relative profiles_file and security_dir. Throws config::ConfigError.
 DdsOptions read_dds_options(config::YamlReader& reader, const std::string& config_dir);
 
-// The profiles file a tool uses without --config: config/dds/profiles.xml of
-// the source tree it was built from while that exists, else the installed
-// /etc/pixyslam/dds/profiles.xml (the Debian package).
+// The profiles file a tool uses without --config: for a program in its build
+// tree config/dds/profiles.xml of the checkout, for an installed one the
+// package's /etc/pixyslam/dds/profiles.xml (the checkout's if that is absent).
 std::string default_profiles_file();
 
 // The `dds:` mapping of a YAML file (a tool's --config, e.g.
