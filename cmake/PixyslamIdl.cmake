@@ -9,7 +9,8 @@ find_program(FASTDDSGEN_EXECUTABLE fastddsgen REQUIRED)
 function(pixyslam_add_idl_library target)
   cmake_parse_arguments(ARG "" "IDL_DIR" "IDL_FILES" ${ARGN})
   set(out_dir ${CMAKE_CURRENT_BINARY_DIR}/${target}_generated)
-  file(MAKE_DIRECTORY ${out_dir})
+  set(tmp_dir ${CMAKE_CURRENT_BINARY_DIR}/${target}_fastddsgen_tmp)  # its preprocessed copies (else in /tmp)
+  file(MAKE_DIRECTORY ${out_dir} ${tmp_dir})
   set(idl_paths "")
   set(generated "")
   foreach(idl ${ARG_IDL_FILES})
@@ -21,7 +22,7 @@ function(pixyslam_add_idl_library target)
   endforeach()
   add_custom_command(
     OUTPUT ${generated}
-    COMMAND ${FASTDDSGEN_EXECUTABLE} -typeobject -replace -d ${out_dir} -I ${ARG_IDL_DIR} ${idl_paths}
+    COMMAND ${FASTDDSGEN_EXECUTABLE} -typeobject -replace -t ${tmp_dir} -d ${out_dir} -I ${ARG_IDL_DIR} ${idl_paths}
     DEPENDS ${idl_paths}
     WORKING_DIRECTORY ${out_dir}
     COMMENT "fastddsgen: ${ARG_IDL_FILES}"

@@ -22,19 +22,13 @@ with a `dds:` mapping), `--domain N`, `--set KEY=VALUE` (a parameter of the conf
 `pixyslam_log` is `pixyslam_spy` under its old name. Regenerate with
 `scripts/tool_help.sh > docs/tools.md`.
 TEXT
-# The subcommands of the tools that have them: each one's own --help.
-declare -A subcommands=(
-  [pixyslam_spy]="participants topics echo hz diagnostics info check print compare"
-  [map_view]="live render video"
-  [slam_offline]="sim mrclam hardware"
-  [pixyslam_calibrate]="camera odometry noise"
-)
 for tool in "${tools[@]}"; do
   [[ -x $bin/$tool ]] || continue  # optional parts (map_view, the optimiser) may be off
   printf '\n## `%s`\n\n```\n' "$tool"
   "$bin/$tool" --help 2>&1 | sed "s#$root#<checkout>#g"
   printf '```\n'
-  for sub in ${subcommands[$tool]:-}; do
+  # The subcommands it lists under "Subcommands:", each one's own --help.
+  for sub in $("$bin/$tool" --help | sed -n '/^Subcommands:/,/^$/s/^  \([a-z_-]*\) .*/\1/p'); do
     printf '\n### `%s %s`\n\n```\n' "$tool" "$sub"
     "$bin/$tool" "$sub" --help 2>&1 | sed "s#$root#<checkout>#g"
     printf '```\n'

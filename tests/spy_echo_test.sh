@@ -5,7 +5,8 @@
 # `echo` (YAML) one document, `echo` of a topic with a kept history (30
 # MapStates) the newest, `participants` the publisher with its pid and
 # host, `topics` its writer with the QoS of the profile, `hz` a rate; with
-# --json the same facts as JSON lines (parsed with python3's json).
+# --json the same facts as JSON lines (parsed with python3's json); `record`
+# of two topics by pattern holds the publisher's samples and the kept history.
 #   spy_echo_test.sh SPY PUBLISHER CONFIG_DIR
 set -euo pipefail
 spy=$1 publisher=$2 config=$3
@@ -103,6 +104,28 @@ echo "== hz"
 rate=$(grep -oE 'rate [0-9.]+' "$work/hz.txt" | grep -oE '[0-9.]+' || true)
 [[ -n "$rate" ]] || fail "hz printed no rate"
 awk -v r="$rate" 'BEGIN { exit !(r > 5 && r < 40) }' || fail "hz rate $rate Hz not near 20 Hz"
+
+echo "== record (like ros2 bag record): two topics by pattern, --duration"
+"$spy" record 'pixyslam/*' '!pixyslam/diagnostics' '!pixyslam/ground_truth' '!pixyslam/landmark_observation' \
+  '!pixyslam/optimised_map' --domain "$domain" --duration 2.5 --out "$work/rec.mcap" 2> "$work/record.log" \
+  || { cat "$work/record.log"; fail "record exited $?"; }
+cat "$work/record.log"
+grep -q "recording 2 topics to $work/rec.mcap" "$work/record.log" || fail "record did not select 2 topics"
+grep -q "stopped after 2.5 s" "$work/record.log" || fail "record did not stop after --duration"
+"$spy" print "$work/rec.mcap" --json > "$work/rec.json"
+python3 -c 'import json, sys
+rows = [json.loads(l) for l in open(sys.argv[1])]
+odo = [r for r in rows if r["topic"] == "pixyslam/odometry"]
+maps = [r for r in rows if r["topic"] == "pixyslam/map_state"]
+assert len(odo) >= 20, len(odo)  # 20 Hz for 2.5 s
+for r in odo:
+    m = r["message"]; s = m["header"]["seq"]
+    assert m["v_mps"] == s + 0.5 and m["encoder_samples"] == s + 3, m
+assert [r["message"]["header"]["seq"] for r in maps] == list(range(1, 31)), maps  # the kept history' \
+  "$work/rec.json" || fail "the recording does not hold the publisher's samples"
+status=0
+"$spy" record pixyslam/nothing --domain "$domain" --duration 1 --out "$work/bad.mcap" 2>/dev/null || status=$?
+[[ $status -eq 2 && ! -e "$work/bad.mcap" ]] || fail "record of an unknown topic gave $status, expected 2 and no file"
 
 echo "== unknown topic"
 status=0

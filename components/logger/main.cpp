@@ -12,21 +12,16 @@
 // Exit status: 0 after a clean stop, 2 for a configuration or command-line
 // error, 1 for any other failure (the first file could not be created, or
 // samples were lost to write failures).
-#include <chrono>
 #include <cstdio>
-#include <exception>
-#include <stdexcept>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "pixyslam/app/cli.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
-#include "pixyslam/config/yaml_reader.h"
-#include "pixyslam/config/yaml_text.h"
-#include "pixyslam/dds/cdr_payload.h"
-#include "pixyslam/logger_node/logger_node.h"
-#include "pixyslam/dds/topic_selection.h"
+#include "pixyslam/parameters/parameters.h"
+#include "pixyslam/logger_node/logger_run.h"
 
 int main(int argc, char** argv) {
   using namespace pixyslam;
@@ -53,18 +48,7 @@ int main(int argc, char** argv) {
   const std::optional<int> bad = app::configure("logger", [&] {
     options = logger_node::read_logger_options_file(config);
     if (!out.empty()) options.output_file = out;
-    if (cli.given("--topics")) {
-      const std::vector<std::string> patterns = config::split_comma_list(topics);
-      std::vector<std::string> known;
-      for (const pixyslam::dds::TopicInfo& t : pixyslam::dds::known_topics()) known.push_back(t.topic);
-      const pixyslam::dds::TopicSelection selection = pixyslam::dds::select_topics(patterns, known);
-      if (patterns.empty() || !selection.error.empty()) {
-        throw std::invalid_argument("--topics: " + (patterns.empty() ? std::string("empty list")
-                                                                     : "'" + patterns[selection.bad_pattern] +
-                                                                           "': " + selection.error));
-      }
-      options.topics = selection.topics;
-    }
+    if (cli.given("--topics")) options.topics = logger_node::select_known_topics(parameters::split_list(topics), "--topics");
     logger_node::apply_overrides(options, overrides);
   });
   if (bad) return *bad;
@@ -72,51 +56,5 @@ int main(int argc, char** argv) {
     std::printf("# logger: effective configuration\n%s", logger_node::to_yaml(options).c_str());
     std::fflush(stdout);
   }
-
-  try {
-    logger_node::LoggerNode node(options);
-    node.start();
-    std::fprintf(stderr, "logger: recording %zu topics to %s%s\n", options.topics.size(),
-                 options.output_file.c_str(), logger_node::rotation_enabled(options) ? " (rotating: _000, _001, ...)" : "");
-    while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
-      if (node.failed()) break;
-    }
-    node.stop();
-    const logger_node::LoggerCounters c = node.counters();
-    for (const logger_node::TopicCounters& t : c.topics) {
-      std::fprintf(stderr,
-                   "logger: %s: received %llu, written %llu, dropped %llu, seq gaps %llu, malformed %llu, "
-                   "seq jumps %llu\n",
-                   t.topic.c_str(), static_cast<unsigned long long>(t.received),
-                   static_cast<unsigned long long>(t.written), static_cast<unsigned long long>(t.dropped),
-                   static_cast<unsigned long long>(t.reader.seq_gaps),
-                   static_cast<unsigned long long>(t.reader.malformed),
-                   static_cast<unsigned long long>(t.reader.seq_jumps));
-    }
-    for (const logger_node::LoggedFile& f : c.files) {
-      std::fprintf(stderr, "logger: file %s: %llu messages, %llu chunks, %llu bytes\n", f.path.c_str(),
-                   static_cast<unsigned long long>(f.counters.messages),
-                   static_cast<unsigned long long>(f.counters.chunks),
-                   static_cast<unsigned long long>(f.counters.bytes_written));
-    }
-    std::fprintf(stderr, "logger: %s: %zu file(s), %llu messages, %llu chunks, %llu bytes; queue peak %zu messages / %zu bytes\n",
-                 options.output_file.c_str(), c.files.size(), static_cast<unsigned long long>(c.file.messages),
-                 static_cast<unsigned long long>(c.file.chunks),
-                 static_cast<unsigned long long>(c.file.bytes_written), c.queue_peak_messages,
-                 c.queue_peak_bytes);
-    if (!c.error.empty()) {
-      std::fprintf(stderr, "logger: recording failed: %s\n", c.error.c_str());
-      return 1;
-    }
-    if (c.write_failures > 0) {
-      std::fprintf(stderr, "logger: %llu write failure(s), samples lost while not recording; last: %s\n",
-                   static_cast<unsigned long long>(c.write_failures), c.last_write_error.c_str());
-      return 1;
-    }
-    std::fprintf(stderr, "logger: stopped (signal %d)\n", app::StopSignal::signal_number());
-    return 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "logger: %s\n", e.what());
-    return 1;
-  }
+  return logger_node::record_until_stopped(options, "logger");
 }

@@ -5,7 +5,7 @@
 // RMSE raw and aligned, and writes the trajectories to --out-dir. When the map
 // optimiser runs (pixyslam/optimised_map), the same for its newest solution
 // (keyframes against the truth, its landmarks) and its CPU time.
-//   sim_evaluator [--config config/slam_estimator.yaml] [--domain N] [--out-dir DIR] [--max-ate M]
+//   sim_evaluator [--config config/slam_estimator.yaml] [--set dds.KEY=V ...] [--domain N] [--out-dir DIR] [--max-ate M]
 //                 [--max-optimised-ratio R]
 // Exit code 1 if the ATE exceeds --max-ate or nothing was estimated; with
 // --max-optimised-ratio also when no OptimisedMap arrived or its landmark RMSE
@@ -61,7 +61,7 @@ void print_topic(const dds::Reader<Message>& reader) {
 
 struct Arguments {
   std::string config;
-  std::vector<std::string> dds_overrides;  // --domain
+  std::vector<std::string> dds_overrides;  // --set dds.KEY=V, then --domain
   std::string out_dir;
   double max_ate_m = 0.0;
   double max_optimised_ratio = -1.0;  // < 0: not checked
@@ -175,7 +175,13 @@ int main(int argc, char** argv) {
   cli.option("--config", args.config, "a YAML with a dds: mapping (e.g. config/slam_estimator.yaml)")
       .existing_file()
       .type("FILE");
-  app::add_domain(cli, args.dds_overrides);
+  std::vector<std::string> sets, domain;
+  app::add_set(cli, sets, "dds.participant_profile=lan_multicast");
+  app::add_domain(cli, domain);
+  cli.footer("DDS settings for --set (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
+             parameters::help_text(pixyslam::dds::dds_parameters(), "dds") +
+             "Exit status: 0 scored, 1 ATE above --max-ate, nothing estimated or no OptimisedMap as required, 2 "
+             "command-line or config error.");
   cli.option("--out-dir", args.out_dir, "write DIR/trajectory.csv and DIR/ground_truth.csv").type("DIR");
   cli.option("--max-ate", args.max_ate_m, "exit 1 if the pose ATE is above M (0: no check)")
       .type("M")
@@ -185,5 +191,7 @@ int main(int argc, char** argv) {
       .type("R")
       .non_negative();
   if (const auto done = cli.parse(argc, argv)) return *done;
+  args.dds_overrides = sets;
+  args.dds_overrides.insert(args.dds_overrides.end(), domain.begin(), domain.end());
   return app::run_main("sim_evaluator", [&] { return sim_evaluator::run(args); });
 }

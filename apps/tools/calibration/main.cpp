@@ -36,6 +36,7 @@
 #include "pixyslam/calibration/noise_calibration.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/yaml_text.h"
+#include "pixyslam/parameters/parameters.h"
 #include "pixyslam/encoder/encoder_options.h"
 #include "pixyslam/pixy/pixy_options.h"
 #include "pixyslam/slam/slam_options_yaml.h"
@@ -77,7 +78,7 @@ void write_file(const std::string& path, const std::string& text) {
 // "--straight a.txt=1.5,b.txt=2": recordings with their measured truth.
 std::vector<calibration::OdometryRun> read_runs(const std::string& flag, const std::string& list, double scale) {
   std::vector<calibration::OdometryRun> runs;
-  for (const std::string& item : config::split_comma_list(list)) {
+  for (const std::string& item : parameters::split_list(list)) {
     const std::size_t eq = item.rfind('=');
     std::size_t used = 0;
     double truth = 0.0;
@@ -228,7 +229,7 @@ int noise(const Flags& args, int robot, bool with_ground_truth, bool fit_range_s
   if (fit_range_scale) keys.insert("range_scale");
   if (args.has("keys")) {
     keys.clear();
-    for (const std::string& key : config::split_comma_list(args.get("keys"))) {
+    for (const std::string& key : parameters::split_list(args.get("keys"))) {
       if (key != "v_sigma" && key != "w_sigma" && key != "range_sigma" && key != "bearing_sigma" &&
           key != "range_scale" && key != "range_exponent" && key != "odometry_delay" && key != "error_correlation") {
         throw std::invalid_argument("--keys: unknown value '" + key +

@@ -4,6 +4,7 @@
 //   pixyslam_spy echo TOPIC [--json] [--count N] [--duration S] [DDS options]
 //   pixyslam_spy hz TOPIC [--json] [--duration S]           [DDS options]
 //   pixyslam_spy diagnostics [--json] [--duration S]        [DDS options]
+//   pixyslam_spy record [TOPIC ...] [--out FILE.mcap] [--duration S] [--set logger.KEY=V] [DDS options]
 //   pixyslam_spy info FILE.mcap [--json]
 //   pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]
 //   pixyslam_spy print FILE.mcap [--topic T] [--json]
@@ -18,6 +19,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <exception>
 #include <iostream>
 #include <stdexcept>
@@ -30,8 +32,9 @@
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
-#include "pixyslam/config/yaml_text.h"
+#include "pixyslam/parameters/parameters.h"
 #include "pixyslam/log_tool/spy_commands.h"
+#include "pixyslam/logger_node/logger_run.h"
 
 #ifndef PIXYSLAM_TOOL_NAME  // pixyslam_spy or pixyslam_log: the same program
 #define PIXYSLAM_TOOL_NAME "pixyslam_spy"
@@ -78,14 +81,24 @@ struct DdsArguments {
   }
 };
 
+// pixyslam_YYYY_MM_DD-HH_MM_SS.mcap in local time, as ros2 bag names its bags.
+std::string default_recording_name() {
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&now, &local);
+  char name[64];
+  std::strftime(name, sizeof(name), "pixyslam_%Y_%m_%d-%H_%M_%S.mcap", &local);
+  return name;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
   app::Cli cli{PIXYSLAM_TOOL_NAME,
-               "Inspects the live system (participants, topics, echo, hz, diagnostics) and its recordings (info, "
-               "check, print, compare), decoding with the project's own types."};
+               "Inspects the live system (participants, topics, echo, hz, diagnostics), records it (record) and "
+               "reads its recordings (info, check, print, compare), decoding with the project's own types."};
   cli.footer(std::string(kTopics) + "\nExit status: 0 ok, 1 check failed / too few samples / file unreadable or "
                                     "damaged, 2 command-line or config error.");
   DdsArguments dds_args;
@@ -125,6 +138,26 @@ int main(int argc, char** argv) {
   hz.flag("--json", json, "a JSON line every second and one for the summary");
   add_duration(hz, "5");
   dds_args.add_to(hz);
+
+  std::vector<std::string> record_topics;
+  std::string record_out;
+  std::vector<std::string> record_sets;
+  app::Cli& record =
+      cli.subcommand("record", "records topics to an MCAP file until Ctrl-C or --duration, like ros2 bag record");
+  record.option("topics", record_topics, "names or patterns, '!' to leave out (default: every topic)")
+      .type("TOPIC");
+  record
+      .option("--out", record_out,
+              "the recording (default pixyslam_YYYY_MM_DD-HH_MM_SS.mcap; a file holding data is kept and the next "
+              "free _NNN name written)")
+      .type("FILE.mcap");
+  add_duration(record, "0: until Ctrl-C");
+  app::add_set(record, record_sets, "logger.compression=lz4");
+  dds_args.add_to(record);
+  record.footer(std::string(kTopics) + "\nParameters for --set (and dds.KEY: the logger's --help):\n" +
+                parameters::help_text(logger_node::logger_parameters(), "logger") +
+                "Exit status: 0 stopped by Ctrl-C or --duration, 1 the recording failed or lost samples to write "
+                "failures, 2 command-line or config error.");
 
   std::string info_file;
   app::Cli& info = cli.subcommand("info", "a recording's topics, counts, rates and times");
@@ -172,8 +205,22 @@ int main(int argc, char** argv) {
       if (compare_files.size() != 2) throw app::UsageError("compare needs exactly two MCAP files");
       compare_request.first_path = compare_files[0];
       compare_request.second_path = compare_files[1];
-      for (std::string& field : config::split_comma_list(ignored)) compare_request.ignored.push_back(std::move(field));
+      for (std::string& field : parameters::split_list(ignored)) compare_request.ignored.push_back(std::move(field));
       return log_tool::run_compare(compare_request, std::cout);
+    }
+    if (record.chosen()) {
+      logger_node::LoggerOptions o;
+      try {
+        o.output_file = record_out.empty() ? default_recording_name() : record_out;
+        o.topics = logger_node::select_known_topics(record_topics.empty() ? std::vector<std::string>{"*"} : record_topics,
+                                                    "record");
+        o.dds = dds::read_dds_options_file(dds_args.config, dds::default_profiles_file());
+        record_sets.insert(record_sets.end(), dds_args.overrides.begin(), dds_args.overrides.end());
+        logger_node::apply_overrides(o, record_sets);
+      } catch (const std::invalid_argument& e) {
+        throw app::UsageError(e.what());
+      }
+      return logger_node::record_until_stopped(o, PIXYSLAM_TOOL_NAME, seconds < 0 ? 0.0 : seconds);
     }
     const dds::DdsOptions options = dds_args.resolve();
     if (participants.chosen()) return log_tool::run_participants(options, seconds < 0 ? 4.0 : seconds, json, std::cout);

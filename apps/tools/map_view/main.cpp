@@ -24,7 +24,6 @@
 #include "pixyslam/map_view/map_log.h"
 #include "pixyslam/map_view/map_view_commands.h"
 
-
 namespace {
 
 // The render options every command shares: --config, --width, --height, --no-truth.

@@ -13,7 +13,7 @@
 #include "pixyslam/app/cli.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
-#include "pixyslam/config/yaml_text.h"
+#include "pixyslam/parameters/parameters.h"
 
 
 int main(int argc, char** argv) {
@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
   if (const auto done = cli.parse(argc, argv)) return *done;
   if (const auto failed = app::configure("pixyslam_play", [&] {
         if (cli.given("--topics")) {
-          o.topics = config::split_comma_list(topics);
+          o.topics = parameters::split_list(topics);
           if (o.topics.empty()) throw std::invalid_argument("--topics needs at least one topic");
         }
         if (quiet) o.progress_period_s = 0.0;

@@ -19,6 +19,7 @@
 #include "pixyslam/sim/sim_world.h"
 #include "pixyslam/slam_node/estimator_node.h"
 #include "pixyslam/slam_node/map_state_conversions.h"
+#include "temp_dir.h"
 #include "raw_sample_writer.h"
 #include "sim_sensor_messages.h"
 
@@ -202,9 +203,9 @@ TEST(OptimizerNodeOptions, ShippedConfigTakesTheEstimatorsModels) {
 }
 
 TEST(OptimizerNodeOptions, ErrorsNameTheFileAndKey) {
-  const std::string dir = ::testing::TempDir();
+  const test::TempDir dir;
   const auto expect_error = [&](const std::string& text, const std::string& needle) {
-    const std::string path = dir + "/map_optimizer_test.yaml";
+    const std::string path = dir.file("map_optimizer_test.yaml");
     FILE* f = std::fopen(path.c_str(), "w");
     ASSERT_NE(f, nullptr);
     std::fputs(text.c_str(), f);

@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "pixyslam/dds/dds_options.h"
+#include "pixyslam/parameters/parameters.h"
 
 namespace pixyslam::app {
 
@@ -204,14 +205,7 @@ void add_verbose(Cli& cli, bool& verbose) {
 
 std::vector<int> parse_int_list(const std::string& text, const std::string& flag, int min) {
   std::vector<int> out;
-  std::string::size_type start = 0;
-  while (start <= text.size()) {
-    const auto comma = std::min(text.find(',', start), text.size());
-    std::string item = text.substr(start, comma - start);
-    start = comma + 1;
-    const auto first = item.find_first_not_of(" \t");
-    if (first == std::string::npos) continue;  // "1,2," and "1,,2": no item there
-    item = item.substr(first, item.find_last_not_of(" \t") - first + 1);
+  for (const std::string& item : parameters::split_list(text)) {  // "1,2," and "1,,2": no item there
     // Digits, '_' only between two digits (10_000).
     std::string digits;
     bool ok = true;

@@ -21,18 +21,4 @@ std::string yaml_quoted(const std::string& text) {
   return out + "\"";
 }
 
-std::vector<std::string> split_comma_list(const std::string& text) {
-  std::vector<std::string> items;
-  std::size_t begin = 0;
-  while (begin <= text.size()) {
-    const std::size_t end = std::min(text.find(',', begin), text.size());
-    std::string item = text.substr(begin, end - begin);
-    item.erase(0, item.find_first_not_of(" \t"));
-    item.erase(item.find_last_not_of(" \t") + 1);
-    if (!item.empty()) items.push_back(item);
-    begin = end + 1;
-  }
-  return items;
-}
-
 }  // namespace pixyslam::config

@@ -37,6 +37,7 @@ constexpr EnvironmentKey kEnvironment[] = {
     {"PIXYSLAM_DDS_SERVER_ID", "discovery_server_id"},
     {"PIXYSLAM_DDS_SECURITY_DIR", "security_dir"},
     {"PIXYSLAM_DDS_TYPE_INFORMATION", "type_information"},
+    {"PIXYSLAM_DDS_LOG", "log_level"},
 };
 
 }  // namespace
@@ -82,6 +83,10 @@ const parameters::Table<DdsOptions>& dds_parameters() {
                            [](O& o) -> int& { return o.discovery_server_id; }),
         P::text<O>("security_dir", "DDS Security certificates and documents (relative: to the YAML file's folder)",
                    [](O& o) -> std::string& { return o.security_dir; }),
+        P::choice<O, DdsLogLevel>(
+            "log_level",
+            {{"error", DdsLogLevel::kError}, {"warning", DdsLogLevel::kWarning}, {"info", DdsLogLevel::kInfo}},
+            "how much of Fast DDS's own log reaches stderr", [](O& o) -> DdsLogLevel& { return o.log_level; }),
     };
     // true | false | auto: an optional<bool>, declared by hand.
     P::Parameter<O> announce;

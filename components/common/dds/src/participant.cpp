@@ -124,11 +124,11 @@ void apply_deployment(const DdsOptions& o, const std::string& name, bool observe
 fdds::DomainParticipant* create_participant(const DdsOptions& options, const std::string& name,
                                             fdds::DomainParticipantListener* listener) {
   register_all_type_objects();
-  // Fast DDS's own log: errors by default; PIXYSLAM_DDS_LOG=warning|info for more.
-  if (const char* level = std::getenv("PIXYSLAM_DDS_LOG")) {
-    const std::string l = level;
-    if (l == "warning") fdds::Log::SetVerbosity(fdds::Log::Warning);
-    if (l == "info") fdds::Log::SetVerbosity(fdds::Log::Info);
+  // Fast DDS's own log (dds.log_level).
+  switch (options.log_level) {
+    case DdsLogLevel::kError: fdds::Log::SetVerbosity(fdds::Log::Error); break;
+    case DdsLogLevel::kWarning: fdds::Log::SetVerbosity(fdds::Log::Warning); break;
+    case DdsLogLevel::kInfo: fdds::Log::SetVerbosity(fdds::Log::Info); break;
   }
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   if (!options.profiles_file.empty() &&

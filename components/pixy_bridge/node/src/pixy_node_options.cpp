@@ -52,12 +52,8 @@ void validate_node(const PixyNodeOptions& o) {
 
 void apply_overrides(PixyNodeOptions& o, std::vector<std::string>& assignments) {
   for (const std::string& a : parameters::take_section(assignments, "pixy")) {
-    const std::string key = a.substr(0, a.find('=')).substr(5);
-    if (parameters::find(pixy::frame_rate_parameters(), key) != nullptr) {
-      parameters::apply_override(o.pixy.rate, pixy::frame_rate_parameters(), "pixy", a);
-    } else {
-      parameters::apply_override(o.pixy.camera, pixy::camera_parameters(), "pixy", a);
-    }
+    parameters::apply_override_to_either(o.pixy.rate, pixy::frame_rate_parameters(), o.pixy.camera,
+                                         pixy::camera_parameters(), "pixy", a);
   }
   pixy::validate(o.pixy.camera);
   pixy::validate(o.pixy.rate);

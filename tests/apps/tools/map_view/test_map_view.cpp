@@ -21,6 +21,7 @@
 #include "pixyslam/map_view/map_view_options.h"
 #include "pixyslam/map_view/msg_conversion.h"
 #include "pixyslam/map_view/render_map.h"
+#include "temp_dir.h"
 
 namespace pixyslam::map_view {
 namespace {
@@ -28,12 +29,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 namespace fs = std::filesystem;
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("pixyslam_test_map_view_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 
 // Covariance with principal std devs (s1, s2), major axis at `angle` (CCW from x).
 LandmarkView landmark_with(double x, double y, double s1, double s2, double angle) {
@@ -644,7 +639,8 @@ void write_log(const std::string& path, int steps, bool with_map_channel, int op
 TEST(MapViewLog, RendersLogWrittenWithMcapWriter) {
   // PIXYSLAM_MAP_VIEW_FIXTURE_DIR (set by ctest): also leave the logs there for the CLI test.
   const char* fixture = std::getenv("PIXYSLAM_MAP_VIEW_FIXTURE_DIR");
-  const fs::path dir = fixture != nullptr ? fs::path(fixture) : temp_dir("log");
+  const test::TempDir temp("pixyslam_test_map_view");
+  const fs::path dir = fixture != nullptr ? fs::path(fixture) : fs::path(temp.path());
   fs::create_directories(dir);
   const std::string log_path = (dir / "with_map.mcap").string();
   write_log(log_path, 40, true);
@@ -686,7 +682,8 @@ TEST(MapViewLog, RendersLogWrittenWithMcapWriter) {
 }
 
 TEST(MapViewLog, ReplaysTheOptimisedMapsOfALog) {
-  const fs::path dir = temp_dir("optimised");
+  const test::TempDir temp("pixyslam_test_map_view");
+  const fs::path dir = temp.path();
   const std::string path = (dir / "optimised.mcap").string();
   write_log(path, 40, true, 10);
   const MapLog log = MapLog::read(path);
@@ -724,7 +721,8 @@ TEST(MapViewLog, ReplaysTheOptimisedMapsOfALog) {
 }
 
 TEST(MapViewLog, BadLogsAreLogErrorsNamingTheFile) {
-  const fs::path dir = temp_dir("bad");
+  const test::TempDir temp("pixyslam_test_map_view");
+  const fs::path dir = temp.path();
   const std::string missing = (dir / "missing.mcap").string();
   try {
     MapLog::read(missing);
@@ -774,7 +772,8 @@ TEST(MapViewLog, FrameTimes) {
 }
 
 TEST(FrameSink, WritesPngSequenceAndMjpgVideo) {
-  const fs::path dir = temp_dir("sink");
+  const test::TempDir temp("pixyslam_test_map_view");
+  const fs::path dir = temp.path();
   const cv::Size size(160, 120);
   cv::Mat frame(size, CV_8UC3, cv::Scalar(255, 255, 255));
   {

@@ -16,6 +16,7 @@
 
 #include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/config/yaml_reader.h"
+#include "temp_dir.h"
 
 namespace pixyslam::config {
 namespace {
@@ -243,37 +244,12 @@ TEST(YamlReader, NonScalarKeyIsAConfigErrorNamingTheLine) {
 namespace pixyslam::config {
 namespace {
 
-// A fresh temporary directory, removed with everything in it at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "pixyslam_yaml_XXXXXX").string();
-    if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  std::string file(const std::string& name, const std::string& text) const {
-    const std::string p = (path_ / name).string();
-    std::ofstream(p, std::ios::binary) << text;
-    return p;
-  }
-  std::string path() const { return path_.string(); }
-
- private:
-  std::filesystem::path path_;
-};
-
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 // Was: yaml-cpp read the directory through an ifstream and std::ios_base::failure
 // escaped (encoder_bridge, pixy_bridge and logger aborted, exit 134).
 TEST(YamlReaderFiles, DirectoryIsAConfigErrorNamingIt) {
-  const TempDir dir;
+  const test::TempDir dir;
   const std::string m = config_error_of([&] { YamlReader::from_file(dir.path()); });
   EXPECT_TRUE(contains(m, dir.path() + ": not a regular file")) << m;
   EXPECT_TRUE(contains(m, "directory")) << m;
@@ -283,7 +259,7 @@ TEST(YamlReaderFiles, DirectoryIsAConfigErrorNamingIt) {
 
 // Was: YAML::LoadFile opened the FIFO and waited for a writer for ever.
 TEST(YamlReaderFiles, FifoIsRejectedWithoutWaitingForAWriter) {
-  const TempDir dir;
+  const test::TempDir dir;
   const std::string fifo = dir.path() + "/config.yaml";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   const std::string m = config_error_of([&] { YamlReader::from_file(fifo); });
@@ -292,15 +268,15 @@ TEST(YamlReaderFiles, FifoIsRejectedWithoutWaitingForAWriter) {
 
 // Was: no limit (48 MB of YAML took 4 GB of memory).
 TEST(YamlReaderFiles, FileOverTheSizeLimitIsRejectedBeforeParsing) {
-  const TempDir dir;
+  const test::TempDir dir;
   // A comment padded to exactly the limit still loads,
   std::string text = "a: 1\n#";
   text += std::string(kMaxConfigFileBytes - text.size() - 1, 'x') + "\n";
   ASSERT_EQ(text.size(), kMaxConfigFileBytes);
-  const std::string at_limit = dir.file("at_limit.yaml", text);
+  const std::string at_limit = dir.write("at_limit.yaml", text);
   EXPECT_EQ(YamlReader::from_file(at_limit).integer("a", 0, 5), 1);
   // one byte more does not: the message names the file and both sizes.
-  const std::string over = dir.file("over.yaml", text + "\n");
+  const std::string over = dir.write("over.yaml", text + "\n");
   const std::string m = config_error_of([&] { YamlReader::from_file(over); });
   EXPECT_TRUE(contains(m, over + ": file is " + std::to_string(kMaxConfigFileBytes + 1) + " bytes")) << m;
   EXPECT_TRUE(contains(m, std::to_string(kMaxConfigFileBytes))) << m;
@@ -337,8 +313,8 @@ TEST(YamlReaderDuplicates, DuplicateSectionIsAnError) {
 }
 
 TEST(YamlReaderDuplicates, DuplicateInANestedMappingOfAFileNamesFilePathAndBothLines) {
-  const TempDir dir;
-  const std::string path = dir.file("nested.yaml",
+  const test::TempDir dir;
+  const std::string path = dir.write("nested.yaml",
                                     "a: 1\n"
                                     "outer:\n"
                                     "  inner:\n"

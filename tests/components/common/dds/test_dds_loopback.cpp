@@ -306,7 +306,8 @@ TEST(DdsOptions, EnvironmentOverridesEachSetting) {
                                                {"PIXYSLAM_DDS_SERVER", "10.1.0.3:11811"},
                                                {"PIXYSLAM_DDS_SERVER_ID", "1"},
                                                {"PIXYSLAM_DDS_SECURITY_DIR", "/sec"},
-                                               {"PIXYSLAM_DDS_TYPE_INFORMATION", "false"}};
+                                               {"PIXYSLAM_DDS_TYPE_INFORMATION", "false"},
+                                               {"PIXYSLAM_DDS_LOG", "warning"}};
   auto lookup = [&](const char* name) -> const char* {
     const auto it = env.find(name);
     return it == env.end() ? nullptr : it->second.c_str();
@@ -319,6 +320,7 @@ TEST(DdsOptions, EnvironmentOverridesEachSetting) {
   EXPECT_EQ(o.initial_peers, (std::vector<std::string>{"10.1.0.1", "10.1.0.2"}));
   EXPECT_EQ(o.discovery_server, "10.1.0.3:11811");
   EXPECT_EQ(o.discovery_server_id, 1);
+  EXPECT_EQ(o.log_level, DdsLogLevel::kWarning);
   EXPECT_EQ(o.security_dir, "/sec");
   EXPECT_FALSE(o.type_information);
   // Nothing set: nothing changes.
@@ -332,7 +334,8 @@ TEST(DdsOptions, BadEnvironmentNamesTheVariable) {
            {"PIXYSLAM_DDS_DOMAIN", "300"},
            {"PIXYSLAM_DDS_PEERS", "10.0.0.1,nope"},
            {"PIXYSLAM_DDS_SERVER", "10.0.0.1"},
-           {"PIXYSLAM_DDS_TYPE_INFORMATION", "maybe"}}) {
+           {"PIXYSLAM_DDS_TYPE_INFORMATION", "maybe"},
+           {"PIXYSLAM_DDS_LOG", "verbose"}}) {
     DdsOptions o;
     try {
       apply_environment(o, [&](const char* n) { return n == name ? value.c_str() : nullptr; });

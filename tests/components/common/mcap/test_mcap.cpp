@@ -22,29 +22,12 @@
 #include "pixyslam/mcap/crc32.h"
 #include "pixyslam/mcap/mcap_reader.h"
 #include "pixyslam/mcap/mcap_writer.h"
+#include "temp_dir.h"
 
 namespace pixyslam::mcap {
 namespace {
 
 using Bytes = std::vector<std::uint8_t>;
-
-// A fresh directory under the system temp dir, removed with everything in it.
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (std::filesystem::temp_directory_path() / "test_mcap_XXXXXX").string();
-    if (::mkdtemp(tmpl.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = tmpl;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
 
 Bytes read_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -164,7 +147,7 @@ TEST(Crc32, MatchesBitwiseDefinitionAndIsIncremental) {
 // The smallest file: every byte hand-computed from the spec. CRCs were computed
 // independently (zlib.crc32) over the byte ranges the spec names.
 TEST(McapExactBytes, EmptyFile) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string path = dir.file("empty.mcap");
   McapWriterOptions options;
   options.library = "t";
@@ -209,7 +192,7 @@ TEST(McapExactBytes, EmptyFile) {
 
 // Unchunked: Schema, Channel and Message records go straight to the file.
 TEST(McapExactBytes, OneMessageUnchunked) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string path = dir.file("one.mcap");
   McapWriterOptions options;
   options.library = "t";
@@ -271,7 +254,7 @@ class McapRoundTrip : public ::testing::TestWithParam<Mode> {};
 TEST_P(McapRoundTrip, SchemasChannelsMessagesAndStatistics) {
   const Mode mode = GetParam();
   if (!mcap_compression_available(mode.compression)) GTEST_SKIP() << "compression not built in";
-  TempDir dir;
+  test::TempDir dir;
   const std::string path = dir.file("round_trip.mcap");
   McapWriterOptions options;
   options.chunk_size_bytes = mode.chunk_size_bytes;
@@ -376,7 +359,7 @@ class McapTruncation : public ::testing::TestWithParam<Mode> {};
 TEST_P(McapTruncation, EveryByteOffset) {
   const Mode mode = GetParam();
   if (!mcap_compression_available(mode.compression)) GTEST_SKIP() << "compression not built in";
-  TempDir dir;
+  test::TempDir dir;
   const std::string path = dir.file("full.mcap");
   McapWriterOptions options;
   options.chunk_size_bytes = mode.chunk_size_bytes;
@@ -446,7 +429,7 @@ INSTANTIATE_TEST_SUITE_P(Modes, McapTruncation,
 // What a killed writer leaves: the chunks written so far, then maybe a block of
 // zeros (a file system that had allocated but not written the tail).
 TEST(McapRecovery, CopyOfOpenFileAndZeroTail) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string path = dir.file("live.mcap");
   McapWriterOptions options;
   options.chunk_size_bytes = 1 << 20;  // nothing is written until flush_chunk()
@@ -498,7 +481,7 @@ class McapCorruption : public ::testing::TestWithParam<Mode> {};
 TEST_P(McapCorruption, FlippedChunkByteIsDetected) {
   const Mode mode = GetParam();
   if (!mcap_compression_available(mode.compression)) GTEST_SKIP() << "compression not built in";
-  TempDir dir;
+  test::TempDir dir;
   const std::string path = dir.file("good.mcap");
   McapWriterOptions options;
   options.chunk_size_bytes = mode.chunk_size_bytes;
@@ -551,7 +534,7 @@ INSTANTIATE_TEST_SUITE_P(Modes, McapCorruption,
                          mode_name);
 
 TEST(McapCorruption, SummaryByteIsDetectedBySummaryCrc) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string path = dir.file("good.mcap");
   McapWriterOptions options;
   options.chunk_size_bytes = 200;
@@ -569,7 +552,7 @@ TEST(McapCorruption, SummaryByteIsDetectedBySummaryCrc) {
 }
 
 TEST(McapCrc, DisabledCrcsAreZeroAndNotChecked) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string path = dir.file("no_crc.mcap");
   McapWriterOptions options;
   options.chunk_size_bytes = 200;
@@ -595,7 +578,7 @@ TEST(McapCrc, DisabledCrcsAreZeroAndNotChecked) {
 }
 
 TEST(McapIndex, ChunkIndexAndMessageIndexArePointedAtCorrectly) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string path = dir.file("indexed.mcap");
   McapWriterOptions options;
   options.chunk_size_bytes = 250;
@@ -616,7 +599,7 @@ TEST(McapIndex, ChunkIndexAndMessageIndexArePointedAtCorrectly) {
 }
 
 TEST(McapReaderErrors, NotMcapFilesThrowNamingTheFile) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string empty = dir.file("empty.mcap");
   write_bytes(empty, {});
   const std::string text = dir.file("text.mcap");
@@ -666,7 +649,7 @@ TEST(McapReaderErrors, GarbageAfterMagicDoesNotCrash) {
 // (The messages returned are not bounded: a Message Index opcode flipped into
 // a Message one is a well-formed Message record outside any chunk.)
 TEST(McapReaderErrors, RandomByteFlipsNeverCrash) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string path = dir.file("flips.mcap");
   McapWriterOptions options;
   options.chunk_size_bytes = 150;
@@ -698,7 +681,7 @@ TEST(McapReaderErrors, HugeLengthIsACutRecordNotAnAllocation) {
 }
 
 TEST(McapWriterErrors, FailuresThrowNamingTheFile) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string bad = dir.file("no/such/dir/x.mcap");
   try {
     McapWriter writer(bad);
@@ -733,14 +716,14 @@ TEST(McapWriterErrors, FailuresThrowNamingTheFile) {
 
 TEST(McapWriterErrors, UnavailableCompressionIsRefused) {
   if (mcap_compression_available(McapCompression::kLz4)) GTEST_SKIP() << "lz4 is built in";
-  TempDir dir;
+  test::TempDir dir;
   McapWriterOptions options;
   options.compression = McapCompression::kLz4;
   EXPECT_THROW(McapWriter(dir.file("x.mcap"), options), std::runtime_error);
 }
 
 TEST(McapWriter, DestructorClosesTheFile) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string path = dir.file("scoped.mcap");
   {
     McapWriterOptions options;
@@ -769,7 +752,7 @@ struct ManyChunks {
   std::uint64_t data_end = 0;         // offset of the Data End record
 };
 
-ManyChunks write_many_chunks(const TempDir& dir, int count, McapCompression compression) {
+ManyChunks write_many_chunks(const test::TempDir& dir, int count, McapCompression compression) {
   ManyChunks out;
   const std::string path = dir.file("many.mcap");
   McapWriterOptions options;
@@ -821,7 +804,7 @@ bool damage_recorded_at(const McapReader& reader, std::uint64_t offset) {
 // header still gives its length and its CRC checks it, so it is read too;
 // damaging its records as well loses that chunk alone.
 TEST(McapDamage, CorruptChunkLengthLosesAtMostThatChunk) {
-  TempDir dir;
+  test::TempDir dir;
   const ManyChunks log = write_many_chunks(dir, 3000, zstd_if_built());
   ASSERT_GE(log.chunks.size(), 20u);
   const std::size_t victim_index = log.chunks.size() / 2;
@@ -856,7 +839,7 @@ TEST(McapDamage, CorruptChunkLengthLosesAtMostThatChunk) {
 // it is still found and read; without the summary the reader scans past it
 // to its Message Index records and loses only it.
 TEST(McapDamage, DestroyedChunkPrefixResynchronisesAtTheNextChunk) {
-  TempDir dir;
+  test::TempDir dir;
   const ManyChunks log = write_many_chunks(dir, 1500, zstd_if_built());
   const std::size_t victim_index = 3;
   const McapChunkInfo& victim = log.chunks[victim_index];
@@ -883,7 +866,7 @@ TEST(McapDamage, DestroyedChunkPrefixResynchronisesAtTheNextChunk) {
 // A file cut in the middle of a chunk: not closed (not damaged), every chunk
 // before the cut read, "intact up to" the cut chunk.
 TEST(McapDamage, TruncatedMidChunkIsNotClosed) {
-  TempDir dir;
+  test::TempDir dir;
   for (const McapCompression compression : {McapCompression::kNone, zstd_if_built()}) {
     SCOPED_TRACE(mcap_compression_name(compression));
     const ManyChunks log = write_many_chunks(dir, 1500, compression);
@@ -913,7 +896,7 @@ TEST(McapDamage, TruncatedMidChunkIsNotClosed) {
 // in the data section, no index): the reader scans to the first record after
 // them and reads everything from there on.
 TEST(McapDamage, GarbageInUnchunkedFileResumesAtTheNextRecord) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string path = dir.file("unchunked.mcap");
   McapWriterOptions options;
   options.chunk_size_bytes = 0;
@@ -967,7 +950,7 @@ TEST(McapDamage, GarbageInUnchunkedFileResumesAtTheNextRecord) {
 // complete or as merely not closed), at most one chunk's messages are lost,
 // and what is read is what was written, in order.
 TEST(McapDamage, SingleByteCorruptionSweepIsAlwaysReportedAsDamage) {
-  TempDir dir;
+  test::TempDir dir;
   const ManyChunks log = write_many_chunks(dir, 1200, zstd_if_built());
   std::uint64_t largest_chunk = 0;
   for (const McapChunkInfo& c : log.chunks) largest_chunk = std::max(largest_chunk, c.message_count);

@@ -24,6 +24,7 @@
 
 #include "pixyslam/serial/pseudo_terminal.h"
 #include "pixyslam/serial/serial_port.h"
+#include "temp_dir.h"
 
 namespace pixyslam::serial {
 namespace {
@@ -66,25 +67,6 @@ bool exists(const std::string& path) {
   struct stat st {};
   return ::lstat(path.c_str(), &st) == 0;
 }
-
-// A fresh directory under TMPDIR, removed (with its files) at the end.
-class TempDir {
- public:
-  TempDir() {
-    const char* base = std::getenv("TMPDIR");
-    std::string templ = std::string(base && *base ? base : "/tmp") + "/pixyslam_serial_XXXXXX";
-    if (::mkdtemp(templ.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = templ;
-  }
-  ~TempDir() {
-    for (const char* f : {"/tty", "/file"}) ::unlink((path_ + f).c_str());
-    ::rmdir(path_.c_str());
-  }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
 
 TEST(SerialPty, RandomChunksArriveInOrderBothWays) {
   PseudoTerminal pty;
@@ -292,7 +274,7 @@ TEST(SerialPty, NonTerminalIsRejected) {
 }
 
 TEST(SerialPty, SymlinkIsCreatedReplacedAndRemoved) {
-  const TempDir dir;
+  const test::TempDir dir;
   const std::string link = dir.path() + "/tty";
   std::string slave;
   {

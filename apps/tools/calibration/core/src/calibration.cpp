@@ -6,7 +6,7 @@
 #include <variant>
 
 #include "pixyslam/config/yaml_reader.h"
-#include "pixyslam/config/yaml_text.h"
+#include "pixyslam/parameters/parameters.h"
 #include "pixyslam/encoder/arduino_line_parser.h"
 #include "pixyslam/encoder/wheel_odometry.h"
 
@@ -38,7 +38,7 @@ CsvTable read_csv(std::string_view text, const std::string& origin) {
     begin = end + 1;
     ++line_number;
     if (line.empty() || line[0] == '#') continue;
-    std::vector<std::string> fields = config::split_comma_list(line);
+    std::vector<std::string> fields = parameters::split_list(line);
     if (table.header.empty()) {
       table.header = fields;
       table.header_line = line_number;

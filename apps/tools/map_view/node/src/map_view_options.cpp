@@ -29,12 +29,7 @@ const parameters::Table<MapViewOptions>& map_view_parameters() {
 
 void apply_overrides(MapViewOptions& o, std::vector<std::string>& assignments) {
   for (const std::string& a : parameters::take_section(assignments, "map_view")) {
-    const std::string key = a.substr(0, a.find('=')).substr(9);
-    if (parameters::find(render_parameters(), key) != nullptr) {
-      parameters::apply_override(o.render, render_parameters(), "map_view", a);
-    } else {
-      parameters::apply_override(o, map_view_parameters(), "map_view", a);
-    }
+    parameters::apply_override_to_either(o.render, render_parameters(), o, map_view_parameters(), "map_view", a);
   }
   validate(o.render);
   parameters::check_ranges(o, map_view_parameters(), "map_view");

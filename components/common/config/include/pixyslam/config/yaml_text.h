@@ -13,8 +13,4 @@ std::string yaml_number(double value);
 // A double-quoted YAML string (" and \ escaped).
 std::string yaml_quoted(const std::string& text);
 
-// A comma-separated list from a flag or an environment variable ("a, b,,c" ->
-// a, b, c): items trimmed of spaces and tabs, empty ones dropped.
-std::vector<std::string> split_comma_list(const std::string& text);
-
 }  // namespace pixyslam::config

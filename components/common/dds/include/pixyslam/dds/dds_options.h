@@ -18,6 +18,9 @@ namespace pixyslam::dds {
 // the addresses of a deployment are settings applied on top of the profile
 // (docs/deployment.md). The default keeps all traffic on 127.0.0.1.
 // Keys, ranges and help: dds_parameters().
+// How much of Fast DDS's own log reaches stderr.
+enum class DdsLogLevel { kError, kWarning, kInfo };
+
 struct DdsOptions {
   int domain_id = 0;
   std::string profiles_file;  // XML; relative paths are resolved against the YAML file's folder
@@ -40,6 +43,7 @@ struct DdsOptions {
   // true | false | auto (unset: on, except with DDS Security, where the name is
   // "pixyslam" and no property is sent).
   std::optional<bool> announce_identity;
+  DdsLogLevel log_level = DdsLogLevel::kError;
 };
 
 // One declaration per setting: key below `dds:`, range or check, help.
@@ -67,7 +71,7 @@ DdsOptions read_dds_options_file(const std::string& yaml_path, const std::string
 // PIXYSLAM_DDS_PROFILES_FILE, PIXYSLAM_DDS_PROFILE, PIXYSLAM_DDS_INTERFACES and
 // PIXYSLAM_DDS_PEERS (comma-separated IPv4), PIXYSLAM_DDS_SERVER (ADDR:PORT),
 // PIXYSLAM_DDS_SERVER_ID, PIXYSLAM_DDS_SECURITY_DIR, PIXYSLAM_DDS_TYPE_INFORMATION
-// (true/false). Unset or empty variables
+// (true/false), PIXYSLAM_DDS_LOG (error/warning/info). Unset or empty variables
 // change nothing. Throws std::invalid_argument naming the variable and value.
 void apply_environment(DdsOptions& options, const std::function<const char*(const char*)>& getenv);
 

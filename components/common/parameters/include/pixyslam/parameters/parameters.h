@@ -329,6 +329,22 @@ void apply_override(Options& o, const Table<Options>& table, const std::string& 
   set_from_text(o, table, section, key.substr(section.size() + 1), assignment.substr(eq + 1));
 }
 
+// An override of one section whose keys two tables declare (one YAML mapping
+// read into two structs): to `first` when it declares the key, else to `second`
+// (which names a key neither declares).
+template <class First, class Second>
+void apply_override_to_either(First& first, const Table<First>& first_table, Second& second,
+                              const Table<Second>& second_table, const std::string& section,
+                              const std::string& assignment) {
+  const std::string key = assignment.substr(0, assignment.find('='));
+  const bool in_section = key.rfind(section + ".", 0) == 0;
+  if (in_section && find(first_table, key.substr(section.size() + 1)) != nullptr) {
+    apply_override(first, first_table, section, assignment);
+  } else {
+    apply_override(second, second_table, section, assignment);
+  }
+}
+
 // The section as YAML (nested mappings, each value with its unit as a comment).
 template <class Options>
 std::string to_yaml(const Options& o, const Table<Options>& table, const std::string& section) {
