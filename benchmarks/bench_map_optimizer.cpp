@@ -50,7 +50,7 @@ int run(int argc, char** argv) {
   app::Cli::Option& dataset_option =
       cli.option("--dataset", dataset, "a MRCLAM data set (exit 77 when the folder is absent); without: the simulated "
                                        "world of the config's world: section").type("DIR");
-  app::Cli::Option& robot_option = cli.option("--robot", robot, "the MRCLAM robot").range(1, 5).type("N");
+  app::Cli::Option& robot_option = cli.option("--robot", robot, "the MRCLAM robot").range(mrclam::kFirstRobot, mrclam::kLastRobot).type("N");
   dataset_option.needs(robot_option);
   robot_option.needs(dataset_option);
   app::add_config(cli, config_file, "filter: (and mrclam: or world:) options").required();

@@ -61,15 +61,16 @@ offline::RunInput first_frames(offline::RunInput input, std::size_t frames) {
 
 int run(int argc, char** argv) {
   std::string dataset, config_file, particles_text;
-  int robot = 0, frames_limit = -1, seed = 0;
+  int robot = 0, frames_limit = -1;
+  std::uint64_t seed = 0;
   app::Cli cli{"bench_mrclam_frame", "Filter speed on real data: one MRCLAM robot through the offline runner per "
                                      "particle count. Exit 77 when the data set folder is absent."};
   cli.option("--dataset", dataset, "the MRCLAM data set folder").required().type("DIR");
-  cli.option("--robot", robot, "the robot").required().range(1, 5).type("N");
+  cli.option("--robot", robot, "the robot").required().range(mrclam::kFirstRobot, mrclam::kLastRobot).type("N");
   app::add_config(cli, config_file, "filter: and mrclam: options").required();
   cli.option("--particles", particles_text, "particle counts, one run each").required().type("M1,M2,...");
   cli.option("--frames", frames_limit, "only the first F camera frames").range(1, 100000000).type("F");
-  cli.option("--seed", seed, "the filter's seed (default: the config's)").range(0, 2147483647).type("S");
+  cli.option("--seed", seed, "the filter's seed (default: the config's)").seed().type("S");
   if (const auto done = cli.parse(argc, argv)) return *done;
   if (!std::filesystem::is_directory(dataset)) {
     std::printf("SKIP: MRCLAM dataset folder %s not found\n", dataset.c_str());
@@ -80,7 +81,7 @@ int run(int argc, char** argv) {
     config::YamlReader root = config::YamlReader::from_file(config_file);
     config::YamlReader filter_yaml = root.child("filter");
     slam::FilterOptions options = slam::read_filter_options(filter_yaml);
-    if (cli.given("--seed")) options.seed = static_cast<std::uint64_t>(seed);
+    if (cli.given("--seed")) options.seed = seed;
     const offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
     root.finish();
 

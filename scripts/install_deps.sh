@@ -14,6 +14,7 @@ PACKAGES=(
   openssl iproute2 tcpdump
   podman runc debootstrap
   clang-14 libclang-rt-14-dev
+  cyclonedds-dev cyclonedds-tools
 )
 
 missing=()

@@ -1,6 +1,6 @@
 // encoder_bridge: the Arduino's wheel-encoder lines (serial) -> Odometry over
 // DDS at publish_rate_hz, until SIGINT/SIGTERM.
-//   encoder_bridge --config config/encoder_bridge.yaml [--device PATH] [--set KEY=VALUE ...] [--verbose]
+//   encoder_bridge --config config/encoder_bridge.yaml [--device PATH] [--set KEY=VALUE ...] [--domain N] [--verbose]
 // --device overrides encoder_bridge.serial_device; --set encoder_bridge.KEY=V,
 // node.KEY=V or dds.KEY=V a parameter. --verbose prints the effective configuration to
 // stdout; logs go to stderr. Exit status: 0 after a clean stop, 2 for a

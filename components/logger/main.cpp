@@ -1,5 +1,5 @@
 // logger: records DDS topics to an MCAP file until SIGINT/SIGTERM.
-//   logger --config config/logger.yaml [--out FILE.mcap] [--topics LIST] [--set KEY=VALUE ...] [--verbose]
+//   logger --config config/logger.yaml [--out FILE.mcap] [--topics LIST] [--set KEY=VALUE ...] [--domain N] [--verbose]
 // --out overrides logger.output_file (with rotation: the base of the names,
 // run.mcap -> run_000.mcap, run_001.mcap, ...); --topics logger.topics
 // (comma-separated names or patterns, as the config's list). --verbose prints the
@@ -36,7 +36,9 @@ int main(int argc, char** argv) {
                  "topics to record, comma-separated names or patterns (overrides logger.topics), e.g. "
                  "pixyslam/odometry,pixyslam/map_state or 'pixyslam/*,!pixyslam/diagnostics'")
       .type("LIST");
+  std::vector<std::string> domain;
   app::add_set(cli, overrides, "logger.compression=lz4");
+  app::add_domain(cli, domain);
   app::add_verbose(cli, verbose);
   cli.footer("logger parameters (logger:; topics apart):\n" +
              parameters::help_text(logger_node::logger_parameters(), "logger") +
@@ -49,6 +51,7 @@ int main(int argc, char** argv) {
     options = logger_node::read_logger_options_file(config);
     if (!out.empty()) options.output_file = out;
     if (cli.given("--topics")) options.topics = logger_node::select_known_topics(parameters::split_list(topics), "--topics");
+    overrides.insert(overrides.end(), domain.begin(), domain.end());  // --domain last: it wins
     logger_node::apply_overrides(options, overrides);
   });
   if (bad) return *bad;

@@ -1,7 +1,7 @@
 // map_optimizer: the map optimiser over DDS (components/map_optimizer): Odometry,
 // LandmarkObservation and the estimator's MapState in, OptimisedMap out, until
 // SIGINT/SIGTERM. Optional: the robot runs without it; it can run on another host.
-//   map_optimizer --config config/map_optimizer.yaml [--out-dir DIR] [--set KEY=VALUE ...]
+//   map_optimizer --config config/map_optimizer.yaml [--out-dir DIR] [--set KEY=VALUE ...] [--domain N]
 // --out-dir writes DIR/trajectory.csv (the final solution's keyframes) and
 // DIR/landmarks.csv at exit, in slam_offline's formats.
 #include <cstdio>
@@ -48,12 +48,15 @@ int main(int argc, char** argv) {
                   "optimizer:, dds:");
   cli.option("--out-dir", out_dir, "at exit, DIR/trajectory.csv (final keyframes) and DIR/landmarks.csv")
       .type("DIR");
+  std::vector<std::string> domain;
   app::add_set(cli, overrides, "optimizer.window_keyframes=50");
+  app::add_domain(cli, domain);
   cli.footer(map_optimizer_node::help_text());
   if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("map_optimizer", [&] {
     map_optimizer_node::OptimizerNodeOptions options = map_optimizer_node::read_optimizer_node_options_file(config);
     try {
+      overrides.insert(overrides.end(), domain.begin(), domain.end());  // --domain last: it wins
       map_optimizer_node::apply_overrides(options, overrides);
     } catch (const std::invalid_argument& e) {
       throw app::UsageError(std::string("--set: ") + e.what());

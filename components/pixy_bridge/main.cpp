@@ -2,7 +2,7 @@
 // per camera frame over DDS, until SIGINT/SIGTERM. With a `camera:` section it
 // reads a camera, video file or y4m stream instead and detects the colour codes
 // itself (a software Pixy, components/pixy_bridge/camera; docs/camera.md).
-//   pixy_bridge --config config/pixy_bridge.yaml [--device PATH] [--camera INPUT] [--set KEY=VALUE ...]
+//   pixy_bridge --config config/pixy_bridge.yaml [--device PATH] [--camera INPUT] [--set KEY=VALUE ...] [--domain N]
 //               [--verbose]
 // --device overrides node.serial_device (or camera.input), --camera selects the
 // camera backend reading INPUT (with the `camera:` settings, or the defaults),

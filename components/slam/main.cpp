@@ -1,7 +1,7 @@
 // slam_estimator: FastSLAM 2.0 over DDS. Odometry + LandmarkObservation in,
 // MapState out, until SIGINT/SIGTERM.
 //   slam_estimator --config config/slam_estimator.yaml [--seed S] [--out-dir DIR] [--checkpoint FILE]
-//                  [--set KEY=VALUE ...] [--verbose]
+//                  [--set KEY=VALUE ...] [--domain N] [--verbose]
 // --checkpoint (or estimator.checkpoint.file) saves the pose and map every
 // period and resumes from the file at start when it is fresh (a restart).
 // --out-dir writes DIR/trajectory.csv (every MapState's mean pose) and DIR/landmarks.csv at exit.
@@ -55,7 +55,9 @@ int main(int argc, char** argv) {
   cli.option("--checkpoint", checkpoint,
                  "save pose and map here every period, resume from it at start when fresh (estimator.checkpoint.file)")
       .type("FILE");
+  std::vector<std::string> domain;
   app::add_set(cli, overrides, "filter.particles=300");
+  app::add_domain(cli, domain);
   app::add_verbose(cli, verbose);
   cli.footer(slam_node::help_text());
   if (const auto done = cli.parse(argc, argv)) return *done;
@@ -63,6 +65,7 @@ int main(int argc, char** argv) {
     slam_node::EstimatorOptions options = slam_node::read_estimator_options_file(config);
     if (!seed.empty()) overrides.push_back("filter.seed=" + seed);  // after --set: the flag wins
     try {
+      overrides.insert(overrides.end(), domain.begin(), domain.end());  // --domain last: it wins
       slam_node::apply_overrides(options, overrides);
     } catch (const std::invalid_argument& e) {
       throw app::UsageError(std::string("--seed/--set: ") + e.what());

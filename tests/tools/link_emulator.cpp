@@ -103,13 +103,13 @@ std::vector<Phase> parse_schedule(const std::string& text) {
 
 int main(int argc, char** argv) {
   std::string a, b, schedule = "0:0:0";
-  int seed = 1;
+  std::uint64_t seed = 1;
   pixyslam::app::Cli cli{"link_emulator", "Forwards frames between two TAP devices with scheduled loss and delay."};
   cli.option("--a", a, "one end").required().type("NETNS:DEV");
   cli.option("--b", b, "the other end").required().type("NETNS:DEV");
   cli.option("--schedule", schedule, "from T seconds on, drop LOSS of the frames and delay them DELAY_MS")
       .type("T:LOSS:DELAY_MS,...");
-  cli.option("--seed", seed, "random seed of the losses").range(0, 2147483647).type("S");
+  cli.option("--seed", seed, "random seed of the losses").seed().type("S");
   if (const auto done = cli.parse(argc, argv)) return *done;
   try {
     std::vector<Phase> phases = parse_schedule(schedule);
@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
     std::printf("ready\n");
     std::fflush(stdout);
 
-    std::mt19937_64 rng(static_cast<unsigned>(seed));
+    std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
     std::deque<Frame> queues[2];  // queues[d]: frames read from fds[d], to write to fds[1 - d]
     std::vector<std::uint8_t> buffer(65536);

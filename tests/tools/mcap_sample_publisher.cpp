@@ -1,7 +1,7 @@
 // Test publisher for the logger's integration tests: N rounds, each one message
 // of every topic (or of Odometry only), at a fixed rate, seq 1..N per topic.
 //   mcap_sample_publisher --profiles config/dds/profiles.xml --domain D --count N
-//                         [--rate HZ] [--topics all|odometry] [--wait-readers S]
+//                         [--rate HZ] [--topics all|odometry] [--diagnostics] [--readers N] [--wait-readers S]
 // Waits for one matched reader per topic, then publishes; prints
 // "progress N" (rounds published) every 10 rounds, line-buffered, so that a
 // test knows how far it got; then waits for the readers' acknowledgments and
@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdio>
 #include <exception>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -117,47 +118,85 @@ msg::OptimisedMap optimised_map(std::uint64_t i) {
   return m;
 }
 
+msg::Diagnostics diagnostics(std::uint64_t i) {
+  msg::Diagnostics m;
+  m.header().stamp_ns(dds::now_ns());
+  m.header().frame_id("mcap_sample_publisher");
+  m.process("mcap_sample_publisher");
+  m.pid(static_cast<std::uint32_t>(1000 + i));
+  m.level(static_cast<std::uint8_t>(i % 3));
+  m.status(i % 3 == 0 ? "" : "status " + std::to_string(i));
+  m.uptime_s(0.1 * static_cast<double>(i));
+  for (int k = 0; k < 2; ++k) {
+    msg::DiagnosticCounter c;
+    c.name(k == 0 ? "rounds" : "rejected");
+    c.value(i * static_cast<std::uint64_t>(k + 1));
+    m.counters().push_back(c);
+  }
+  return m;
+}
+
+// One topic's writer, publishing make(i) in round i.
+struct TopicPublisher {
+  std::string topic;
+  std::function<bool(std::uint64_t)> publish;
+  std::function<bool(int, std::chrono::milliseconds)> wait_for_readers;
+  std::function<bool(std::chrono::seconds)> wait_for_acknowledgments;
+  std::function<std::uint64_t()> published;
+};
+
+template <class Message>
+TopicPublisher topic_publisher(dds::Participant& participant, Message (*make)(std::uint64_t)) {
+  auto writer = std::make_shared<dds::Writer<Message>>(participant);
+  return {std::string(dds::MessageTraits<Message>::topic),
+          [writer, make](std::uint64_t i) {
+            Message m = make(i);
+            return writer->publish(m);
+          },
+          [writer](int count, std::chrono::milliseconds wait) { return writer->wait_for_readers(count, wait); },
+          [writer](std::chrono::seconds wait) { return writer->wait_for_acknowledgments(wait); },
+          [writer] { return writer->published(); }};
+}
+
 int run(int argc, char** argv) {
   dds::DdsOptions options;
   int count = 0;
   double rate_hz = 500.0;
   std::string topics = "all";
   double wait_s = 20.0;
+  bool with_diagnostics = false;
+  int readers = 1;
   app::Cli cli{"mcap_sample_publisher", "Publishes N messages of every topic (or Odometry only) for the logger tests."};
   cli.option("--profiles", options.profiles_file, "the Fast DDS profiles XML").required().existing_file().type("FILE");
   std::vector<std::string> dds_overrides;
   app::add_domain(cli, dds_overrides);
   cli.option("--count", count, "messages per topic").required().range(1, 100000000).type("N");
   cli.option("--rate", rate_hz, "rounds per second").positive().type("HZ");
-  cli.option("--topics", topics, "every topic, or Odometry only").choices({"all", "odometry"});
+  cli.option("--topics", topics, "every data topic, or Odometry only").choices({"all", "odometry"});
+  cli.flag("--diagnostics", with_diagnostics, "also publish N Diagnostics");
   cli.option("--wait-readers", wait_s, "seconds to wait for the readers").non_negative().type("S");
+  cli.option("--readers", readers, "matched readers per topic to wait for").range(1, 100).type("N");
   if (const auto done = cli.parse(argc, argv)) return *done;
   dds::resolve_settings(options, dds_overrides);
   options.robot_id = "sample_publisher";
   const auto total = static_cast<std::uint64_t>(count);
-  const bool all_topics = topics == "all";
 
   dds::Participant participant(options, "mcap_sample_publisher");
-  dds::Writer<msg::Odometry> odometry_writer(participant);
-  std::unique_ptr<dds::Writer<msg::LandmarkObservation>> observation_writer;
-  std::unique_ptr<dds::Writer<msg::MapState>> map_writer;
-  std::unique_ptr<dds::Writer<msg::GroundTruth>> truth_writer;
-  std::unique_ptr<dds::Writer<msg::OptimisedMap>> optimised_writer;
-  if (all_topics) {
-    observation_writer = std::make_unique<dds::Writer<msg::LandmarkObservation>>(participant);
-    map_writer = std::make_unique<dds::Writer<msg::MapState>>(participant);
-    truth_writer = std::make_unique<dds::Writer<msg::GroundTruth>>(participant);
-    optimised_writer = std::make_unique<dds::Writer<msg::OptimisedMap>>(participant);
+  std::vector<TopicPublisher> publishers = {topic_publisher(participant, &odometry)};
+  if (topics == "all") {
+    publishers.push_back(topic_publisher(participant, &observation));
+    publishers.push_back(topic_publisher(participant, &map_state));
+    publishers.push_back(topic_publisher(participant, &ground_truth));
+    publishers.push_back(topic_publisher(participant, &optimised_map));
   }
+  if (with_diagnostics) publishers.push_back(topic_publisher(participant, &diagnostics));
   const auto wait = std::chrono::milliseconds(static_cast<long>(wait_s * 1000.0));
-  bool matched = odometry_writer.wait_for_readers(1, wait);
-  if (all_topics) {
-    matched = matched && observation_writer->wait_for_readers(1, wait) && map_writer->wait_for_readers(1, wait) &&
-              truth_writer->wait_for_readers(1, wait) && optimised_writer->wait_for_readers(1, wait);
-  }
-  if (!matched) {
-    std::fprintf(stderr, "mcap_sample_publisher: no reader on domain %d after %.0f s\n", options.domain_id, wait_s);
-    return 1;
+  for (const TopicPublisher& p : publishers) {
+    if (!p.wait_for_readers(readers, wait)) {
+      std::fprintf(stderr, "mcap_sample_publisher: fewer than %d reader(s) of %s on domain %d after %.0f s\n", readers,
+                   p.topic.c_str(), options.domain_id, wait_s);
+      return 1;
+    }
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(200));  // every reader fully matched
 
@@ -168,39 +207,15 @@ int run(int argc, char** argv) {
   std::uint64_t round = 0;
   for (std::uint64_t i = 1; i <= total && !app::StopSignal::requested(); ++i) {
     std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(period * static_cast<double>(i - 1)));
-    msg::Odometry o = odometry(i);
-    ok = odometry_writer.publish(o) && ok;
-    if (all_topics) {
-      msg::LandmarkObservation l = observation(i);
-      msg::MapState s = map_state(i);
-      msg::GroundTruth g = ground_truth(i);
-      msg::OptimisedMap m = optimised_map(i);
-      ok = observation_writer->publish(l) && ok;
-      ok = map_writer->publish(s) && ok;
-      ok = truth_writer->publish(g) && ok;
-      ok = optimised_writer->publish(m) && ok;
-    }
+    for (const TopicPublisher& p : publishers) ok = p.publish(i) && ok;
     round = i;
     if (i % 10 == 0 || i == total) std::printf("progress %llu\n", static_cast<unsigned long long>(i));
   }
   // Stopped early: the reader may be gone, nothing to wait for.
   const auto ack = app::StopSignal::requested() ? std::chrono::seconds(0) : std::chrono::seconds(10);
-  ok = odometry_writer.wait_for_acknowledgments(ack) && ok;
-  if (all_topics) {
-    ok = observation_writer->wait_for_acknowledgments(ack) && ok;
-    ok = map_writer->wait_for_acknowledgments(ack) && ok;
-    ok = truth_writer->wait_for_acknowledgments(ack) && ok;
-    ok = optimised_writer->wait_for_acknowledgments(ack) && ok;
-  }
-  std::printf("published %s %llu\n", dds::kOdometryTopic.data(), static_cast<unsigned long long>(odometry_writer.published()));
-  if (all_topics) {
-    std::printf("published %s %llu\n", dds::kLandmarkObservationTopic.data(),
-                static_cast<unsigned long long>(observation_writer->published()));
-    std::printf("published %s %llu\n", dds::kMapStateTopic.data(), static_cast<unsigned long long>(map_writer->published()));
-    std::printf("published %s %llu\n", dds::kGroundTruthTopic.data(),
-                static_cast<unsigned long long>(truth_writer->published()));
-    std::printf("published %s %llu\n", dds::kOptimisedMapTopic.data(),
-                static_cast<unsigned long long>(optimised_writer->published()));
+  for (const TopicPublisher& p : publishers) ok = p.wait_for_acknowledgments(ack) && ok;
+  for (const TopicPublisher& p : publishers) {
+    std::printf("published %s %llu\n", p.topic.c_str(), static_cast<unsigned long long>(p.published()));
   }
   return ok && round == total ? 0 : 1;
 }

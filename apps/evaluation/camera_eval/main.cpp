@@ -17,12 +17,12 @@
 int main(int argc, char** argv) {
   using namespace pixyslam;
   std::string dir;
-  double seed = 1;
+  std::uint64_t seed = 1;
   app::Cli cli{"camera_eval",
                "The colour-code detector on the synthetic camera through the simulated world: per landmark the "
                "frames in view and detected, range error at 1 m, wrong ids, detection time per frame."};
   cli.option("--config-dir", dir, "the config folder (pixy_bridge.yaml, slam_sim.yaml)").required().type("DIR");
-  cli.option("--seed", seed, "the world's seed").range(0, 1e15).type("S");
+  cli.option("--seed", seed, "the synthetic camera's noise seed").seed().type("S");
   if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("camera_eval", [&] {
     config::YamlReader pixy_root = config::YamlReader::from_file(dir + "/pixy_bridge.yaml");
@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
     config::YamlReader world_yaml = sim_root.child("world");
     camera_eval::EvalOptions options;
     options.world = sim::read_world_options(world_yaml);
-    options.seed = static_cast<std::uint64_t>(seed);
+    options.seed = seed;
     config::YamlReader filter_yaml = sim_root.child("filter");
     options.filter = slam::read_filter_options(filter_yaml);
     // Whole-pixel boxes of a camera image: the aspect check forgives one pixel.

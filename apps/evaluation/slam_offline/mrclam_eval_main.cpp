@@ -189,7 +189,7 @@ void run_loro(const std::string& dataset, slam::FilterOptions options, const off
   constexpr double kDeg = 180.0 / M_PI;
   std::printf("\nLORO: leave one robot out: the mrclam: corrections fitted on the other robots with ground truth\n");
   std::vector<mrclam::RobotData> pool;
-  for (int r = 1; r <= 5; ++r) {
+  for (int r = mrclam::kFirstRobot; r <= mrclam::kLastRobot; ++r) {
     mrclam::RobotData d = mrclam::load_robot(dataset, r);
     if (!d.groundtruth.empty()) pool.push_back(std::move(d));
   }

@@ -225,7 +225,7 @@ int main(int argc, char** argv) {
   mrclam.option("--dataset", args.dataset, "the data set's folder (e.g. ../shared/data/mrclam/Dataset6)")
       .required()
       .type("DIR");
-  mrclam.option("--robot", args.robot, "the robot, 1-5").required().range(1, 5).type("N");
+  mrclam.option("--robot", args.robot, "the robot, 1-5").required().range(mrclam::kFirstRobot, mrclam::kLastRobot).type("N");
   app::Cli& hardware = cli.subcommand(
       "hardware", "the robot_sim hardware decoded by the bridges' parsers (their configs beside --sim-config)");
   common(hardware);

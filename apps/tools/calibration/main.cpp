@@ -385,7 +385,7 @@ int main(int argc, char** argv) {
       "odometry noise densities, range and bearing sigmas, the range's cos-bearing exponent and command lag from "
       "the filter's own innovations (never the ground truth); the errors' correlation time from pairs of sightings");
   value(noise_command, "mrclam", "the MRCLAM data set folder of the recording", "DIR")->required();
-  noise_command.option("--robot", robot, "the robot, 1-5").required().range(1, 5).type("N");
+  noise_command.option("--robot", robot, "the robot, 1-5").required().range(mrclam::kFirstRobot, mrclam::kLastRobot).type("N");
   value(noise_command, "config", "the base YAML (filter: and mrclam:)", "BASE.yaml")->required();
   value(noise_command, "out", "write BASE with the calibrated keys replaced", "FILE.yaml")->required();
   value(noise_command, "keys",

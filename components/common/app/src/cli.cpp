@@ -26,7 +26,16 @@ Cli::Option& Cli::Option::existing_file() {
 }
 
 Cli::Option& Cli::Option::range(double min, double max) {
-  option_->check(CLI::Range(min, max));
+  if (integer_) {
+    option_->check(CLI::Range(static_cast<std::int64_t>(min), static_cast<std::int64_t>(max)));
+  } else {
+    option_->check(CLI::Range(min, max));
+  }
+  return *this;
+}
+
+Cli::Option& Cli::Option::seed() {
+  option_->check(CLI::Range(std::uint64_t{0}, parameters::kMaxSeed));
   return *this;
 }
 
@@ -109,7 +118,15 @@ Cli::Option& Cli::option(const std::string& name, double& value, const std::stri
 }
 
 Cli::Option& Cli::option(const std::string& name, int& value, const std::string& help) {
-  return keep(app_->add_option(name, value, help));
+  Option& o = keep(app_->add_option(name, value, help));
+  o.integer_ = true;
+  return o;
+}
+
+Cli::Option& Cli::option(const std::string& name, std::uint64_t& value, const std::string& help) {
+  Option& o = keep(app_->add_option(name, value, help));
+  o.integer_ = true;
+  return o;
 }
 
 Cli::Option& Cli::option(const std::string& name, std::vector<std::string>& values, const std::string& help) {

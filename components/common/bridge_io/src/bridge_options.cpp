@@ -17,7 +17,8 @@ void add_bridge_flags(app::Cli& cli, BridgeCommandLine& args, const std::string&
                       const std::string& set_example) {
   app::add_config(cli, args.config, config_help);
   cli.option("--device", args.device, "the serial device (overrides the config's)").type("PATH");
-  app::add_set(cli, args.overrides, set_example + " or dds.domain_id=3");
+  app::add_set(cli, args.overrides, set_example + " or dds.participant_profile=lan_multicast");
+  app::add_domain(cli, args.domain);
   app::add_verbose(cli, args.verbose);
 }
 
@@ -29,7 +30,8 @@ void apply_command_line(const BridgeCommandLine& args, std::string& serial_devic
     }
   }
   std::vector<std::string> rest = args.overrides;
-  const std::vector<std::string> dds_overrides = parameters::take_section(rest, "dds");
+  std::vector<std::string> dds_overrides = parameters::take_section(rest, "dds");
+  dds_overrides.insert(dds_overrides.end(), args.domain.begin(), args.domain.end());  // --domain wins
   if (!rest.empty()) throw std::invalid_argument("--set " + rest.front() + ": not a parameter of this process");
   // The DDS settings resolved here, once: file, environment, command line.
   dds::resolve_settings(dds, dds_overrides);

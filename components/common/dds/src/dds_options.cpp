@@ -61,7 +61,8 @@ const parameters::Table<DdsOptions>& dds_parameters() {
                    [](const std::string& v) {
                      if (v.empty()) throw std::invalid_argument("empty");
                    }),
-        P::boolean<O>("type_information", "announce XTypes type information (generic tools)",
+        P::boolean<O>("type_information",
+                      "announce XTypes type information (generic Fast DDS tools; other vendors then cannot match)",
                       [](O& o) -> bool& { return o.type_information; }),
         P::real<O>("diagnostics_period_s", 0.0, 3600.0, "s", "period of the report on pixyslam/diagnostics (0: none)",
                    [](O& o) -> double& { return o.diagnostics_period_s; }),

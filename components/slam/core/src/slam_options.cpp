@@ -12,7 +12,7 @@ const parameters::Table<FilterOptions>& filter_parameters() {
   static const P::Table<O> table = {
       P::integer<O, int>("particles", 1, 1000000, "", "M, the number of particles",
                          [](O& o) -> int& { return o.particles; }),
-      P::integer<O, std::uint64_t>("seed", 0, std::uint64_t{1} << 53, "",
+      P::integer<O, std::uint64_t>("seed", 0, P::kMaxSeed, "",
                                    "random seed: the same seed and input give bit-identical output",
                                    [](O& o) -> std::uint64_t& { return o.seed; }),
       P::real<O>("motion.v_sigma_m_per_sqrt_s", 0.0, 10.0, "m/sqrt(s)", "white-noise density of the forward speed",

@@ -18,8 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kFirstRobot = 1;
-constexpr int kLastRobot = 5;
 constexpr const char* kBarcodeFile = "Barcodes.dat";
 constexpr const char* kLandmarkFile = "Landmark_Groundtruth.dat";
 constexpr const char* kLandmarkFixedFile = "Landmark_Groundtruth_fixed_11_17.dat";

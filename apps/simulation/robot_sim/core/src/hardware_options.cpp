@@ -29,7 +29,7 @@ const parameters::Table<HardwareOptions>& hardware_parameters() {
   using O = HardwareOptions;
   namespace P = parameters;
   static const P::Table<O> table = {
-      P::integer<O, std::uint64_t>("seed", 0, std::uint64_t{1} << 53, "", "wheel and camera noise",
+      P::integer<O, std::uint64_t>("seed", 0, P::kMaxSeed, "", "wheel and camera noise",
                                    [](O& o) -> std::uint64_t& { return o.seed; }),
       P::real<O>("arduino_rate_hz", 1.0, 1000.0, "Hz", "encoder lines per second",
                  [](O& o) -> double& { return o.arduino_rate_hz; }),

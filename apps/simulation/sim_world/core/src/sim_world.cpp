@@ -13,7 +13,7 @@ const parameters::Table<WorldOptions>& world_parameters() {
   using O = WorldOptions;
   namespace P = parameters;
   static const P::Table<O> table = {
-      P::integer<O, std::uint64_t>("seed", 0, std::uint64_t{1} << 53, "", "odometry and camera noise; same seed = same run",
+      P::integer<O, std::uint64_t>("seed", 0, P::kMaxSeed, "", "odometry and camera noise; same seed = same run",
                                    [](O& o) -> std::uint64_t& { return o.seed; }),
       P::real<O>("duration_s", 1.0, 1e6, "s", "simulated time", [](O& o) -> double& { return o.duration_s; }),
       P::real<O>("length_m", 0.0, 1000.0, "m", "the loop's long sides", [](O& o) -> double& { return o.length_m; }),

@@ -165,7 +165,11 @@ void LogPlayer::wait_for_readers() {
       said = true;
     }
     while (channel->matched_readers() < options_.wait_readers) {
-      if (std::chrono::steady_clock::now() >= until || app::StopSignal::requested()) {
+      if (app::StopSignal::requested()) {  // play() then plays nothing
+        log_ << "pixyslam_play: stopped while waiting for readers\n";
+        return;
+      }
+      if (std::chrono::steady_clock::now() >= until) {
         log_ << "pixyslam_play: warning: " << channel->report().topic << " has " << channel->matched_readers()
              << " of " << options_.wait_readers << " readers after " << options_.wait_timeout_s
              << " s; playing anyway\n";

@@ -5,6 +5,7 @@
 // and costs ~15 s per file that includes it). One flag name per meaning
 // (docs/tools.md) and the same exit codes everywhere: 0 ok (and after
 // --help), 1 runtime failure, 2 usage or configuration error.
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -34,7 +35,8 @@ class Cli {
     explicit Option(CLI::Option* option) : option_(option) {}
     Option& required();
     Option& existing_file();
-    Option& range(double min, double max);
+    Option& range(double min, double max);  // INT in [min - max] in --help for an int option
+    Option& seed();                         // an integer in [0, parameters::kMaxSeed]
     Option& non_negative();
     Option& positive();  // a finite number > 0
     Option& choices(const std::vector<std::string>& allowed);
@@ -43,7 +45,9 @@ class Cli {
     Option& type(const std::string& name);  // the value's name in --help, e.g. "DIR"
 
    private:
+    friend class Cli;
     CLI::Option* option_;
+    bool integer_ = false;  // declared on an int (or uint64) member
   };
 
   Cli(const std::string& name, const std::string& description);
@@ -55,6 +59,7 @@ class Cli {
   Option& option(const std::string& name, std::string& value, const std::string& help);
   Option& option(const std::string& name, double& value, const std::string& help);
   Option& option(const std::string& name, int& value, const std::string& help);
+  Option& option(const std::string& name, std::uint64_t& value, const std::string& help);
   Option& option(const std::string& name, std::vector<std::string>& values, const std::string& help);
   // Calls `each` with every value given (repeatable).
   Option& option_each(const std::string& name, std::function<void(const std::string&)> each, const std::string& help);

@@ -18,6 +18,7 @@ struct BridgeCommandLine {
   std::string config;
   std::string device;
   std::vector<std::string> overrides;
+  std::vector<std::string> domain;  // --domain N: "dds.domain_id=N", after --set
   bool verbose = false;
 };
 void add_bridge_flags(app::Cli& cli, BridgeCommandLine& args, const std::string& config_help,

@@ -26,8 +26,8 @@ struct DdsOptions {
   std::string profiles_file;  // XML; relative paths are resolved against the YAML file's folder
   std::string participant_profile = "loopback";
   std::string robot_id = "robot1";  // written into every message header
-  bool type_information = true;     // announce XTypes type information (generic tools);
-                                    // off for readers of other vendors (see README)
+  bool type_information = false;    // announce XTypes type information: off by default, so that
+                                    // other vendors (Cyclone DDS) match; docs/inspection.md says why
   std::vector<std::string> interfaces;     // IPv4 addresses DDS may use on this host (whitelist);
                                            // empty: the profile's choice
   std::vector<std::string> initial_peers;  // IPv4 addresses of other hosts, for unicast discovery

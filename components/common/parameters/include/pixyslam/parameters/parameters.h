@@ -90,6 +90,10 @@ Parameter<Options> boolean(std::string path, std::string help, std::function<boo
   return p;
 }
 
+// Every random seed of the project is in [0, kMaxSeed] (2^53: exact in a
+// double, so YAML, the command line and JSON carry it unchanged).
+constexpr std::uint64_t kMaxSeed = std::uint64_t{1} << 53;
+
 // An enum given by name: `names` pairs each value with its YAML text.
 template <class Options, class Enum>
 Parameter<Options> choice(std::string path, std::vector<std::pair<std::string, Enum>> names, std::string help,

@@ -8,6 +8,10 @@
 
 namespace pixyslam::mrclam {
 
+// The robots of an MRCLAM data set are subjects kFirstRobot..kLastRobot.
+constexpr int kFirstRobot = 1;
+constexpr int kLastRobot = 5;
+
 // Reader for the UTIAS Multi-Robot Cooperative Localization and Mapping
 // (MRCLAM) data sets: one folder per data set with whitespace-separated text
 // files, times in unix seconds, positions in metres, angles in radians
