@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The Debian package (cpack -G DEB from this build): its control data (runtime
-# dependencies found by dpkg-shlibdeps, conffiles), its files (programs in
+# The Debian packages pixyslam-robot and pixyslam-station (cpack -G DEB from
+# this build): their control data (runtime dependencies found by
+# dpkg-shlibdeps: no GUI library for the robot; conffiles), their files (programs in
 # /usr/lib/pixyslam/bin with /usr/bin/pixyslam-NAME links, /etc/pixyslam,
 # systemd units whose ExecStart exists in the package), no file that another
 # package of this Debian system owns (dpkg refuses to overwrite those: a
@@ -17,22 +18,33 @@ work=$(mktemp -d /tmp/pixyslam_deb_test.XXXXXX)
 trap 'rm -rf "$work"' EXIT
 trap 'exit 130' INT TERM  # a killed test still cleans up (the EXIT trap)
 cpack --config "$build/CPackConfig.cmake" -G DEB -B "$work/out" > "$work/cpack.log" 2>&1 || { cat "$work/cpack.log"; exit 1; }
-deb=$(ls "$work"/out/pixyslam_*.deb)
+robot_deb=$(ls "$work"/out/pixyslam-robot_*.deb)
+station_deb=$(ls "$work"/out/pixyslam-station_*.deb)
 fail() { echo "FAIL: $*"; exit 1; }
-info=$(dpkg-deb -I "$deb")
-echo "$info" | grep -E "^ (Package|Version|Depends|Installed-Size):"
-for dep in libfastrtps2.9 libyaml-cpp0.7 libzstd1; do
-  echo "$info" | grep -q "Depends:.*$dep" || fail "Depends lacks $dep"
+robot_info=$(dpkg-deb -I "$robot_deb")
+station_info=$(dpkg-deb -I "$station_deb")
+echo "$robot_info" | grep -E "^ (Package|Version|Depends|Installed-Size):"
+echo "$station_info" | grep -E "^ (Package|Version|Depends|Installed-Size):"
+for dep in libfastrtps2.9 libyaml-cpp0.7 libzstd1 libopencv-videoio406; do
+  echo "$robot_info" | grep -q "Depends:.*$dep" || fail "pixyslam-robot's Depends lacks $dep"
 done
-dpkg-deb -x "$deb" "$work/root"
-dpkg-deb -e "$deb" "$work/control"
+! echo "$robot_info" | grep -E "^ Depends:.*(highgui|libqt|libgtk|libceres)" || fail "pixyslam-robot depends on a GUI library or Ceres"
+echo "$station_info" | grep -q "Depends:.*pixyslam-robot (= " || fail "pixyslam-station does not depend on pixyslam-robot"
+echo "$station_info" | grep -q "Depends:.*libopencv-highgui406" || fail "pixyslam-station lacks map_view's highgui"
+for deb in "$robot_deb" "$station_deb"; do
+  dpkg-deb -x "$deb" "$work/root"  # both into one root: the station's programs beside the robot's
+done
+dpkg-deb -e "$robot_deb" "$work/control"
+dpkg-deb -e "$station_deb" "$work/station_control"
 for f in usr/lib/pixyslam/bin/slam_estimator usr/lib/pixyslam/bin/encoder_bridge usr/lib/pixyslam/bin/pixy_bridge \
          usr/lib/pixyslam/bin/logger usr/lib/pixyslam/bin/pixyslam_launch usr/lib/pixyslam/bin/pixyslam_calibrate \
          usr/bin/pixyslam-launch usr/bin/pixyslam-logger usr/bin/pixyslam-slam-estimator usr/bin/pixyslam-calibrate \
          etc/pixyslam/dds/profiles.xml etc/pixyslam/launch_robot.yaml etc/default/pixyslam \
          usr/lib/systemd/system/pixyslam-robot.service usr/lib/systemd/system/pixyslam-station.service; do
-  [[ -e $work/root/$f ]] || fail "$f is not in the package"
+  [[ -e $work/root/$f ]] || fail "$f is in neither package"
 done
+dpkg-deb -c "$robot_deb" | grep -q "usr/lib/pixyslam/bin/map_view" && fail "map_view (GUI) is in pixyslam-robot"
+dpkg-deb -c "$station_deb" | grep -q "etc/pixyslam" && fail "pixyslam-station ships config files (pixyslam-robot's)"
 grep -qx "/etc/pixyslam/slam_estimator.yaml" "$work/control/conffiles" || fail "config files are not conffiles"
 # Every /usr/bin entry is a pixyslam-NAME link to a program of the package.
 for link in "$work"/root/usr/bin/*; do
@@ -43,12 +55,12 @@ done
 while IFS= read -r path; do
   path=${path#.}
   [[ -z $path || -d $work/root$path && ! -L $work/root$path ]] && continue
-  if owner=$(dpkg-query -S "$path" 2>/dev/null) && [[ ${owner%%:*} != pixyslam ]]; then
+  if owner=$(dpkg-query -S "$path" 2>/dev/null) && ! [[ ${owner%%:*} =~ ^pixyslam(-robot|-station)?$ ]]; then
     fail "$path is also in the installed package ${owner%%:*}"
   fi
 done < <(cd "$work/root" && find . -mindepth 1)
 for script in postinst prerm postrm; do
-  [[ -x $work/control/$script ]] || fail "no $script maintainer script"
+  [[ -x $work/control/$script && -x $work/station_control/$script ]] || fail "no $script maintainer script in both"
 done
 grep -q "adduser --system" "$work/control/postinst" || fail "postinst makes no system user"
 for unit in "$work"/root/usr/lib/systemd/system/*.service; do
@@ -78,4 +90,4 @@ grep "\[launch\]" "$work/run.log"
 [[ $status -eq 0 ]] || fail "the packaged robot side exited with $status"
 grep -q "started encoder_bridge (pid [0-9]*): $work/root/usr/lib/pixyslam/bin/encoder_bridge" "$work/run.log" ||
   fail "the launcher did not start the packaged encoder_bridge"
-echo "PASS: $(basename "$deb"), $(stat -c %s "$deb") bytes"
+echo "PASS: $(basename "$robot_deb") $(stat -c %s "$robot_deb") bytes, $(basename "$station_deb") $(stat -c %s "$station_deb") bytes"
