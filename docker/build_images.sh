@@ -1,18 +1,38 @@
 #!/usr/bin/env bash
-# Builds pixyslam-{robot,estimator,logger,viewer} from docker/Dockerfile with
-# the programs in build/bin (scripts/build.sh first), on the local base image
-# (docker/build_base_image.sh), and prints their sizes.
-#   docker/build_images.sh [podman|docker]      (exit 77: no such engine here)
+# Builds pixyslam-{robot,estimator,logger,viewer} from docker/Dockerfile on the
+# local base image (docker/build_base_image.sh) and prints their sizes.
+#   docker/build_images.sh [podman|docker] [--from-source]
+# Default: from the packages of this checkout's build (cpack of build/, the
+# programs the tests ran); --from-source: the Dockerfile's builder stage
+# compiles the checkout (no host build needed). Exit 77: no such engine here.
 set -euo pipefail
-engine=${1:-podman}
+engine=podman from_source=0
+for a in "$@"; do
+  case $a in
+    --from-source) from_source=1 ;;
+    podman|docker) engine=$a ;;
+    -h|--help) sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "build_images: unknown argument '$a' (see --help)" >&2; exit 2 ;;
+  esac
+done
 command -v "$engine" >/dev/null || { echo "SKIP: $engine is not installed"; exit 77; }
 root=$(cd "$(dirname "$0")/.." && pwd)
 export CONTAINERS_CONF=${CONTAINERS_CONF:-$root/docker/containers.conf}
-[[ -x $root/build/bin/slam_estimator ]] || { echo "build/bin is empty: run scripts/build.sh first" >&2; exit 1; }
+packages=builder
+if ((from_source == 0)); then
+  [[ -f $root/build/CPackConfig.cmake ]] || { echo "build/ is not configured: run scripts/build.sh first (or --from-source)" >&2; exit 1; }
+  rm -rf "$root/build/packages"
+  cpack --config "$root/build/CPackConfig.cmake" -G DEB -B "$root/build/packages" > /dev/null
+  rm -rf "$root/build/packages/_CPack_Packages"
+  packages=context
+fi
 "$root/docker/build_base_image.sh" "$engine"
+start=$(date +%s)
 for role in robot estimator logger viewer; do
   # --network host: only for apt inside the build (the images run without it).
   "$engine" build --network host -q -f "$root/docker/Dockerfile" --target "$role" \
-    --build-arg BASE_IMAGE=localhost/pixyslam-base:bookworm -t "localhost/pixyslam-$role:latest" "$root" > /dev/null
+    --build-arg BASE_IMAGE=localhost/pixyslam-base:bookworm --build-arg PACKAGES=$packages \
+    -t "localhost/pixyslam-$role:latest" "$root" > /dev/null
 done
-"$engine" images --format '{{.Repository}}:{{.Tag}} {{.Size}}' | grep pixyslam | sort
+echo "build_images: packages from $packages, $(($(date +%s) - start)) s"
+"$engine" images --format '{{.Repository}}:{{.Tag}} {{.Size}}' | grep "pixyslam-" | sort

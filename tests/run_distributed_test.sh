@@ -50,6 +50,11 @@ else
   log_host=laptop log_addr=10.200.$net.2
 fi
 work=$(mktemp -d /tmp/pixyslam_distributed.XXXXXX)
+if [[ $runner == podman ]]; then
+  # The containers run as their packages' user: they read the config and write the run folder.
+  chmod 755 "$work"
+  install -d -m 1777 "$work/run"
+fi
 pids=()
 cleanup() {
   for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
@@ -125,7 +130,8 @@ declare -A launcher_of
 launch() {  # launch HOST: that host's share, in its namespace, in the background
   if [[ $runner == podman ]]; then
     # One run folder for all (the viewer renders the logger's file); the
-    # container's programs are its own (/usr/local/bin).
+    # container's programs are its own (its packages', run as user pixyslam,
+    # who writes the run folder).
     podman run --rm --name "${tag}_$1" --network "ns:/run/netns/${tag}_$1" -v "$work:$work" \
       "localhost/pixyslam-$1:latest" "$work/config/launch_sim.yaml" --deployment "$work/deploy.yaml" \
       --host "$1" --run-dir "$work/run" > "$work/$1.log" 2>&1 &
