@@ -1,15 +1,19 @@
 // End-to-end latency on loopback: Odometry published by this process -> the
 // MapState that includes it, from a separate slam_estimator process.
-//   bench_latency [--config config/slam_estimator.yaml] [--duration S] 
+//   bench_latency [--config config/slam_estimator.yaml] [--duration S] [--out FILE.csv]
 // Streams the simulated world in real time at the paper's rates (odometry 10 Hz,
 // stamped at the start of its period and sent at its end, as the encoder bridge
 // does; camera frames 10 Hz) and prints p50/p90/p99/max of the latency.
+// --out writes every sample's latency (one column latency_ms) for
+// scripts/plot_results.py.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -38,7 +42,7 @@ std::string own_folder() {
 
 }  // namespace
 
-int run(const std::string& config, double duration_s) {
+int run(const std::string& config, double duration_s, const std::string& out) {
   // The estimator as its own process, its output forwarded with a prefix.
   launcher::ProcessGroup estimator(own_folder(), stdout);
   std::vector<std::string> command{"slam_estimator", "--config", config};
@@ -123,6 +127,12 @@ int run(const std::string& config, double duration_s) {
               percentile(latencies_ms, 1.0));
   std::printf("  filter step time in the estimator [ms]:   p50 %.3f  p99 %.3f\n", percentile(update_ms, 0.5),
               percentile(update_ms, 0.99));
+  if (!out.empty()) {
+    std::ofstream csv(out);
+    csv << "latency_ms\n";
+    for (double l : latencies_ms) csv << l << '\n';
+    if (!csv) throw std::runtime_error("cannot write " + out);
+  }
   return latencies_ms.size() + 5 >= run.odometry.size() ? 0 : 1;
 }
 
@@ -133,11 +143,13 @@ int main(int argc, char** argv) {
   app::StopSignal::install();
   std::string config = std::string(PIXYSLAM_CONFIG_DIR) + "/slam_estimator.yaml";
   double duration_s = 60.0;
+  std::string out;
   app::Cli cli{"bench_latency",
                "End-to-end latency Odometry -> MapState through a separate slam_estimator on loopback."};
   cli.option("--config", config, "the estimator's YAML (default config/slam_estimator.yaml)").existing_file().type("FILE");
   cli.option("--duration", duration_s, "seconds of odometry (default 60)").positive().type("S");
+  cli.option("--out", out, "every sample's latency as CSV (for scripts/plot_results.py)").type("FILE.csv");
   if (const auto done = cli.parse(argc, argv)) return *done;
   // A bad config exits 2, any other error 1 (as every program here).
-  return app::run_main("bench_latency", [&] { return bench::run(config, duration_s); });
+  return app::run_main("bench_latency", [&] { return bench::run(config, duration_s, out); });
 }

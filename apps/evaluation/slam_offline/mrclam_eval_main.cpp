@@ -26,6 +26,11 @@
 // --optimise adds, to every full run and segment (and the LORO runs with the
 // held-out fit), the map optimiser over the whole run after the filter
 // (optimised_run.h): its ATE, heading RMSE and landmark errors beside the filter's.
+// --out-dir DIR writes the numbers behind the tables as CSV for plots
+// (scripts/plot_results.py): runs.csv (one row per full run), segments.csv (one
+// per segment start) and errors_robotR_seedS.csv (per truth pose of a full run:
+// time since the robot's first truth pose, position and heading error of the
+// filter and of dead reckoning).
 // Exit codes: 0 done, 77 dataset folder absent (skip), 1 error or a robot's
 // mean ATE not better than dead reckoning, 2 command-line or config error.
 #include <algorithm>
@@ -34,6 +39,7 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -409,8 +415,58 @@ void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<i
   }
 }
 
+// The CSV files of --out-dir (none when the folder is empty).
+class CsvOutput {
+ public:
+  explicit CsvOutput(std::string dir) : dir_(std::move(dir)) {
+    if (dir_.empty()) return;
+    std::filesystem::create_directories(dir_);
+    runs_ = open("runs.csv");
+    runs_ << "robot,seed,ate_m,ate_aligned_m,dr_ate_m,heading_deg,dr_heading_deg,landmarks_raw_m,"
+             "landmarks_aligned_m,nees_inside_fraction\n";
+  }
+  void run(int robot, int seed, const offline::RunInput& input, const offline::RunResult& res,
+           const offline::Report& rep) {
+    if (dir_.empty()) return;
+    constexpr double kDeg = 180.0 / M_PI;
+    runs_ << robot << ',' << seed << ',' << rep.filter.ate_rmse_m << ',' << rep.filter.ate_rmse_aligned_m << ','
+          << rep.dead_reckoning.ate_rmse_m << ',' << rep.filter.heading_rmse_rad * kDeg << ','
+          << rep.dead_reckoning.heading_rmse_rad * kDeg << ',' << rep.landmarks.rmse_m << ','
+          << rep.landmarks.rmse_aligned_m << ',' << rep.nees.fraction_inside() << '\n';
+    if (input.truth.empty() || res.trajectory.empty()) return;
+    const std::vector<eval::TimedPose> truth = offline::sorted_by_time(input.truth);
+    const std::vector<eval::PoseError> filter = eval::pose_errors(res.trajectory, truth);
+    const std::vector<eval::PoseError> dr = eval::pose_errors(res.dead_reckoning, truth);
+    std::ofstream out = open("errors_robot" + std::to_string(robot) + "_seed" + std::to_string(seed) + ".csv");
+    out << "t_s,position_m,heading_deg,dr_position_m,dr_heading_deg\n";
+    for (std::size_t i = 0; i < filter.size() && i < dr.size(); ++i) {
+      out << filter[i].t_s - truth.front().t_s << ',' << filter[i].position_m << ',' << filter[i].heading_rad * kDeg
+          << ',' << dr[i].position_m << ',' << dr[i].heading_rad * kDeg << '\n';
+    }
+  }
+  void segments(const std::vector<Segment>& all) {
+    if (dir_.empty()) return;
+    std::ofstream out = open("segments.csv");
+    out << "robot,seed,start_s,length_s,ate_m,heading_deg,nees_inside_fraction\n";
+    for (const Segment& g : all) {
+      out << g.robot << ',' << g.seed << ',' << g.start_s << ',' << g.length_s << ',' << g.errors.ate_rmse_m << ','
+          << g.errors.heading_rmse_rad * 180.0 / M_PI << ',' << g.nees.fraction_inside() << '\n';
+    }
+  }
+
+ private:
+  std::ofstream open(const std::string& name) const {
+    std::ofstream f(dir_ + "/" + name);
+    if (!f) throw std::runtime_error("cannot write " + dir_ + "/" + name);
+    f.precision(9);
+    return f;
+  }
+  std::string dir_;
+  std::ofstream runs_;
+};
+
 struct EvalArguments {
-  std::string dataset, config_path, association = "known_id";
+  std::string dataset, config_path, association = "known_id", out_dir;
   std::vector<int> robots{1, 2, 3, 4, 5}, seeds{1, 2, 3};
   double segment_every_s = 0.0;  // 0: no segments
   bool loro = false, blind_return = false, optimise = false;
@@ -434,6 +490,7 @@ int run(const EvalArguments& args) {
   const offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
   root.finish();
   if (association == "maximum_likelihood") options.association = slam::Association::kMaximumLikelihood;
+  CsvOutput csv(args.out_dir);
 
   std::printf("%-6s %-5s %9s %9s %9s %10s %10s %11s %11s %8s %5s %8s %7s %6s %6s\n", "robot", "seed", "ATE_m",
               "ATE_al_m", "DR_ATE_m", "head_deg", "DR_head", "lm_raw_m", "lm_align_m", "gated", "map", "wall_s",
@@ -477,6 +534,7 @@ int run(const EvalArguments& args) {
                   100.0 * rep.nees.fraction_below_upper());
       std::fflush(stdout);
       config_scores[robot].push_back({rep.filter.ate_rmse_m, rep.filter.heading_rmse_rad * kDeg});
+      csv.run(robot, seed, input, res, rep);
       if (const auto opt = optimised(optimise, options, input, res)) {
         const offline::Report o = offline::evaluate(input, *opt);
         std::printf("%-6d %-5d %9.3f %9.3f %9s %10.2f %10s %11.3f %11.3f %8s %5zu %8.2f  (map optimiser)\n", robot,
@@ -549,6 +607,7 @@ int run(const EvalArguments& args) {
       config_segments[robot] = of_robot;
       all.insert(all.end(), of_robot.begin(), of_robot.end());
     }
+    csv.segments(all);
     if (!all.empty()) {
       print_segment_summary("SEGMENTS all robots", all);
       const Segment& worst = *std::max_element(all.begin(), all.end(), [](const Segment& a, const Segment& b) {
@@ -594,6 +653,10 @@ int main(int argc, char** argv) {
            "restarts every 60 s with a blind stretch, then far new landmarks, then the first ones again: the "
            "heading error before and after they return");
   cli.flag("--optimise", a.optimise, "also the map optimiser (Ceres) over every run after the filter");
+  cli.option("--out-dir", a.out_dir,
+             "write runs.csv, segments.csv and errors_robotR_seedS.csv (error over time) there, for "
+             "scripts/plot_results.py")
+      .type("DIR");
   cli.footer("Exit status: 0 done, 1 an error or a robot's mean ATE not better than dead reckoning, 2 a bad "
              "command line or config, 77 the data set folder is absent (skip).");
   if (const auto done = cli.parse(argc, argv)) return *done;

@@ -107,6 +107,26 @@ TEST(CompareTrajectory, DelayedEstimateGivesConstantErrorRemovedByAlignment) {
   EXPECT_NEAR(e.ate_rmse_aligned_m, 0.0, 1e-9);  // a pure translation
 }
 
+TEST(PoseErrors, OnePerTruthPoseInTheSpanInTruthOrderAggregatingToCompareTrajectory) {
+  // Estimate 0.3 m to the side of a straight line and 0.1 rad off, from t = 1 to 3 s;
+  // truth every 0.5 s from 0 to 4 s, given newest first.
+  const std::vector<TimedPose> estimate = {{1.0, 1.0, 0.3, 0.1}, {3.0, 3.0, 0.3, 0.1}};
+  std::vector<TimedPose> truth;
+  for (int i = 8; i >= 0; --i) truth.push_back({0.5 * i, 0.5 * i, 0.0, 0.0});
+  const std::vector<PoseError> errors = pose_errors(estimate, truth);
+  ASSERT_EQ(errors.size(), 5u);  // t = 3.0, 2.5, ..., 1.0
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    EXPECT_DOUBLE_EQ(errors[i].t_s, 3.0 - 0.5 * static_cast<double>(i));
+    EXPECT_NEAR(errors[i].position_m, 0.3, 1e-12);
+    EXPECT_NEAR(errors[i].heading_rad, 0.1, 1e-12);
+  }
+  const TrajectoryErrors e = compare_trajectory(estimate, truth);
+  EXPECT_EQ(e.samples, errors.size());
+  EXPECT_NEAR(e.ate_rmse_m, 0.3, 1e-12);
+  EXPECT_THROW(pose_errors({}, truth), std::invalid_argument);
+  EXPECT_THROW(pose_errors(estimate, {{9.0, 0, 0, 0}}), std::invalid_argument);
+}
+
 TEST(CompareTrajectory, HeadingInterpolatesAcrossPi) {
   const std::vector<TimedPose> estimate = {{0.0, 0, 0, kPi - 0.1}, {1.0, 0, 0, -kPi + 0.1}};
   // Shortest path from pi-0.1 to -pi+0.1 passes through pi: at t=0.5 heading is

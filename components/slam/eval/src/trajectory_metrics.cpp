@@ -56,20 +56,44 @@ TimedPose interpolate(const std::vector<TimedPose>& knots, double t) {
 
 }  // namespace
 
-TrajectoryErrors compare_trajectory(const std::vector<TimedPose>& estimate, const std::vector<TimedPose>& truth) {
+namespace {
+
+// Each truth pose within the estimate's span with the estimate interpolated at its time.
+template <class Visit>
+void for_each_pair(const std::vector<TimedPose>& estimate, const std::vector<TimedPose>& truth, const Visit& visit) {
   if (estimate.empty()) throw std::invalid_argument("compare_trajectory: estimate is empty");
   const std::vector<TimedPose> knots = strictly_increasing(estimate);
   const double t_begin = knots.front().t_s;
   const double t_end = knots.back().t_s;
+  bool any = false;
+  for (const TimedPose& g : truth) {
+    if (!(g.t_s >= t_begin && g.t_s <= t_end)) continue;
+    visit(interpolate(knots, g.t_s), g);
+    any = true;
+  }
+  if (!any) {
+    throw std::invalid_argument("compare_trajectory: no truth pose lies within the estimate's time span [" +
+                                std::to_string(t_begin) + ", " + std::to_string(t_end) + "] s");
+  }
+}
 
+}  // namespace
+
+std::vector<PoseError> pose_errors(const std::vector<TimedPose>& estimate, const std::vector<TimedPose>& truth) {
+  std::vector<PoseError> out;
+  for_each_pair(estimate, truth, [&](const TimedPose& e, const TimedPose& g) {
+    out.push_back({g.t_s, std::hypot(e.x_m - g.x_m, e.y_m - g.y_m), wrap_angle(e.theta_rad - g.theta_rad)});
+  });
+  return out;
+}
+
+TrajectoryErrors compare_trajectory(const std::vector<TimedPose>& estimate, const std::vector<TimedPose>& truth) {
   std::vector<Eigen::Vector2d> est_xy;
   std::vector<Eigen::Vector2d> truth_xy;
   double pos_sum_sq = 0.0;
   double heading_sum_sq = 0.0;
   TrajectoryErrors errors;
-  for (const TimedPose& g : truth) {
-    if (!(g.t_s >= t_begin && g.t_s <= t_end)) continue;
-    const TimedPose e = interpolate(knots, g.t_s);
+  for_each_pair(estimate, truth, [&](const TimedPose& e, const TimedPose& g) {
     const Eigen::Vector2d pe(e.x_m, e.y_m);
     const Eigen::Vector2d pg(g.x_m, g.y_m);
     const double pos_err = (pe - pg).norm();
@@ -79,11 +103,7 @@ TrajectoryErrors compare_trajectory(const std::vector<TimedPose>& estimate, cons
     errors.max_position_error_m = std::max(errors.max_position_error_m, pos_err);
     est_xy.push_back(pe);
     truth_xy.push_back(pg);
-  }
-  if (est_xy.empty()) {
-    throw std::invalid_argument("compare_trajectory: no truth pose lies within the estimate's time span [" +
-                                std::to_string(t_begin) + ", " + std::to_string(t_end) + "] s");
-  }
+  });
   errors.samples = est_xy.size();
   const double n = static_cast<double>(errors.samples);
   errors.ate_rmse_m = std::sqrt(pos_sum_sq / n);

@@ -45,6 +45,18 @@ struct TrajectoryErrors {
 // if the estimate is empty or unsorted, or if no truth pose falls in its span.
 TrajectoryErrors compare_trajectory(const std::vector<TimedPose>& estimate, const std::vector<TimedPose>& truth);
 
+// The error at one truth pose: estimate (interpolated as above) minus truth.
+struct PoseError {
+  double t_s = 0.0;
+  double position_m = 0.0;   // |estimate - truth|
+  double heading_rad = 0.0;  // wrapped estimate - truth
+};
+
+// The errors compare_trajectory() aggregates, one per truth pose within the
+// estimate's span, in the order of `truth` (e.g. the error over time of a run).
+// Same requirements and exceptions as compare_trajectory().
+std::vector<PoseError> pose_errors(const std::vector<TimedPose>& estimate, const std::vector<TimedPose>& truth);
+
 // Landmark map error statistics: ids found in both (matched), truth ids absent
 // from the estimate (missing), estimate ids absent from the truth (extra); RMSE
 // of the position error over matched landmarks, raw and after the best rigid
