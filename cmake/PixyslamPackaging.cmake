@@ -66,13 +66,16 @@ set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
 set(CPACK_DEBIAN_ROBOT_PACKAGE_NAME pixyslam-robot)
-set(CPACK_COMPONENT_ROBOT_DESCRIPTION
+string(CONCAT CPACK_COMPONENT_ROBOT_DESCRIPTION
   "FastSLAM 2.0 for a landmark-pole robot: the robot side over Fast DDS\n"
   "Encoder and Pixy bridges, the FastSLAM 2.0 estimator, the MCAP logger, the launcher,\n"
   "inspection and playback tools and the simulator, with systemd unit; no GUI library.")
 set(CPACK_DEBIAN_ROBOT_PACKAGE_DEPENDS "fastdds-tools, adduser")
+# The single package of earlier versions held these files: replaced on upgrade.
+set(CPACK_DEBIAN_ROBOT_PACKAGE_CONFLICTS pixyslam)
+set(CPACK_DEBIAN_ROBOT_PACKAGE_REPLACES pixyslam)
 set(CPACK_DEBIAN_STATION_PACKAGE_NAME pixyslam-station)
-set(CPACK_COMPONENT_STATION_DESCRIPTION
+string(CONCAT CPACK_COMPONENT_STATION_DESCRIPTION
   "FastSLAM 2.0 for a landmark-pole robot: the station (laptop) side\n"
   "The map viewer, the background map optimiser (Ceres), the offline runner and the\n"
   "calibration tool, with systemd unit.")
@@ -88,8 +91,14 @@ file(WRITE ${PROJECT_BINARY_DIR}/debian/conffiles "${pixyslam_conffiles}")
 # stopped before removal (prerm), state, user and enablement links gone on purge (postrm).
 set(robot_scripts ${PROJECT_SOURCE_DIR}/packaging/debian/robot)
 set(station_scripts ${PROJECT_SOURCE_DIR}/packaging/debian/station)
+foreach(component robot station)
+  set(UNIT pixyslam-${component}.service)
+  configure_file(${PROJECT_SOURCE_DIR}/packaging/debian/prerm.in ${PROJECT_BINARY_DIR}/debian/${component}/prerm
+                 @ONLY FILE_PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE GROUP_READ GROUP_EXECUTE
+                 WORLD_READ WORLD_EXECUTE)
+endforeach()
 set(CPACK_DEBIAN_ROBOT_PACKAGE_CONTROL_EXTRA ${PROJECT_BINARY_DIR}/debian/conffiles
-  ${robot_scripts}/postinst ${robot_scripts}/prerm ${robot_scripts}/postrm)
+  ${robot_scripts}/postinst ${PROJECT_BINARY_DIR}/debian/robot/prerm ${robot_scripts}/postrm)
 set(CPACK_DEBIAN_STATION_PACKAGE_CONTROL_EXTRA
-  ${station_scripts}/postinst ${station_scripts}/prerm ${station_scripts}/postrm)
+  ${station_scripts}/postinst ${PROJECT_BINARY_DIR}/debian/station/prerm ${station_scripts}/postrm)
 include(CPack)

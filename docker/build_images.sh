@@ -1,28 +1,33 @@
 #!/usr/bin/env bash
 # Builds pixyslam-{robot,estimator,logger,viewer} from docker/Dockerfile on the
 # local base image (docker/build_base_image.sh) and prints their sizes.
-#   docker/build_images.sh [podman|docker] [--from-source]
-# Default: from the packages of this checkout's build (cpack of build/, the
-# programs the tests ran); --from-source: the Dockerfile's builder stage
-# compiles the checkout (no host build needed). Exit 77: no such engine here.
+#   docker/build_images.sh [podman|docker] [--from-source] [--build-dir DIR]
+# Default: from the packages of this checkout's build (cpack of build/, or of
+# --build-dir: the programs the tests ran); --from-source: the Dockerfile's
+# builder stage compiles the checkout (no host build needed). Exit 77: no such
+# engine here.
 set -euo pipefail
-engine=podman from_source=0
-for a in "$@"; do
-  case $a in
+engine=podman from_source=0 build_dir=""
+while (($#)); do
+  case $1 in
     --from-source) from_source=1 ;;
-    podman|docker) engine=$a ;;
-    -h|--help) sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
-    *) echo "build_images: unknown argument '$a' (see --help)" >&2; exit 2 ;;
+    --build-dir) build_dir=${2:?--build-dir needs a folder}; shift ;;
+    podman|docker) engine=$1 ;;
+    -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "build_images: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
+  shift
 done
 command -v "$engine" >/dev/null || { echo "SKIP: $engine is not installed"; exit 77; }
 root=$(cd "$(dirname "$0")/.." && pwd)
 export CONTAINERS_CONF=${CONTAINERS_CONF:-$root/docker/containers.conf}
 packages=builder
 if ((from_source == 0)); then
-  [[ -f $root/build/CPackConfig.cmake ]] || { echo "build/ is not configured: run scripts/build.sh first (or --from-source)" >&2; exit 1; }
+  build_dir=${build_dir:-$root/build}
+  [[ -f $build_dir/CPackConfig.cmake ]] || { echo "$build_dir is not configured: run scripts/build.sh first (or --from-source)" >&2; exit 1; }
+  # The build context holds build/packages/ (.dockerignore): that build's packages go there.
   rm -rf "$root/build/packages"
-  cpack --config "$root/build/CPackConfig.cmake" -G DEB -B "$root/build/packages" > /dev/null
+  cpack --config "$build_dir/CPackConfig.cmake" -G DEB -B "$root/build/packages" > /dev/null
   rm -rf "$root/build/packages/_CPack_Packages"
   packages=context
 fi

@@ -37,7 +37,7 @@ def quantile(sorted_values, q):
 
 
 def error_over_time(plt, indir, seed, out):
-    files = sorted(glob.glob(os.path.join(indir, f"errors_robot*_seed{seed}.csv")))
+    files = [f for f in sorted(glob.glob(os.path.join(indir, f"errors_robot*_seed{seed}.csv"))) if read_csv(f)]
     if not files:
         return None
     fig, (ax_pos, ax_head) = plt.subplots(2, 1, figsize=(10, 7), sharex=True)
@@ -70,6 +70,8 @@ def segment_distribution(plt, indir, out):
     rows = read_csv(path_in)
     ate = sorted(column(rows, "ate_m"))
     n = len(ate)
+    if n == 0:
+        return None
     fig, (ax_hist, ax_cdf) = plt.subplots(1, 2, figsize=(11, 4))
     ax_hist.hist(ate, bins=30, color="#4c72b0")
     ax_hist.set_xlabel("ATE of the restarted run [m]")
@@ -97,6 +99,8 @@ def latency_histogram(plt, indir, out):
         return None
     lat = sorted(column(read_csv(path_in), "latency_ms"))
     n = len(lat)
+    if n == 0:
+        return None
     fig, ax = plt.subplots(figsize=(8, 4))
     ax.hist(lat, bins=40, color="#55a868")
     for q, label in ((0.5, "p50"), (0.99, "p99")):
@@ -139,7 +143,7 @@ def main():
             print(f"plot_results: {path}")
             written += 1
         else:
-            print(f"plot_results: no {name} in {args.dir}: skipped", file=sys.stderr)
+            print(f"plot_results: no (or an empty) {name} in {args.dir}: skipped", file=sys.stderr)
     return 0 if written else 1
 
 

@@ -28,6 +28,9 @@ cleanup() {
   for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
   sleep 0.5
   for pid in "${pids[@]}"; do kill -KILL "$pid" 2>/dev/null || true; done
+  for h in fast cyc; do  # anything left in the namespaces
+    ip netns pids "${tag}_$h" 2>/dev/null | xargs -r kill -KILL 2>/dev/null || true
+  done
   ip netns del "${tag}_fast" 2>/dev/null || true
   ip netns del "${tag}_cyc" 2>/dev/null || true
   rm -rf "$work"
@@ -68,11 +71,14 @@ grep -q ready "$work/relay.log" || fail "cyclone_relay did not match the recorde
 "${fast[@]}" "$bin/mcap_sample_publisher" --profiles "$config/dds/profiles.xml" --domain "$domain" \
   --count "$count" --rate 100 --topics all --diagnostics --readers 2 --wait-readers 30 > "$work/publisher.log" 2>&1 ||
   fail "publisher (no Cyclone reader matched, or samples not acknowledged)"
-sleep 2  # the relayed samples reach their recorder
-kill -INT "${pids[@]:0:2}"
-for pid in "${pids[@]:0:2}"; do wait "$pid" || fail "a recorder exited $?"; done
-kill -INT "$relay_pid"
-wait "$relay_pid" || fail "cyclone_relay exited $?"
+sleep 1  # the last samples reach the relay
+# The relay first: it waits for the relayed recorder's acknowledgments.
+kill -INT "$relay_pid" 2>/dev/null || true
+status=0
+wait "$relay_pid" || status=$?
+((status == 0)) || fail "cyclone_relay exited $status (its samples not all acknowledged?)"
+kill -INT "${pids[@]:0:2}" 2>/dev/null || true
+for pid in "${pids[@]:0:2}"; do status=0; wait "$pid" || status=$?; ((status == 0)) || fail "a recorder exited $status"; done
 pids=()
 cat "$work/relay.log"
 

@@ -6,10 +6,10 @@
  * Cyclone writer -> Fast DDS reader, compared field by field by the caller.
  *   cyclone_relay IN_DOMAIN OUT_DOMAIN SECONDS
  * Prints "ready" once every writer has matched a reader on OUT_DOMAIN (so that
- * nothing relayed is lost to a reader not yet there; up to 30 s, else exit 1),
- * then "relayed TOPIC N" per topic at
- * the end (after SECONDS or SIGINT/SIGTERM). Exit status: 0 ok, 1 DDS error,
- * 2 usage error. */
+ * nothing relayed is lost to a reader not yet there; 30 s for all, else exit 1),
+ * then "relayed TOPIC N" per topic at the end (after SECONDS or SIGINT/SIGTERM).
+ * Exit status: 0 ok, 1 DDS error, no reader matched, or written samples not
+ * acknowledged within 5 s; 2 usage error. A process ending frees every entity. */
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -91,6 +91,7 @@ int main(int argc, char** argv) {
   dds_qset_durability(writer_qos, DDS_DURABILITY_TRANSIENT_LOCAL);
 
   const dds_entity_t waitset = dds_create_waitset(in);
+  if (waitset < 0) return fail("waitset", waitset);
   for (int i = 0; i < kRoutes; ++i) {
     route_t* r = &routes[i];
     const dds_entity_t in_topic = dds_create_topic(in, r->type, r->topic, NULL, NULL);
@@ -100,18 +101,20 @@ int main(int argc, char** argv) {
     r->writer = dds_create_writer(out, out_topic, writer_qos, NULL);
     if (r->reader < 0 || r->writer < 0) return fail(r->topic, r->reader < 0 ? r->reader : r->writer);
     const dds_entity_t condition = dds_create_readcondition(r->reader, DDS_ANY_STATE);
+    if (condition < 0) return fail("read condition", condition);
     const dds_return_t attached = dds_waitset_attach(waitset, condition, (dds_attach_t)i);
     if (attached < 0) return fail("waitset", attached);
   }
   dds_delete_qos(reader_qos);
   dds_delete_qos(writer_qos);
+  const dds_time_t give_up = dds_time() + DDS_SECS(30);
   for (int i = 0; i < kRoutes; ++i) {
-    const dds_time_t give_up = dds_time() + DDS_SECS(30);
     dds_publication_matched_status_t matched = {0};
     while (dds_get_publication_matched_status(routes[i].writer, &matched) == DDS_RETCODE_OK &&
            matched.current_count == 0) {
-      if (stop_requested || dds_time() > give_up) {
-        fprintf(stderr, "cyclone_relay: no reader of %s on domain %ld\n", routes[i].topic, out_domain);
+      if (stop_requested) return 0;
+      if (dds_time() > give_up) {
+        fprintf(stderr, "cyclone_relay: no reader of %s on domain %ld after 30 s\n", routes[i].topic, out_domain);
         return 1;
       }
       dds_sleepfor(DDS_MSECS(20));
@@ -143,9 +146,16 @@ int main(int argc, char** argv) {
       }
     }
   }
-  /* Let the readers on the other domain acknowledge what was written. */
-  for (int i = 0; i < kRoutes; ++i) dds_wait_for_acks(routes[i].writer, DDS_SECS(5));
+  /* The readers on the other domain acknowledge what was written. */
+  int status = 0;
+  for (int i = 0; i < kRoutes; ++i) {
+    const dds_return_t acked = dds_wait_for_acks(routes[i].writer, DDS_SECS(5));
+    if (acked < 0) {
+      fprintf(stderr, "cyclone_relay: %s: not acknowledged: %s\n", routes[i].topic, dds_strretcode(acked));
+      status = 1;
+    }
+  }
   for (int i = 0; i < kRoutes; ++i) printf("relayed %s %llu\n", routes[i].topic, routes[i].relayed);
   dds_delete(DDS_CYCLONEDDS_HANDLE);
-  return 0;
+  return status;
 }

@@ -51,7 +51,7 @@ Deployment read_deployment(const std::string& path) {
     server.finish();
   }
   d.security_dir = y.text("security_dir", "");
-  d.type_information = y.choice("type_information", {"true", "false"}, d.type_information);
+  if (y.has("type_information")) d.type_information = y.choice("type_information", {"true", "false"}, "false");
   if (d.type_information == "true" && d.profile == "discovery_client") {
     // `fastdds discovery` (2.9) crashes on the type information of a sequence of structs.
     y.fail("type_information", "true does not work with profile discovery_client (the Fast DDS 2.9 discovery "
@@ -116,7 +116,7 @@ std::vector<std::pair<std::string, std::string>> host_environment(const Deployme
     environment.emplace_back("PIXYSLAM_DDS_SERVER", server->address + ":" + std::to_string(d.discovery_server_port));
     environment.emplace_back("PIXYSLAM_DDS_SERVER_ID", std::to_string(d.discovery_server_id));
   }
-  environment.emplace_back("PIXYSLAM_DDS_TYPE_INFORMATION", d.type_information);
+  if (!d.type_information.empty()) environment.emplace_back("PIXYSLAM_DDS_TYPE_INFORMATION", d.type_information);
   if (!d.security_dir.empty()) environment.emplace_back("PIXYSLAM_DDS_SECURITY_DIR", d.security_dir);
   return environment;
 }

@@ -24,10 +24,10 @@ struct Deployment {
   int discovery_server_port = 11811;
   int discovery_server_id = 0;
   std::string security_dir;  // profile secure: scripts/make_dds_security.sh output
-  // Announce XTypes type information ("true" | "false"): for generic Fast DDS
-  // tools; off (default) other vendors match, the links carry ~10x less
-  // discovery traffic, and the 2.9 discovery server does not crash.
-  std::string type_information = "false";
+  // Announce XTypes type information ("true" | "false") on every process of
+  // the deployment; "" (key absent): each process's own dds.type_information
+  // (off by default: other vendors match, ~10x less discovery traffic).
+  std::string type_information;
   std::vector<HostSpec> hosts;
 };
 
