@@ -36,6 +36,31 @@ def quantile(sorted_values, q):
     return sorted_values[lo] + (rank - lo) * (sorted_values[hi] - sorted_values[lo])
 
 
+def sorted_column(indir, name, col):
+    """The column of indir/name sorted, or None when the file is absent or empty."""
+    path = os.path.join(indir, name)
+    if not os.path.exists(path):
+        return None
+    values = sorted(column(read_csv(path), col))
+    return values or None
+
+
+def mark_quantiles(ax, values, marks, y_of, unit_format):
+    """A dashed line and a label at each (q, label) of marks; y_of(i) places label i."""
+    for i, (q, label) in enumerate(marks):
+        v = quantile(values, q)
+        ax.axvline(v, linestyle="--", color="grey", linewidth=0.8)
+        ax.text(v, y_of(i), f" {label} {unit_format.format(v)}", fontsize=8)
+
+
+def save(plt, fig, out, name):
+    fig.tight_layout()
+    path = os.path.join(out, name)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def error_over_time(plt, indir, seed, out):
     files = [f for f in sorted(glob.glob(os.path.join(indir, f"errors_robot*_seed{seed}.csv"))) if read_csv(f)]
     if not files:
@@ -56,65 +81,40 @@ def error_over_time(plt, indir, seed, out):
     ax_head.set_ylabel("|heading error| [deg]")
     ax_head.set_xlabel("time since the robot's first ground-truth pose [s]")
     ax_head.grid(alpha=0.3)
-    fig.tight_layout()
-    path = os.path.join(out, "mrclam_error_over_time.png")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(plt, fig, out, "mrclam_error_over_time.png")
 
 
 def segment_distribution(plt, indir, out):
-    path_in = os.path.join(indir, "segments.csv")
-    if not os.path.exists(path_in):
+    ate = sorted_column(indir, "segments.csv", "ate_m")
+    if ate is None:
         return None
-    rows = read_csv(path_in)
-    ate = sorted(column(rows, "ate_m"))
     n = len(ate)
-    if n == 0:
-        return None
     fig, (ax_hist, ax_cdf) = plt.subplots(1, 2, figsize=(11, 4))
     ax_hist.hist(ate, bins=30, color="#4c72b0")
     ax_hist.set_xlabel("ATE of the restarted run [m]")
     ax_hist.set_ylabel("segment starts")
     ax_hist.set_title(f"{n} restarts from the truth every 60 s")
     ax_cdf.plot(ate, [(i + 1) / n for i in range(n)], color="#4c72b0")
-    for q, label in ((0.5, "median"), (0.9, "p90")):
-        v = quantile(ate, q)
-        ax_cdf.axvline(v, linestyle="--", color="grey", linewidth=0.8)
-        ax_cdf.text(v, 0.05 if q == 0.5 else 0.15, f" {label} {v:.3f} m", fontsize=8)
+    mark_quantiles(ax_cdf, ate, ((0.5, "median"), (0.9, "p90")), lambda i: (0.05, 0.15)[i], "{:.3f} m")
     ax_cdf.set_xlabel("ATE [m]")
     ax_cdf.set_ylabel("fraction of segment starts")
     ax_cdf.set_title(f"mean {sum(ate) / n:.3f} m, worst {ate[-1]:.3f} m")
     ax_cdf.grid(alpha=0.3)
-    fig.tight_layout()
-    path = os.path.join(out, "mrclam_segment_ate.png")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(plt, fig, out, "mrclam_segment_ate.png")
 
 
 def latency_histogram(plt, indir, out):
-    path_in = os.path.join(indir, "latency.csv")
-    if not os.path.exists(path_in):
+    lat = sorted_column(indir, "latency.csv", "latency_ms")
+    if lat is None:
         return None
-    lat = sorted(column(read_csv(path_in), "latency_ms"))
     n = len(lat)
-    if n == 0:
-        return None
     fig, ax = plt.subplots(figsize=(8, 4))
     ax.hist(lat, bins=40, color="#55a868")
-    for q, label in ((0.5, "p50"), (0.99, "p99")):
-        v = quantile(lat, q)
-        ax.axvline(v, linestyle="--", color="grey", linewidth=0.8)
-        ax.text(v, ax.get_ylim()[1] * (0.9 if q == 0.5 else 0.7), f" {label} {v:.2f} ms", fontsize=8)
+    mark_quantiles(ax, lat, ((0.5, "p50"), (0.99, "p99")), lambda i: ax.get_ylim()[1] * (0.9, 0.7)[i], "{:.2f} ms")
     ax.set_xlabel("Odometry published -> MapState received [ms]")
     ax.set_ylabel("samples")
     ax.set_title(f"end-to-end latency through slam_estimator on loopback, {n} samples")
-    fig.tight_layout()
-    path = os.path.join(out, "latency_histogram.png")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(plt, fig, out, "latency_histogram.png")
 
 
 def main():
