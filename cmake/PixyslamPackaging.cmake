@@ -2,7 +2,7 @@
 #   pixyslam-robot    what runs on the robot, no GUI library (OpenCV core,
 #                     imgproc, videoio for the camera only): the bridges, the
 #                     estimator, the logger, the launcher, the inspection and
-#                     playback tools, the simulator; config/ as /etc/pixyslam
+#                     playback tools, the simulator, the Foxglove bridge; config/ as /etc/pixyslam
 #                     (conffiles), /etc/default/pixyslam, the robot unit, the
 #                     pixyslam system user (maintainer scripts), the docs.
 #   pixyslam-station  the laptop's extras, depending on pixyslam-robot: map_view
@@ -19,6 +19,9 @@ include(GNUInstallDirs)
 set(pixyslam_robot_programs
   encoder_bridge pixy_bridge slam_estimator logger robot_sim sim_evaluator
   pixyslam_launch pixyslam_spy pixyslam_log pixyslam_play)
+if(TARGET foxglove_bridge)
+  list(APPEND pixyslam_robot_programs foxglove_bridge)
+endif()
 set(pixyslam_station_programs slam_offline pixyslam_calibrate)
 foreach(optional map_view map_optimizer)
   if(TARGET ${optional})
@@ -69,6 +72,7 @@ set(CPACK_DEBIAN_ROBOT_PACKAGE_NAME pixyslam-robot)
 string(CONCAT CPACK_COMPONENT_ROBOT_DESCRIPTION
   "FastSLAM 2.0 for a landmark-pole robot: the robot side over Fast DDS\n"
   "Encoder and Pixy bridges, the FastSLAM 2.0 estimator, the MCAP logger, the launcher,\n"
+  "the Foxglove WebSocket bridge,\n"
   "inspection and playback tools and the simulator, with systemd unit; no GUI library.")
 set(CPACK_DEBIAN_ROBOT_PACKAGE_DEPENDS "fastdds-tools, adduser")
 # The single package of earlier versions held these files: replaced on upgrade.

@@ -15,7 +15,11 @@ PACKAGES=(
   podman runc debootstrap
   clang-14 libclang-rt-14-dev
   cyclonedds-dev cyclonedds-tools
+  libwebsocketpp-dev libasio-dev nlohmann-json3-dev
 )
+# Node.js and npm run the tests that use Foxglove's and MCAP's own npm clients;
+# Debian's only where the machine has none (a newer one may be installed apart).
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then PACKAGES+=(nodejs npm); fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -18,6 +18,7 @@
 // 2 command-line or config error.
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <cstdlib>
 #include <ctime>
 #include <exception>
@@ -191,6 +192,14 @@ int main(int argc, char** argv) {
       .non_negative()
       .type("X");
 
+  log_tool::FoxgloveRequest foxglove_request;
+  std::vector<std::string> foxglove_files;
+  app::Cli& foxglove = cli.subcommand(
+      "foxglove", "a copy of a recording with 3D scene channels for Foxglove (SceneUpdate, PosesInFrame, FrameTransform)");
+  foxglove.option("files", foxglove_files, "the recording and the new file").required().type("IN.mcap OUT.mcap");
+  foxglove.option("--compression", foxglove_request.compression, "chunk compression of OUT")
+      .choices({"none", "zstd", "lz4"});
+
   try {
     if (const auto done = cli.parse(argc, argv)) return *done;
   } catch (const app::UsageError& e) {  // from --expect
@@ -207,6 +216,16 @@ int main(int argc, char** argv) {
       compare_request.second_path = compare_files[1];
       for (std::string& field : parameters::split_list(ignored)) compare_request.ignored.push_back(std::move(field));
       return log_tool::run_compare(compare_request, std::cout);
+    }
+    if (foxglove.chosen()) {
+      if (foxglove_files.size() != 2) throw app::UsageError("foxglove needs the recording and the new file");
+      foxglove_request.input_path = foxglove_files[0];
+      foxglove_request.output_path = foxglove_files[1];
+      if (std::filesystem::exists(foxglove_request.output_path) &&
+          std::filesystem::equivalent(foxglove_request.input_path, foxglove_request.output_path)) {
+        throw app::UsageError("foxglove: OUT is IN; write a new file");
+      }
+      return log_tool::run_foxglove(foxglove_request, std::cerr);
     }
     if (record.chosen()) {
       logger_node::LoggerOptions o;

@@ -61,4 +61,20 @@ struct CompareRequest {
 // messages and every compared field agrees, else 1.
 int run_compare(const CompareRequest& request, std::ostream& out);
 
+struct FoxgloveRequest {
+  std::string input_path;
+  std::string output_path;
+  std::string compression = "zstd";  // none | zstd | lz4 (zstd falls back to none where not built)
+};
+
+// `pixyslam_log foxglove IN.mcap OUT.mcap`: OUT holds every message of IN
+// unchanged (same topics, schemas, times) plus the foxglove_bridge's
+// pixyslam/viz/* channels (foxglove.SceneUpdate, PosesInFrame, FrameTransform
+// in OMG IDL, CDR) made from each MapState and GroundTruth, at the log time of
+// the message they come from, so Foxglove draws the recording in 3D. Prints a
+// line per visual channel on `err`. Returns 0; 1 if a MapState or GroundTruth
+// did not decode (counted, skipped: the rest is converted) or IN is damaged
+// (what could be read is converted).
+int run_foxglove(const FoxgloveRequest& request, std::ostream& err);
+
 }  // namespace pixyslam::log_tool
