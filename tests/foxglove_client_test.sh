@@ -44,6 +44,7 @@ if ! (cd "$work/npm" && timeout 180 npm ci --no-audit --no-fund --loglevel=error
   exit 77
 fi
 export FOXGLOVE_NODE_MODULES=$work/npm/node_modules
+export FOXGLOVE_LAYOUT=$source_dir/docs/foxglove_layout.json
 client=$source_dir/tests/foxglove/foxglove_client.mjs
 data_topics=(pixyslam/odometry pixyslam/landmark_observation pixyslam/map_state pixyslam/ground_truth
              pixyslam/diagnostics pixyslam/optimised_map)
@@ -88,7 +89,7 @@ bridge_status=0
 wait "$bridge_pid" || bridge_status=$?
 tail -n 1 "$work/bridge.log"
 [[ $bridge_status -eq 0 ]] || fail "foxglove_bridge: exit $bridge_status after SIGINT"
-grep -q "7 bad requests" "$work/bridge.log" || fail "foxglove_bridge did not count the 7 malformed requests"
+grep -q "(1 refused, 7 bad requests)" "$work/bridge.log" || fail "foxglove_bridge did not count the refused client and the 7 malformed requests"
 
 "$bin/pixyslam_log" foxglove "$work/recording.mcap" "$work/foxglove.mcap" --compression none \
   > "$work/convert.log" 2>&1 || fail "pixyslam_log foxglove failed"

@@ -93,7 +93,24 @@ function crossCheck() {
   return checked;
 }
 
+// Every topic docs/foxglove_layout.json names (3D topics, plot paths, raw
+// message paths) must be one this run decoded: the layout cannot rot.
+function checkLayout() {
+  const file = process.env.FOXGLOVE_LAYOUT;
+  if (!file) return;
+  const layout = JSON.parse(readFileSync(file, "utf8"));
+  const named = new Set();
+  for (const panel of Object.values(layout.configById)) {
+    for (const topic of Object.keys(panel.topics ?? {})) named.add(topic);
+    for (const p of panel.paths ?? []) named.add(p.value.split(".")[0]);
+    if (panel.topicPath) named.add(panel.topicPath.split(".")[0]);
+  }
+  for (const topic of named) if (!stats.has(topic)) fail(`layout ${file} names ${topic}, which was not received`);
+  console.log(`layout: ${named.size} topics named, all received: ${[...named].every((t) => stats.has(t))}`);
+}
+
 function report(expected) {
+  checkLayout();
   for (const topic of expected) {
     const s = stats.get(topic);
     if (s === undefined || s.count === 0) fail(`${topic}: no message decoded`);
@@ -157,10 +174,41 @@ async function live(url, seconds, expected) {
   report(expected);
 }
 
-// A second connection sends malformed requests and must get a status for each.
+// A second connection sends malformed requests and must get a status for each;
+// then a connection without the subprotocol must be refused, and one sending a
+// frame over the server's limit closed (code 1009), the first client unharmed.
 let abuseDone = Promise.resolve();
 function sendRaw(url) {
-  abuseDone = new Promise((resolve) => {
+  abuseDone = malformedRequests(url).then(() => withoutSubprotocol(url)).then(() => oversizedFrame(url));
+}
+
+function withoutSubprotocol(url) {
+  return new Promise((resolve) => {
+    const ws = new WebSocket(url);
+    ws.on("open", () => { fail("a connection without the foxglove.websocket.v1 subprotocol was accepted"); ws.close(); });
+    ws.on("unexpected-response", (_req, res) => { console.log(`no subprotocol: refused with HTTP ${res.statusCode}`); resolve(); });
+    ws.on("error", () => resolve());
+    ws.on("close", () => resolve());
+  });
+}
+
+function oversizedFrame(url) {
+  return new Promise((resolve) => {
+    const ws = new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
+    const timer = setTimeout(() => { fail("oversized frame: connection not closed"); ws.terminate(); resolve(); }, 5000);
+    ws.on("open", () => ws.send("x".repeat(200000)));
+    ws.on("close", (code) => {
+      clearTimeout(timer);
+      console.log(`oversized frame: connection closed with code ${code}`);
+      if (code !== 1009) fail(`oversized frame: close code ${code}, expected 1009 (message too big)`);
+      resolve();
+    });
+    ws.on("error", () => {});
+  });
+}
+
+function malformedRequests(url) {
+  return new Promise((resolve) => {
     const ws = new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
     const requests = [
       "not json",
@@ -187,7 +235,8 @@ function sendRaw(url) {
       resolve();
     });
     ws.on("error", (e) => { fail(`abuse connection: ${e.message}`); resolve(); });
-    setTimeout(() => ws.close(), 5000);
+    const timer = setTimeout(() => ws.close(), 5000);
+    ws.on("close", () => clearTimeout(timer));
   });
 }
 
