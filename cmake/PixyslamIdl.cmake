@@ -2,7 +2,8 @@
 #
 # Generates C++ types, PubSubTypes and TypeObjects with fastddsgen (-typeobject)
 # into the build tree at build time, and a static library TARGET of them linked
-# to Fast DDS. PLAIN_IDL_FILES get types and PubSubTypes only: fastddsgen 2.3's
+# to Fast DDS. The types' constructors do not re-register the TypeObjects
+# (cmake/strip_type_registration.cmake): the participant registers them once. PLAIN_IDL_FILES get types and PubSubTypes only: fastddsgen 2.3's
 # types re-register their TypeObjects in every constructor, which costs far
 # more than the message itself for types built by the thousand (Foxglove's). Also generates <TARGET>_idl_text.cpp: each file's IDL with its
 # includes inlined (an `omgidl` schema for MCAP), looked up by file stem.
@@ -22,10 +23,16 @@ function(pixyslam_add_idl_library target)
       list(APPEND generated ${out_dir}/${stem}${suffix}.cxx ${out_dir}/${stem}${suffix}.h)
     endforeach()
   endforeach()
+  set(type_sources "")
+  foreach(idl ${ARG_IDL_FILES})
+    get_filename_component(stem ${idl} NAME_WE)
+    list(APPEND type_sources ${out_dir}/${stem}.cxx)
+  endforeach()
   add_custom_command(
     OUTPUT ${generated}
     COMMAND ${FASTDDSGEN_EXECUTABLE} -typeobject -replace -t ${tmp_dir} -d ${out_dir} -I ${ARG_IDL_DIR} ${idl_paths}
-    DEPENDS ${idl_paths}
+    COMMAND ${CMAKE_COMMAND} "-DFILES=${type_sources}" -P ${PROJECT_SOURCE_DIR}/cmake/strip_type_registration.cmake
+    DEPENDS ${idl_paths} ${PROJECT_SOURCE_DIR}/cmake/strip_type_registration.cmake
     WORKING_DIRECTORY ${out_dir}
     COMMENT "fastddsgen: ${ARG_IDL_FILES}"
     VERBATIM)
