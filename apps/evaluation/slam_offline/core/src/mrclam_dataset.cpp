@@ -201,6 +201,10 @@ RobotData load_robot(const std::string& dataset_dir, int robot) {
     const int subject = it->second;
     if (subject >= kFirstRobot && subject <= kLastRobot) {
       ++data.counts.robot_rows;
+      if (data.robot_sightings.empty() || data.robot_sightings.back().t_s != m.t_s) {
+        data.robot_sightings.push_back(MeasurementFrame{m.t_s, {}});
+      }
+      data.robot_sightings.back().detections.push_back(Detection{subject, m.range_m, m.bearing_rad});
       continue;
     }
     ++data.counts.landmark_rows;
@@ -275,9 +279,11 @@ void write_robot(const std::string& dataset_dir, const RobotData& data) {
   });
   write_file(dir / (prefix + "Measurement.dat"), [&](std::ostream& out) {
     out << "# Time [s]\tBarcode #\trange [m]\tbearing [rad]\n";
-    for (const MeasurementFrame& f : data.frames) {
-      for (const Detection& d : f.detections) {
-        out << f.t_s << '\t' << d.subject << '\t' << d.range_m << '\t' << d.bearing_rad << '\n';
+    for (const std::vector<MeasurementFrame>* frames : {&data.frames, &data.robot_sightings}) {
+      for (const MeasurementFrame& f : *frames) {
+        for (const Detection& d : f.detections) {
+          out << f.t_s << '\t' << d.subject << '\t' << d.range_m << '\t' << d.bearing_rad << '\n';
+        }
       }
     }
   });

@@ -74,7 +74,11 @@ class SeqTracker {
 template <class Message>
 class Writer {
  public:
-  explicit Writer(Participant& participant) : participant_(participant) {
+  // `robot_id`: written into each header by publish() ("" = the participant's
+  // dds.robot_id; a process publishing for several robots names each).
+  explicit Writer(Participant& participant, std::string robot_id = "")
+      : participant_(participant),
+        robot_id_(robot_id.empty() ? participant.options().robot_id : std::move(robot_id)) {
     const std::string topic(MessageTraits<Message>::topic);
     writer_ = participant.publisher().create_datawriter_with_profile(
         &participant.topic(topic, detail::type_support<Message>()), topic);
@@ -99,7 +103,7 @@ class Writer {
   // Returns false if DDS refused the sample (e.g. history full and timed out).
   bool publish(Message& message) {
     message.header().seq(++seq_);
-    message.header().robot_id(participant_.options().robot_id);
+    message.header().robot_id(robot_id_);
     const bool ok = writer_->write(&message);
     if (!ok) ++failures_;
     return ok;
@@ -140,6 +144,7 @@ class Writer {
 
  private:
   Participant& participant_;
+  std::string robot_id_;
   eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
   std::uint64_t seq_ = 0;
   std::uint64_t failures_ = 0;

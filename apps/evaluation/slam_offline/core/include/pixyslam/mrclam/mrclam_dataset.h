@@ -50,7 +50,8 @@ struct ReadCounts {
 
 // Everything one robot contributes, sorted by time (stable sorts, so rows with
 // equal times keep their file order). Frames hold landmark detections only;
-// frames that saw no landmark are omitted. groundtruth is empty if
+// frames that saw no landmark are omitted; robot_sightings hold the rows that
+// saw another robot, grouped by time the same way. groundtruth is empty if
 // RobotN_Groundtruth.dat is absent. landmarks come from
 // Landmark_Groundtruth_fixed_11_17.dat when that file exists (Dataset1's
 // original file has landmarks 11 and 17 swapped), else from
@@ -59,6 +60,7 @@ struct RobotData {
   int robot = 0;
   std::vector<OdometryRow> odometry;
   std::vector<MeasurementFrame> frames;
+  std::vector<MeasurementFrame> robot_sightings;  // the other robots seen (subjects 1..5), same layout
   std::vector<eval::TimedPose> groundtruth;
   std::vector<eval::LandmarkPoint> landmarks;
   std::string landmark_file;
