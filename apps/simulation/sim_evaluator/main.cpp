@@ -73,15 +73,17 @@ int run(const Arguments& args) {
 
   Received r;
   dds::Participant participant(dds_options, "sim_evaluator");
-  dds::Reader<msg::Odometry> odometry(participant, [](const msg::Odometry&) {});
-  dds::Reader<msg::LandmarkObservation> observations(participant, [](const msg::LandmarkObservation&) {});
+  // One robot's run (dds.robot_id): several robots may share the domain.
+  const std::string& robot = dds_options.robot_id;
+  dds::Reader<msg::Odometry> odometry(participant, [](const msg::Odometry&) {}, robot);
+  dds::Reader<msg::LandmarkObservation> observations(participant, [](const msg::LandmarkObservation&) {}, robot);
   dds::Reader<msg::GroundTruth> truth(participant, [&](const msg::GroundTruth& m) {
     std::lock_guard<std::mutex> lock(r.mutex);
     r.truth.push_back({seconds(m.header().stamp_ns()), m.pose().x_m(), m.pose().y_m(), m.pose().theta_rad()});
     if (r.true_landmarks.empty()) {
       for (const msg::TrueLandmark& l : m.landmarks()) r.true_landmarks.push_back({l.landmark_id(), l.x_m(), l.y_m()});
     }
-  });
+  }, robot);
   dds::Reader<msg::MapState> maps(participant, [&](const msg::MapState& m) {
     std::lock_guard<std::mutex> lock(r.mutex);
     const double t = seconds(m.header().stamp_ns());
@@ -90,7 +92,7 @@ int run(const Arguments& args) {
     r.update_ms.push_back(m.update_time_s() * 1e3);
     r.map.clear();
     for (const msg::LandmarkEstimate& l : m.landmarks()) r.map.push_back({l.landmark_id(), l.x_m(), l.y_m()});
-  });
+  }, robot);
   dds::Reader<msg::OptimisedMap> optimised(participant, [&](const msg::OptimisedMap& m) {
     std::lock_guard<std::mutex> lock(r.mutex);
     if (r.optimised_maps > 0 && m.header().stamp_ns() < r.optimised_stamp_ns) return;  // an older solution
@@ -103,7 +105,7 @@ int run(const Arguments& args) {
     r.optimised_landmarks.clear();
     for (const msg::OptimisedLandmark& l : m.landmarks()) r.optimised_landmarks.push_back({l.landmark_id(), l.x_m(), l.y_m()});
     r.optimiser_cpu_s = m.cpu_time_s();
-  });
+  }, robot);
   std::fprintf(stderr, "sim_evaluator: listening on DDS domain %d\n", dds_options.domain_id);
   while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
   }

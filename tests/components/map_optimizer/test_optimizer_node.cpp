@@ -56,6 +56,7 @@ TEST(OptimizerNode, OptimisesBesideTheEstimatorFromDdsInput) {
       slam_node::read_estimator_options_file(kConfigDir + "/slam_estimator.yaml");
   estimator_options.status_period_s = 0.0;
   estimator_options.initial_pose = run.initial_pose;
+  estimator_options.dds.robot_id = "test_robot";  // the sensors' robot: an estimator reads only its own
   slam_node::EstimatorNode estimator(estimator_options);
   estimator.start();
   OptimizerNodeOptions options = test_options();

@@ -305,6 +305,49 @@ TEST(EstimatorNode, ReportsRejectedInputOnTheDiagnosticsTopic) {
   EXPECT_EQ(counter(reports.back(), "odometry_invalid"), 1);
 }
 
+// Two robots on one domain: each estimator takes its own robot's sensors only
+// (header.robot_id = its dds.robot_id) and counts the other's as ignored.
+TEST(EstimatorNode, TwoRobotsOnOneDomainEachEstimatorReadsItsOwn) {
+  EstimatorOptions a = test_options();
+  a.dds.robot_id = "test_robot_a";
+  EstimatorOptions b = test_options();
+  b.dds.robot_id = "test_robot_b";
+  EstimatorNode node_a(a), node_b(b);
+  node_a.start();
+  node_b.start();
+  dds::Participant sensors(a.dds, "test_sensors");
+  dds::Writer<msg::Odometry> odometry_a(sensors, "test_robot_a"), odometry_b(sensors, "test_robot_b");
+  dds::Writer<msg::LandmarkObservation> frames_b(sensors, "test_robot_b");
+  ASSERT_TRUE(odometry_a.wait_for_readers(2, std::chrono::seconds(10)));
+  ASSERT_TRUE(odometry_b.wait_for_readers(2, std::chrono::seconds(10)));
+  ASSERT_TRUE(frames_b.wait_for_readers(2, std::chrono::seconds(10)));
+  const std::uint64_t base_ns = dds::now_ns();
+  slam::OdometrySample s;
+  s.v_mps = 0.1;
+  for (int i = 0; i < 30; ++i) {  // robot a: 30 odometry; robot b: 20 odometry and 5 frames
+    s.t_s = 0.1 * i;
+    msg::Odometry m = test_support::odometry_msg(s, 0.1, to_stamp_ns(s.t_s, base_ns));
+    ASSERT_TRUE(odometry_a.publish(m));
+    if (i < 20) ASSERT_TRUE(odometry_b.publish(m));
+    if (i < 5) {
+      msg::LandmarkObservation f = test_support::observation_msg(slam::ObservationFrame{s.t_s, {}}, m.header().stamp_ns());
+      ASSERT_TRUE(frames_b.publish(f));
+    }
+  }
+  for (auto* w : {&odometry_a, &odometry_b}) ASSERT_TRUE(w->wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(frames_b.wait_for_acknowledgments(std::chrono::seconds(10)));
+  node_a.stop();
+  node_b.stop();
+  const EstimatorCounters ca = node_a.counters(), cb = node_b.counters();
+  EXPECT_EQ(ca.odometry_received, 30u);
+  EXPECT_EQ(ca.observations_received, 0u);
+  EXPECT_EQ(ca.other_robot_samples, 25u);
+  EXPECT_EQ(cb.odometry_received, 20u);
+  EXPECT_EQ(cb.observations_received, 5u);
+  EXPECT_EQ(cb.other_robot_samples, 30u);
+  EXPECT_EQ(ca.odometry_lost + cb.odometry_lost + cb.observations_lost, 0u);
+}
+
 // Any participant can send any bytes: samples that do not decode are counted
 // per topic (diagnostics), dropped, and the filter goes on with the good ones.
 TEST(EstimatorNode, MalformedSamplesAreCountedAndTheFilterGoesOn) {

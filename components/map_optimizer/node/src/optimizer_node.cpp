@@ -27,12 +27,14 @@ OptimizerNode::OptimizerNode(const OptimizerNodeOptions& options)
   map_optimizer::validate(options_.optimizer);
   participant_ = std::make_unique<dds::Participant>(options_.dds, "map_optimizer");
   writer_ = std::make_unique<dds::Writer<msg::OptimisedMap>>(*participant_);
+  // Only this robot's data (dds.robot_id): several robots may share the domain.
+  const std::string& robot = options_.dds.robot_id;
   odometry_reader_ = std::make_unique<dds::Reader<msg::Odometry>>(
-      *participant_, [this](const msg::Odometry& m) { inbox_.push(m); });
+      *participant_, [this](const msg::Odometry& m) { inbox_.push(m); }, robot);
   observation_reader_ = std::make_unique<dds::Reader<msg::LandmarkObservation>>(
-      *participant_, [this](const msg::LandmarkObservation& m) { inbox_.push(m); });
+      *participant_, [this](const msg::LandmarkObservation& m) { inbox_.push(m); }, robot);
   map_state_reader_ = std::make_unique<dds::Reader<msg::MapState>>(
-      *participant_, [this](const msg::MapState& m) { on_map_state(m); });
+      *participant_, [this](const msg::MapState& m) { on_map_state(m); }, robot);
   diagnostics_ = std::make_unique<diagnostics::DiagnosticsPublisher>(
       *participant_, "map_optimizer", options_.dds.diagnostics_period_s, [this] { return diagnostics_snapshot(); });
 }

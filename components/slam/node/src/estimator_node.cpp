@@ -26,10 +26,11 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options)
   }
   participant_ = std::make_unique<dds::Participant>(options_.dds, "slam_estimator");
   map_writer_ = std::make_unique<dds::Writer<msg::MapState>>(*participant_);
+  // Only this robot's sensors (dds.robot_id): several robots may share the domain.
   odometry_reader_ = std::make_unique<dds::Reader<msg::Odometry>>(
-      *participant_, [this](const msg::Odometry& m) { inbox_.push(m); });
+      *participant_, [this](const msg::Odometry& m) { inbox_.push(m); }, options_.dds.robot_id);
   observation_reader_ = std::make_unique<dds::Reader<msg::LandmarkObservation>>(
-      *participant_, [this](const msg::LandmarkObservation& m) { inbox_.push(m); });
+      *participant_, [this](const msg::LandmarkObservation& m) { inbox_.push(m); }, options_.dds.robot_id);
   diagnostics_ = std::make_unique<diagnostics::DiagnosticsPublisher>(
       *participant_, "slam_estimator", options_.dds.diagnostics_period_s, [this] { return diagnostics_snapshot(); });
   const CheckpointOptions& k = options_.checkpoint;
@@ -79,6 +80,12 @@ void EstimatorNode::stop() {
 
 diagnostics::Snapshot EstimatorNode::diagnostics_snapshot() const {
   const EstimatorCounters c = counters();
+  if (c.odometry_received == 0 && c.other_robot_samples > 0 && !warned_other_robot_.exchange(true)) {
+    std::fprintf(stderr,
+                 "slam_estimator: only other robots' sensor samples arrive (%llu so far), none of robot '%s': is "
+                 "dds.robot_id the same as the bridges'?\n",
+                 static_cast<unsigned long long>(c.other_robot_samples), options_.dds.robot_id.c_str());
+  }
   std::lock_guard<std::mutex> lock(state_mutex_);
   const slam::FilterCounters f = filter_ ? filter_->counters() : slam::FilterCounters{};
   diagnostics::Snapshot s;
@@ -89,6 +96,7 @@ diagnostics::Snapshot EstimatorNode::diagnostics_snapshot() const {
                 {"odometry_malformed", c.odometry_malformed, true},
                 {"observations_malformed", c.observations_malformed, true},
                 {"seq_jumps", c.seq_jumps, true},
+                {"other_robot_samples", c.other_robot_samples, false},
                 {"steps", c.steps, false},
                 {"samples_late", c.samples_late, true},
                 {"samples_reordered", c.samples_reordered, false},
@@ -120,6 +128,7 @@ EstimatorCounters EstimatorNode::counters() const {
   c.odometry_malformed = odometry_reader_->malformed() + odometry_reader_->callback_errors();
   c.observations_malformed = observation_reader_->malformed() + observation_reader_->callback_errors();
   c.seq_jumps = odometry_reader_->seq_jumps() + observation_reader_->seq_jumps();
+  c.other_robot_samples = odometry_reader_->other_robot() + observation_reader_->other_robot();
   const slam::SensorQueueCounters q = inbox_.queue_counters();
   c.samples_late = q.late;
   c.samples_reordered = q.reordered;

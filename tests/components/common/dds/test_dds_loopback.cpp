@@ -18,6 +18,9 @@
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <atomic>
+#include <thread>
+
 #include <gtest/gtest.h>
 
 #include "pixyslam/dds/endpoints.h"
@@ -79,6 +82,43 @@ TEST(DdsLoopback, EveryOdometryMessageArrivesInOrder) {
   }
   EXPECT_EQ(reader.lost(), 0u);
   EXPECT_EQ(reader.received(), static_cast<std::uint64_t>(kCount));
+}
+
+TEST(DdsLoopback, ARobotsReaderGetsOnlyItsRobotsSamples) {
+  Participant sender(loopback_options(), "test_fleet_sender");
+  Participant receiver(loopback_options(), "test_fleet_receiver");
+  std::atomic<int> from_other{0};
+  std::vector<std::uint64_t> seqs;
+  std::mutex mutex;
+  Reader<msg::Odometry> robot2(
+      receiver,
+      [&](const msg::Odometry& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (m.header().robot_id() != "robot2") ++from_other;
+        seqs.push_back(m.header().seq());
+      },
+      "robot2");
+  Collector<msg::Odometry> everyone(receiver);
+  Writer<msg::Odometry> w1(sender, "robot1"), w2(sender, "robot2"), w3(sender, "robot2'; x");
+  ASSERT_TRUE(w1.wait_for_readers(2, std::chrono::seconds(10)));
+  ASSERT_TRUE(w2.wait_for_readers(2, std::chrono::seconds(10)));
+  ASSERT_TRUE(w3.wait_for_readers(2, std::chrono::seconds(10)));
+  for (int i = 0; i < 50; ++i) {
+    msg::Odometry m;
+    ASSERT_TRUE(w1.publish(m));
+    ASSERT_TRUE(w2.publish(m));
+    ASSERT_TRUE(w3.publish(m));
+  }
+  ASSERT_TRUE(everyone.wait_for(150));
+  ASSERT_TRUE(w2.wait_for_acknowledgments(std::chrono::seconds(5)));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_EQ(from_other.load(), 0);
+  ASSERT_EQ(seqs.size(), 50u);  // robot2's, in order, nothing lost
+  for (std::size_t i = 0; i < seqs.size(); ++i) EXPECT_EQ(seqs[i], i + 1);
+  EXPECT_EQ(robot2.received(), 50u);
+  EXPECT_EQ(robot2.lost(), 0u);
+  EXPECT_EQ(robot2.other_robot(), 100u);  // robot1's and the look-alike's, dropped and counted
 }
 
 // A valid Odometry as the bytes DataWriter::write puts on the wire.

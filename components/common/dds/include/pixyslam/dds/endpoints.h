@@ -162,8 +162,12 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
  public:
   using Callback = std::function<void(const Message&)>;
 
-  Reader(Participant& participant, Callback on_message)
-      : participant_(participant), on_message_(std::move(on_message)) {
+  // `robot_id` non-empty: only samples whose header.robot_id is that reach the
+  // callback and the counts; the others are dropped and counted in
+  // other_robot(). (Not a DDS content filter: that would drop malformed
+  // samples uncounted, before they decode.)
+  Reader(Participant& participant, Callback on_message, std::string robot_id = "")
+      : participant_(participant), on_message_(std::move(on_message)), robot_id_(std::move(robot_id)) {
     const std::string topic(MessageTraits<Message>::topic);
     reader_ = participant.subscriber().create_datareader_with_profile(
         &participant.topic(topic, detail::type_support<Message>()), topic, this);
@@ -190,6 +194,7 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
     return guarded != nullptr ? guarded->malformed() : 0;
   }
   std::uint64_t callback_errors() const { return callback_errors_.load(); }
+  std::uint64_t other_robot() const { return other_robot_.load(); }
   int matched_writers() const {
     eprosima::fastdds::dds::SubscriptionMatchedStatus status;
     reader_->get_subscription_matched_status(status);
@@ -208,6 +213,10 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
         return;
       }
       if (!info.valid_data) continue;
+      if (!robot_id_.empty() && sample_.header().robot_id() != robot_id_) {
+        ++other_robot_;
+        continue;
+      }
       const auto now = std::chrono::steady_clock::now();
       WriterSeq& writer = writers_[info.publication_handle];
       if (!writer.seen) {
@@ -236,6 +245,7 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
 
   Participant& participant_;
   Callback on_message_;
+  std::string robot_id_;
   eprosima::fastdds::dds::DataReader* reader_ = nullptr;
   eprosima::fastdds::dds::TypeSupport type_;
   Message sample_;
@@ -245,6 +255,7 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
   std::atomic<std::uint64_t> lost_{0};
   std::atomic<std::uint64_t> seq_jumps_{0};
   std::atomic<std::uint64_t> callback_errors_{0};
+  std::atomic<std::uint64_t> other_robot_{0};
 };
 
 }  // namespace pixyslam::dds

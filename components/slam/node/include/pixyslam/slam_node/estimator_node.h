@@ -31,6 +31,7 @@ struct EstimatorCounters {
   std::uint64_t odometry_malformed = 0;  // samples that did not decode (dropped)
   std::uint64_t observations_malformed = 0;
   std::uint64_t seq_jumps = 0;           // implausible seq jumps (restart, hostile writer)
+  std::uint64_t other_robot_samples = 0; // sensor samples of other robots (header.robot_id), ignored
   std::uint64_t steps = 0;               // filter steps (= MapStates published)
   std::uint64_t map_states_published = 0;
   std::uint64_t samples_late = 0;
@@ -74,6 +75,7 @@ class EstimatorNode {
   EstimatorOptions options_;
   std::unique_ptr<dds::Participant> participant_;
   std::unique_ptr<dds::Writer<msg::MapState>> map_writer_;
+  mutable std::atomic<bool> warned_other_robot_{false};
   std::unique_ptr<dds::Reader<msg::Odometry>> odometry_reader_;
   std::unique_ptr<dds::Reader<msg::LandmarkObservation>> observation_reader_;
   std::unique_ptr<diagnostics::DiagnosticsPublisher> diagnostics_;
