@@ -245,13 +245,14 @@ void EstimatorNode::log_status() const {
   std::lock_guard<std::mutex> lock(state_mutex_);
   const slam::FilterCounters f = filter_ ? filter_->counters() : slam::FilterCounters{};
   std::fprintf(stderr,
-               "slam_estimator: odometry %llu (lost %llu), observations %llu (lost %llu), "
+               "slam_estimator: odometry %llu (lost %llu), observations %llu (lost %llu), other robots' %llu, "
                "steps %llu, late %llu, reordered %llu; detections used %llu, new %llu, gated %llu, "
                "invalid %llu; resamples %llu; landmarks %zu; checkpoints %llu (errors %llu)%s\n",
                static_cast<unsigned long long>(c.odometry_received),
                static_cast<unsigned long long>(c.odometry_lost),
                static_cast<unsigned long long>(c.observations_received),
                static_cast<unsigned long long>(c.observations_lost),
+               static_cast<unsigned long long>(c.other_robot_samples),
                static_cast<unsigned long long>(c.steps), static_cast<unsigned long long>(c.samples_late),
                static_cast<unsigned long long>(c.samples_reordered),
                static_cast<unsigned long long>(f.observations_used),

@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# ctest dataset_bridge_two_robots: a made-up two-robot MRCLAM data set (robot 1:
+# 100 odometry rows, 10 landmark frames, 3 sightings of robot 2; robot 2: 80,
+# 8, 0; ground truth beside the odometry) published by dataset_bridge at rate 0
+# (as fast as acknowledged) on a DDS domain of its own, with two estimators
+# (dds.robot_id robot1 and robot2) and `pixyslam_log record` listening. Passes
+# if the recording holds every sample once, seq 1..N per robot and topic, and
+# each estimator took exactly its own robot's samples and counted the other's.
+#   dataset_bridge_test.sh BIN_DIR CONFIG_DIR
+set -euo pipefail
+bin=$1 config=$2
+domain=$((140 + $$ % 40))
+work=$(mktemp -d "${TMPDIR:-/tmp}/pixyslam_dataset_bridge.XXXXXX")
+pids=()
+cleanup() {
+  for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
+  sleep 0.3
+  for pid in "${pids[@]}"; do kill -KILL "$pid" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  if [[ -n ${KEEP_WORK:-} ]]; then echo "kept $work"; else rm -rf "$work"; fi
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+fail() { echo "FAIL: $*"; for f in "$work"/*.log; do echo "== $f"; tail -n 15 "$f"; done; exit 1; }
+
+data=$work/Dataset
+mkdir -p "$data"
+printf '# Subject #\tBarcode #\n1\t11\n2\t12\n3\t13\n4\t14\n5\t15\n6\t16\n7\t17\n' > "$data/Barcodes.dat"
+printf '# Subject\tx\ty\tsx\tsy\n6\t2.0\t1.0\t0\t0\n7\t-1.0\t2.0\t0\t0\n' > "$data/Landmark_Groundtruth.dat"
+make_robot() {  # ROBOT ODOMETRY_ROWS FRAMES SIGHTINGS
+  local r=$1 rows=$2 frames=$3 sightings=$4
+  awk -v n="$rows" 'BEGIN { print "# t v w"; for (i = 0; i < n; ++i) printf "%.3f\t0.2\t0.1\n", 1000 + 0.1 * i }' \
+    > "$data/Robot${r}_Odometry.dat"
+  awk -v n="$rows" 'BEGIN { print "# t x y th"; for (i = 0; i < n; ++i) printf "%.3f\t%.4f\t0.0\t%.4f\n", 1000 + 0.1 * i, 0.02 * i, 0.01 * i }' \
+    > "$data/Robot${r}_Groundtruth.dat"
+  awk -v f="$frames" -v s="$sightings" 'BEGIN { print "# t barcode range bearing";
+    for (i = 0; i < f; ++i) printf "%.3f\t16\t2.0\t0.3\n", 1000.05 + i;
+    for (i = 0; i < s; ++i) printf "%.3f\t12\t1.5\t-0.2\n", 1000.55 + i }' > "$data/Robot${r}_Measurement.dat"
+}
+make_robot 1 100 10 3
+make_robot 2 80 8 0
+
+"$bin/pixyslam_log" record --out "$work/run.mcap" --domain "$domain" > "$work/record.log" 2>&1 &
+record_pid=$!
+pids+=("$record_pid")
+for r in 1 2; do
+  "$bin/slam_estimator" --config "$config/slam_estimator.yaml" --domain "$domain" \
+    --set dds.robot_id=robot$r > "$work/estimator$r.log" 2>&1 &
+  pids+=("$!")
+  eval "estimator${r}_pid=$!"
+done
+# Readers per topic: the recorder and both estimators (odometry, observations).
+"$bin/dataset_bridge" --config "$config/dataset_bridge.yaml" --dataset "$data" --robots 1,2 --rate 0 \
+  --domain "$domain" --set dataset_bridge.wait_readers=3 > "$work/bridge.log" 2>&1 || fail "dataset_bridge: exit $?"
+cat "$work/bridge.log"
+grep -q "published 180 odometry, 18 observations, 180 ground truth" "$work/bridge.log" || fail "bridge counts"
+grep -q "3 robot sightings not published" "$work/bridge.log" || fail "sightings count"
+
+sleep 0.5
+for r in 1 2; do
+  pid_var=estimator${r}_pid
+  kill -INT "${!pid_var}"
+  wait "${!pid_var}" || fail "slam_estimator robot$r: exit $?"
+done
+kill -INT "$record_pid"
+wait "$record_pid" || fail "pixyslam_log record: exit $?"
+grep "slam_estimator: odometry" "$work/estimator1.log" "$work/estimator2.log"
+# Each estimator: its own robot's samples, none lost; the other robot's counted.
+grep -q "odometry 100 (lost 0), observations 10 (lost 0), other robots' 88," "$work/estimator1.log" ||
+  fail "estimator robot1 did not take exactly robot 1's samples"
+grep -q "odometry 80 (lost 0), observations 8 (lost 0), other robots' 110," "$work/estimator2.log" ||
+  fail "estimator robot2 did not take exactly robot 2's samples"
+
+"$bin/pixyslam_log" check "$work/run.mcap" --expect pixyslam/odometry=180 \
+  --expect pixyslam/landmark_observation=18 --expect pixyslam/ground_truth=180 > "$work/check.log" 2>&1 ||
+  fail "log check"
+cat "$work/check.log"
+grep -q "robot1: seq 1..100, robot2: seq 1..80" "$work/check.log" || fail "odometry seq per robot"
+echo PASS
