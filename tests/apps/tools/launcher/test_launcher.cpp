@@ -128,6 +128,31 @@ TEST(LaunchPlan, LaunchArgumentsSubstituteAndAddWordsOnlyWhenGiven) {
   std::remove(clash.c_str());
 }
 
+// One block for N robots: for_each expands it, ${robot} in name and command.
+TEST(LaunchPlan, ForEachMakesOneProcessPerValue) {
+  const std::string path = write_temp(
+      "launch:\n  arguments:\n    robots: {default: '1,3', help: robots}\n    seed: {help: seed}\n"
+      "  processes:\n    - name: estimator_${robot}\n      for_each: {robot: '${robots}'}\n"
+      "      command: [slam_estimator, --set, 'dds.robot_id=robot${robot}', --out-dir, '${run_dir}/robot${robot}']\n"
+      "      if_given: {seed: [--seed, '${seed}${robot}']}\n    - {name: logger, command: [logger]}\n");
+  const LaunchPlan plan = read_launch_plan(path, {{"run_dir", "/r"}}, {{"seed", "7"}});
+  ASSERT_EQ(plan.processes.size(), 3u);
+  EXPECT_EQ(plan.processes[0].name, "estimator_1");
+  EXPECT_EQ(plan.processes[1].command,
+            (std::vector<std::string>{"slam_estimator", "--set", "dds.robot_id=robot3", "--out-dir", "/r/robot3",
+                                      "--seed", "73"}));
+  EXPECT_EQ(plan.processes[2].name, "logger");
+  const LaunchPlan five = read_launch_plan(path, {{"run_dir", "/r"}}, {{"robots", "1,2,3,4,5"}});
+  EXPECT_EQ(five.processes.size(), 6u);
+  EXPECT_THROW(read_launch_plan(path, {{"run_dir", "/r"}}, {{"robots", ""}}), config::ConfigError);  // no robot
+  std::remove(path.c_str());
+  // The name must tell the copies apart.
+  const std::string same = write_temp(
+      "launch:\n  processes:\n    - {name: e, for_each: {robot: '1,2'}, command: [p, '${robot}']}\n");
+  EXPECT_THROW(read_launch_plan(same, {}), config::ConfigError);
+  std::remove(same.c_str());
+}
+
 TEST(LineSplitter, SplitsAtNewlinesAcrossChunksAndCutsLongLines) {
   LineSplitter splitter(8);
   auto lines = splitter.feed("ab\ncd", 5);

@@ -35,53 +35,80 @@ namespace {
 
 constexpr const char* kDurationArgument = "duration";
 
+// One process of `item` with these variables.
+ProcessSpec read_process(config::YamlReader& item, const std::map<std::string, std::string>& variables,
+                         const std::vector<LaunchArgument>& arguments) {
+  const auto expand = [&](const std::string& word, config::YamlReader& where, const std::string& key_name) {
+    try {
+      return substitute(word, variables);
+    } catch (const std::invalid_argument& e) {
+      where.fail(key_name, e.what());
+    }
+    return std::string();
+  };
+  ProcessSpec p;
+  p.name = expand(item.text("name"), item, "name");
+  for (const std::string& word : item.text_list("command")) p.command.push_back(expand(word, item, "command"));
+  if (p.command.empty()) item.fail("command", "must list the program and its arguments");
+  if (item.has("if_given")) {
+    config::YamlReader extra = item.child("if_given");
+    for (const std::string& name : extra.keys()) {
+      const bool declared = std::any_of(arguments.begin(), arguments.end(),
+                                        [&](const LaunchArgument& a) { return a.name == name; });
+      if (!declared) extra.fail(name, "not a declared launch argument (launch.arguments)");
+      const std::vector<std::string> words = extra.text_list(name);
+      if (variables.at(name).empty()) continue;
+      for (const std::string& word : words) p.command.push_back(expand(word, extra, name));
+    }
+    extra.finish();
+  }
+  p.delay_s = item.number("delay_s", 0.0, 600.0, 0.0);
+  p.ends_run = item.boolean("ends_run", false);
+  const std::string role = item.text("role", "essential");
+  if (role != "essential" && role != "optional") {
+    item.fail("role", "'" + role + "' is not a role (essential | optional)");
+  }
+  p.optional = role == "optional";
+  if (p.optional && p.ends_run) item.fail("role", "an optional process cannot end the run (ends_run)");
+  return p;
+}
+
 std::vector<ProcessSpec> read_processes(config::YamlReader& launch, const std::string& key,
                                         const std::map<std::string, std::string>& variables,
                                         const std::vector<LaunchArgument>& arguments, std::set<std::string>& names) {
   std::vector<ProcessSpec> out;
   if (!launch.has(key)) return out;
   for (config::YamlReader& item : launch.mapping_list(key)) {
-    ProcessSpec p;
-    p.name = item.text("name");
-    if (p.name.empty() || !names.insert(p.name).second) {
-      item.fail("name", "'" + p.name + "' is empty or used twice");
-    }
-    for (const std::string& word : item.text_list("command")) {
+    // for_each: {NAME: 'A,B,...'}: one process per value, ${NAME} set to it.
+    std::string each_name;
+    std::vector<std::string> each_values = {""};
+    if (item.has("for_each")) {
+      config::YamlReader each = item.child("for_each");
+      const std::vector<std::string> keys = each.keys();
+      if (keys.size() != 1) item.fail("for_each", "needs exactly one NAME: 'VALUE,VALUE,...'");
+      each_name = keys.front();
+      if (variables.count(each_name) != 0) {
+        each.fail(each_name, "is already a variable (a launch argument or the launcher's)");
+      }
       try {
-        p.command.push_back(substitute(word, variables));
+        each_values = parameters::split_list(substitute(each.text(each_name), variables));
       } catch (const std::invalid_argument& e) {
-        item.fail("command", e.what());
+        each.fail(each_name, e.what());
       }
+      if (each_values.empty()) each.fail(each_name, "no value (a comma-separated list is required)");
+      each.finish();
     }
-    if (p.command.empty()) item.fail("command", "must list the program and its arguments");
-    if (item.has("if_given")) {
-      config::YamlReader extra = item.child("if_given");
-      for (const std::string& name : extra.keys()) {
-        const bool declared = std::any_of(arguments.begin(), arguments.end(),
-                                          [&](const LaunchArgument& a) { return a.name == name; });
-        if (!declared) extra.fail(name, "not a declared launch argument (launch.arguments)");
-        const std::vector<std::string> words = extra.text_list(name);
-        if (variables.at(name).empty()) continue;
-        for (const std::string& word : words) {
-          try {
-            p.command.push_back(substitute(word, variables));
-          } catch (const std::invalid_argument& e) {
-            extra.fail(name, e.what());
-          }
-        }
+    for (const std::string& value : each_values) {
+      std::map<std::string, std::string> process_variables = variables;
+      if (!each_name.empty()) process_variables[each_name] = value;
+      ProcessSpec p = read_process(item, process_variables, arguments);
+      if (p.name.empty() || !names.insert(p.name).second) {
+        item.fail("name", "'" + p.name + "' is empty or used twice" +
+                              (each_name.empty() ? "" : " (with for_each, put ${" + each_name + "} in the name)"));
       }
-      extra.finish();
+      out.push_back(std::move(p));
     }
-    p.delay_s = item.number("delay_s", 0.0, 600.0, 0.0);
-    p.ends_run = item.boolean("ends_run", false);
-    const std::string role = item.text("role", "essential");
-    if (role != "essential" && role != "optional") {
-      item.fail("role", "'" + role + "' is not a role (essential | optional)");
-    }
-    p.optional = role == "optional";
-    if (p.optional && p.ends_run) item.fail("role", "an optional process cannot end the run (ends_run)");
     item.finish();
-    out.push_back(std::move(p));
   }
   return out;
 }

@@ -44,7 +44,10 @@ struct LaunchPlan {
   std::vector<ProcessSpec> after_run;  // run one after another once all have stopped
 };
 
-// Reads the `launch:` mapping of a file. In every command word, ${name} is
+// Reads the `launch:` mapping of a file. A process with `for_each: {NAME:
+// 'A,B'}` (a comma-separated list, launch arguments substituted) stands for one
+// process per value, ${NAME} set to it in its name and command (e.g. one
+// estimator per robot: `for_each: {robot: '${robots}'}`). In every command word, ${name} is
 // replaced by variables[name] or a launch argument's value (unknown names are
 // errors); the launcher defines config_dir (the launch file's folder), bin_dir
 // and run_dir. `given` are the command line's NAME:=VALUE (split_launch_arguments);
