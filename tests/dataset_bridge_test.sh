@@ -44,7 +44,7 @@ make_robot 2 80 8 0
 record_pid=$!
 pids+=("$record_pid")
 for r in 1 2; do
-  "$bin/slam_estimator" --config "$config/slam_estimator.yaml" --domain "$domain" \
+  "$bin/slam_estimator" --config "$config/slam_estimator_mrclam.yaml" --domain "$domain" \
     --set dds.robot_id=robot$r > "$work/estimator$r.log" 2>&1 &
   pids+=("$!")
   eval "estimator${r}_pid=$!"

@@ -31,6 +31,17 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options)
       *participant_, [this](const msg::Odometry& m) { inbox_.push(m); }, options_.dds.robot_id);
   observation_reader_ = std::make_unique<dds::Reader<msg::LandmarkObservation>>(
       *participant_, [this](const msg::LandmarkObservation& m) { inbox_.push(m); }, options_.dds.robot_id);
+  if (options_.initial_pose_source == "ground_truth") {
+    truth_reader_ = std::make_unique<dds::Reader<msg::GroundTruth>>(
+        *participant_,
+        [this](const msg::GroundTruth& m) {
+          std::lock_guard<std::mutex> lock(truth_mutex_);
+          if (first_truth_) return;
+          first_truth_ = slam::Pose2(m.pose().x_m(), m.pose().y_m(), m.pose().theta_rad());
+          truth_cv_.notify_all();
+        },
+        options_.dds.robot_id);
+  }
   diagnostics_ = std::make_unique<diagnostics::DiagnosticsPublisher>(
       *participant_, "slam_estimator", options_.dds.diagnostics_period_s, [this] { return diagnostics_snapshot(); });
   const CheckpointOptions& k = options_.checkpoint;
@@ -51,6 +62,7 @@ EstimatorNode::~EstimatorNode() {
   stop();
   diagnostics_.reset();
   // Readers first: no callback may run into a half-destroyed node.
+  truth_reader_.reset();
   odometry_reader_.reset();
   observation_reader_.reset();
   map_writer_.reset();
@@ -159,6 +171,10 @@ void EstimatorNode::filter_loop() {
     }
     if (stopping) break;
   }
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    if (!latest_published_) publish_map_state();  // the last state always goes out
+  }
   log_status();
 }
 
@@ -186,13 +202,23 @@ void EstimatorNode::step(const slam::SensorInput& input) {
   trajectory_.emplace_back(map_state_.header().stamp_ns(),
                            slam::Pose2(mean.x_m(), mean.y_m(), mean.theta_rad()));
   ++counters_.steps;
-  if (map_writer_->publish(map_state_)) ++counters_.map_states_published;
   const std::uint64_t stamp = map_state_.header().stamp_ns();
+  const auto period_ns = static_cast<std::uint64_t>(options_.map_state_period_s * 1e9);
+  latest_published_ = false;
+  if (period_ns == 0 || counters_.map_states_published == 0 || stamp >= last_published_ns_ + period_ns) {
+    publish_map_state();
+  }
   if (!options_.checkpoint.file.empty() &&
       (counters_.checkpoints_written + counters_.checkpoint_errors == 0 ||
        stamp >= last_checkpoint_ns_ + static_cast<std::uint64_t>(options_.checkpoint.period_s * 1e9))) {
     write_checkpoint(false);
   }
+}
+
+void EstimatorNode::publish_map_state() {
+  latest_published_ = true;
+  last_published_ns_ = map_state_.header().stamp_ns();
+  if (map_writer_->publish(map_state_)) ++counters_.map_states_published;
 }
 
 void EstimatorNode::create_filter(double first_t_s) {
@@ -219,7 +245,20 @@ void EstimatorNode::create_filter(double first_t_s) {
     }
     checkpoint_.reset();
   }
-  if (!filter_) filter_ = std::make_unique<slam::FastSlam2>(options_.filter, options_.initial_pose);
+  slam::Pose2 start = options_.initial_pose;
+  if (!filter_ && truth_reader_) {
+    std::unique_lock<std::mutex> lock(truth_mutex_);
+    if (truth_cv_.wait_for(lock, std::chrono::duration<double>(options_.initial_pose_wait_s),
+                           [this] { return first_truth_.has_value(); })) {
+      start = *first_truth_;
+      std::fprintf(stderr, "slam_estimator: start pose from %s's ground truth: (%.3f, %.3f, %.3f)\n",
+                   options_.dds.robot_id.c_str(), start.x(), start.y(), start.z());
+    } else {
+      std::fprintf(stderr, "slam_estimator: no ground truth of %s after %.1f s: starting from the configured pose\n",
+                   options_.dds.robot_id.c_str(), options_.initial_pose_wait_s);
+    }
+  }
+  if (!filter_) filter_ = std::make_unique<slam::FastSlam2>(options_.filter, start);
 }
 
 void EstimatorNode::write_checkpoint(bool final) {

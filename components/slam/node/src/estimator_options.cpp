@@ -17,6 +17,11 @@ const parameters::Table<EstimatorOptions>& estimator_parameters() {
       P::real<O>("initial_pose.y_m", -1e6, 1e6, "m", "start pose y", [](O& o) -> double& { return o.initial_pose.y(); }),
       P::real<O>("initial_pose.theta_rad", -2.0 * M_PI, 2.0 * M_PI, "rad", "start heading",
                  [](O& o) -> double& { return o.initial_pose.z(); }),
+      P::choice<O, std::string>("initial_pose.source", {{"config", "config"}, {"ground_truth", "ground_truth"}},
+                                "the start pose: the three keys above, or this robot's first GroundTruth",
+                                [](O& o) -> std::string& { return o.initial_pose_source; }),
+      P::real<O>("initial_pose.wait_s", 0.0, 3600.0, "s", "ground_truth: how long the first step waits for it",
+                 [](O& o) -> double& { return o.initial_pose_wait_s; }),
       P::real<O>("odometry_max_delay_s", 0.0, 10.0, "s", "how long odometry may lag behind the newest input",
                  [](O& o) -> double& { return o.queue.odometry_max_delay_s; }),
       P::real<O>("observation_max_delay_s", 0.0, 10.0, "s", "how long observations may lag behind the newest input",
@@ -25,6 +30,8 @@ const parameters::Table<EstimatorOptions>& estimator_parameters() {
                     [](O& o) -> bool& { return o.use_detection_sigmas; }),
       P::integer<O, int>("published_particle_poses", 0, 512, "", "particle poses in each MapState (a subsample)",
                          [](O& o) -> int& { return o.published_particle_poses; }),
+      P::real<O>("map_state_period_s", 0.0, 3600.0, "s", "a MapState at most this often in filter time (0: every step)",
+                 [](O& o) -> double& { return o.map_state_period_s; }),
       P::choice<O, std::string>("landmarks", {{"best", "best"}, {"mixture", "mixture"}},
                                 "MapState landmarks: the best particle's, or the mixture over particles",
                                 [](O& o) -> std::string& { return o.landmarks; }),
@@ -74,8 +81,19 @@ std::string help_text() {
 EstimatorOptions read_estimator_options_file(const std::string& path) {
   config::YamlReader root = config::YamlReader::from_file(path);
   EstimatorOptions o;
-  config::YamlReader filter = root.child("filter");
-  o.filter = slam::read_filter_options(filter);
+  // `filter:` here, or `filter_config: FILE`: the filter: of another file (e.g.
+  // the offline runner's slam_mrclam.yaml), relative to this one.
+  if (root.has("filter_config")) {
+    if (root.has("filter")) root.fail("filter_config", "give filter: or filter_config:, not both");
+    std::string filter_config = root.text("filter_config");
+    if (!filter_config.empty() && filter_config.front() != '/') filter_config = config::folder_of(path) + "/" + filter_config;
+    config::YamlReader filter_root = config::YamlReader::from_file(filter_config);
+    config::YamlReader filter = filter_root.child("filter");
+    o.filter = slam::read_filter_options(filter);
+  } else {
+    config::YamlReader filter = root.child("filter");
+    o.filter = slam::read_filter_options(filter);
+  }
 
   config::YamlReader estimator = root.child("estimator");
   config::read_parameters(estimator, estimator_parameters(), o);

@@ -128,7 +128,8 @@ PublishCounters publish_recording(const DatasetBridgeOptions& options,
     const auto timeout = std::chrono::milliseconds(static_cast<int>(options.wait_readers_timeout_s * 1000));
     for (auto& w : writers) {
       if (!w->odometry.wait_for_readers(options.wait_readers, timeout) ||
-          !w->observation.wait_for_readers(options.wait_readers, timeout)) {
+          !w->observation.wait_for_readers(options.wait_readers, timeout) ||
+          !w->truth.wait_for_readers(options.wait_readers, timeout)) {
         std::fprintf(stderr, "dataset_bridge: fewer than %d readers matched after %.0f s; publishing anyway\n",
                      options.wait_readers, options.wait_readers_timeout_s);
         break;

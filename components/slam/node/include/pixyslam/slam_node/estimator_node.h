@@ -1,6 +1,7 @@
 #pragma once
 
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -68,6 +69,7 @@ class EstimatorNode {
   void step(const slam::SensorInput& input);
   // The filter, from the checkpoint when there is a fresh one (state_mutex_ held).
   void create_filter(double first_t_s);
+  void publish_map_state();  // state_mutex_ held
   void write_checkpoint(bool final);
   void log_status() const;
   diagnostics::Snapshot diagnostics_snapshot() const;
@@ -76,6 +78,11 @@ class EstimatorNode {
   std::unique_ptr<dds::Participant> participant_;
   std::unique_ptr<dds::Writer<msg::MapState>> map_writer_;
   mutable std::atomic<bool> warned_other_robot_{false};
+  // initial_pose.source ground_truth: the first GroundTruth's pose.
+  std::mutex truth_mutex_;
+  std::condition_variable truth_cv_;
+  std::optional<slam::Pose2> first_truth_;
+  std::unique_ptr<dds::Reader<msg::GroundTruth>> truth_reader_;
   std::unique_ptr<dds::Reader<msg::Odometry>> odometry_reader_;
   std::unique_ptr<dds::Reader<msg::LandmarkObservation>> observation_reader_;
   std::unique_ptr<diagnostics::DiagnosticsPublisher> diagnostics_;
@@ -95,6 +102,8 @@ class EstimatorNode {
   EstimatorCounters counters_;
   std::optional<slam::MapCheckpoint> checkpoint_;  // read at start, used by create_filter()
   std::uint64_t last_checkpoint_ns_ = 0;
+  std::uint64_t last_published_ns_ = 0;
+  bool latest_published_ = true;  // map_state_ went out (map_state_period_s)
 };
 
 }  // namespace pixyslam::slam_node

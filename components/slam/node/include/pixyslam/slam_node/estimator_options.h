@@ -25,9 +25,21 @@ struct CheckpointOptions {
 struct EstimatorOptions {
   slam::FilterOptions filter;            // `filter:` (see config/slam_mrclam.yaml for the keys)
   slam::Pose2 initial_pose = slam::Pose2::Zero();  // `estimator.initial_pose` {x_m, y_m, theta_rad}
+  // `estimator.initial_pose.source`: config (the pose above) | ground_truth: the
+  // first GroundTruth of this robot (an experiment's known start: recorded data
+  // sets, the simulator), waited for up to initial_pose.wait_s before the first
+  // filter step (then the pose above, with a warning). The filter reads nothing
+  // else of the ground truth.
+  std::string initial_pose_source = "config";
+  double initial_pose_wait_s = 10.0;
   slam::SensorQueueOptions queue;        // `estimator.odometry_max_delay_s`, `observation_max_delay_s`
   bool use_detection_sigmas = true;      // per-detection sigmas from the camera, else filter's
   int published_particle_poses = 100;    // MapState.particle_poses subsample size (<= 512)
+  // `estimator.map_state_period_s`: a MapState after a filter step at most this
+  // often in filter time (0: after every step). A recording replayed faster
+  // than real time steps at hundreds of Hz per robot; the trajectory files keep
+  // every step either way, and the last state is always published.
+  double map_state_period_s = 0.0;
   std::string landmarks = "best";        // MapState landmarks: "best" particle or "mixture"
   double status_period_s = 10.0;         // counters to the log every so often (0: never)
   CheckpointOptions checkpoint;          // `estimator.checkpoint`
