@@ -79,19 +79,7 @@ BridgeNode::BridgeNode(const BridgeOptions& options) : options_(options), visual
   participant_ = std::make_unique<dds::Participant>(options_.dds, "foxglove_bridge");
   for (const std::string& topic : options_.topics) {
     const std::uint32_t id = raw_channel_id(topic);
-    if (topic == dds::kOdometryTopic) {
-      subscribe<msg::Odometry>(id);
-    } else if (topic == dds::kLandmarkObservationTopic) {
-      subscribe<msg::LandmarkObservation>(id);
-    } else if (topic == dds::kMapStateTopic) {
-      subscribe<msg::MapState>(id);
-    } else if (topic == dds::kGroundTruthTopic) {
-      subscribe<msg::GroundTruth>(id);
-    } else if (topic == dds::kDiagnosticsTopic) {
-      subscribe<msg::Diagnostics>(id);
-    } else if (topic == dds::kOptimisedMapTopic) {
-      subscribe<msg::OptimisedMap>(id);
-    } else {
+    if (!dds::visit_topic_type(topic, [&](auto tag) { subscribe<typename decltype(tag)::type>(id); })) {
       throw std::logic_error("foxglove_bridge: no reader for topic '" + topic + "'");
     }
   }

@@ -3,18 +3,11 @@
 #include <stdexcept>
 
 #include "pixyslam/config/parameters_yaml.h"
-#include "pixyslam/dds/cdr_payload.h"
-#include "pixyslam/dds/topic_selection.h"
+#include "pixyslam/dds/topic_config.h"
 
 namespace pixyslam::foxglove_node {
 
 namespace {
-
-std::vector<std::string> all_topics() {
-  std::vector<std::string> out;
-  for (const dds::TopicInfo& t : dds::known_topics()) out.push_back(t.topic);
-  return out;
-}
 
 void check_frame(const std::string& v) {
   if (v.empty()) throw std::invalid_argument("empty");
@@ -58,17 +51,7 @@ const parameters::Table<BridgeOptions>& bridge_parameters() {
 BridgeOptions read_bridge_options(config::YamlReader& root, const std::string& config_dir) {
   BridgeOptions o;
   config::YamlReader section = root.child("foxglove_bridge");
-  if (section.has("topics")) {
-    const std::vector<std::string> patterns = section.text_list("topics");
-    if (patterns.empty()) section.fail("topics", "empty list (leave the key out to bridge every topic)");
-    const dds::TopicSelection selection = dds::select_topics(patterns, all_topics());
-    if (!selection.error.empty()) {
-      section.fail("topics[" + std::to_string(selection.bad_pattern) + "]", selection.error);
-    }
-    o.topics = selection.topics;
-  } else {
-    o.topics = all_topics();
-  }
+  o.topics = dds::read_topic_patterns(section);
   config::read_parameters(section, bridge_parameters(), o);
   config::check_rules(section, [&] { parameters::check_ranges(o, bridge_parameters(), "foxglove_bridge"); });
   section.finish();

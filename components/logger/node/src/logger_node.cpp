@@ -88,19 +88,7 @@ LoggerNode::LoggerNode(const LoggerOptions& options) : options_(options) {
   participant_ = std::make_unique<dds::Participant>(options_.dds, "logger");
   for (std::size_t i = 0; i < options_.topics.size(); ++i) {
     const std::string& name = options_.topics[i];
-    if (name == dds::kOdometryTopic) {
-      subscribe<msg::Odometry>(i);
-    } else if (name == dds::kLandmarkObservationTopic) {
-      subscribe<msg::LandmarkObservation>(i);
-    } else if (name == dds::kMapStateTopic) {
-      subscribe<msg::MapState>(i);
-    } else if (name == dds::kGroundTruthTopic) {
-      subscribe<msg::GroundTruth>(i);
-    } else if (name == dds::kDiagnosticsTopic) {
-      subscribe<msg::Diagnostics>(i);
-    } else if (name == dds::kOptimisedMapTopic) {
-      subscribe<msg::OptimisedMap>(i);
-    } else {
+    if (!dds::visit_topic_type(name, [&](auto tag) { subscribe<typename decltype(tag)::type>(i); })) {
       throw std::logic_error("logger: no reader for topic '" + name + "'");
     }
   }

@@ -6,7 +6,7 @@
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/dds/cdr_payload.h"
-#include "pixyslam/dds/topic_selection.h"
+#include "pixyslam/dds/topic_config.h"
 
 namespace pixyslam::logger_node {
 
@@ -16,12 +16,6 @@ mcap::McapCompression default_compression() {
 }
 
 namespace {
-
-std::vector<std::string> all_topics() {
-  std::vector<std::string> out;
-  for (const dds::TopicInfo& t : dds::known_topics()) out.push_back(t.topic);
-  return out;
-}
 
 constexpr std::uint64_t kMinRotateSizeBytes = 65536;
 
@@ -101,17 +95,7 @@ void apply_overrides(LoggerOptions& o, const std::vector<std::string>& assignmen
 LoggerOptions read_logger_options(config::YamlReader& root, const std::string& config_dir) {
   LoggerOptions o;
   config::YamlReader section = root.child("logger");
-  if (section.has("topics")) {
-    const std::vector<std::string> patterns = section.text_list("topics");
-    if (patterns.empty()) section.fail("topics", "empty list (leave the key out to record every topic)");
-    const dds::TopicSelection selection = dds::select_topics(patterns, all_topics());
-    if (!selection.error.empty()) {
-      section.fail("topics[" + std::to_string(selection.bad_pattern) + "]", selection.error);
-    }
-    o.topics = selection.topics;
-  } else {
-    o.topics = all_topics();
-  }
+  o.topics = dds::read_topic_patterns(section);
   config::read_parameters(section, logger_parameters(), o);
   config::check_rules(section, [&] { validate(o); });
   section.finish();

@@ -408,12 +408,12 @@ bool decode_as(const std::vector<std::uint8_t>& bytes, Value& value, std::string
 
 // A recorded payload of `topic` as a field tree; false with `error` if undecodable.
 bool decode_value(const std::string& topic, const std::vector<std::uint8_t>& bytes, Value& value, std::string& error) {
-  if (topic == dds::kOdometryTopic) return decode_as<msg::Odometry>(bytes, value, error);
-  if (topic == dds::kLandmarkObservationTopic) return decode_as<msg::LandmarkObservation>(bytes, value, error);
-  if (topic == dds::kMapStateTopic) return decode_as<msg::MapState>(bytes, value, error);
-  if (topic == dds::kGroundTruthTopic) return decode_as<msg::GroundTruth>(bytes, value, error);
-  if (topic == dds::kDiagnosticsTopic) return decode_as<msg::Diagnostics>(bytes, value, error);
-  if (topic == dds::kOptimisedMapTopic) return decode_as<msg::OptimisedMap>(bytes, value, error);
+  bool decoded = false;
+  if (dds::visit_topic_type(topic, [&](auto tag) {
+        decoded = decode_as<typename decltype(tag)::type>(bytes, value, error);
+      })) {
+    return decoded;
+  }
   error = "not a topic of this project";
   return false;
 }

@@ -23,6 +23,7 @@
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
 #include "pixyslam/app/stop_signal.h"
+#include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/log_tool/message_format.h"
 
@@ -229,16 +230,11 @@ std::string participant_label(const std::map<std::string, ParticipantEntry>& par
 // Dispatches on the topic name to the project's message type.
 template <class Function>
 int with_topic_type(const std::string& topic, Function f) {
-  if (topic == dds::kOdometryTopic) return f(msg::Odometry{});
-  if (topic == dds::kLandmarkObservationTopic) return f(msg::LandmarkObservation{});
-  if (topic == dds::kMapStateTopic) return f(msg::MapState{});
-  if (topic == dds::kGroundTruthTopic) return f(msg::GroundTruth{});
-  if (topic == dds::kDiagnosticsTopic) return f(msg::Diagnostics{});
-  if (topic == dds::kOptimisedMapTopic) return f(msg::OptimisedMap{});
-  std::fprintf(stderr, "pixyslam_spy: unknown topic '%s'; known: %s, %s, %s, %s, %s, %s\n", topic.c_str(),
-               std::string(dds::kOdometryTopic).c_str(), std::string(dds::kLandmarkObservationTopic).c_str(),
-               std::string(dds::kMapStateTopic).c_str(), std::string(dds::kGroundTruthTopic).c_str(),
-               std::string(dds::kDiagnosticsTopic).c_str(), std::string(dds::kOptimisedMapTopic).c_str());
+  int status = 2;
+  if (dds::visit_topic_type(topic, [&](auto tag) { status = f(typename decltype(tag)::type{}); })) return status;
+  std::string known;
+  for (const dds::TopicInfo& t : dds::known_topics()) known += (known.empty() ? "" : ", ") + t.topic;
+  std::fprintf(stderr, "pixyslam_spy: unknown topic '%s'; known: %s\n", topic.c_str(), known.c_str());
   return 2;
 }
 

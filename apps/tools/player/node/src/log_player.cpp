@@ -65,15 +65,12 @@ class TypedChannel final : public LogPlayer::Channel {
 };
 
 std::unique_ptr<LogPlayer::Channel> make_channel(const std::string& topic, dds::Participant& participant) {
-  if (topic == dds::kOdometryTopic) return std::make_unique<TypedChannel<msg::Odometry>>(participant);
-  if (topic == dds::kLandmarkObservationTopic) {
-    return std::make_unique<TypedChannel<msg::LandmarkObservation>>(participant);
-  }
-  if (topic == dds::kMapStateTopic) return std::make_unique<TypedChannel<msg::MapState>>(participant);
-  if (topic == dds::kGroundTruthTopic) return std::make_unique<TypedChannel<msg::GroundTruth>>(participant);
-  if (topic == dds::kDiagnosticsTopic) return std::make_unique<TypedChannel<msg::Diagnostics>>(participant);
-  if (topic == dds::kOptimisedMapTopic) return std::make_unique<TypedChannel<msg::OptimisedMap>>(participant);
-  throw std::logic_error("no channel type for " + topic);
+  std::unique_ptr<LogPlayer::Channel> channel;
+  dds::visit_topic_type(topic, [&](auto tag) {
+    channel = std::make_unique<TypedChannel<typename decltype(tag)::type>>(participant);
+  });
+  if (!channel) throw std::logic_error("no channel type for " + topic);
+  return channel;
 }
 
 // Sleeps until `until`, waking every 100 ms for a stop; false if stopped.

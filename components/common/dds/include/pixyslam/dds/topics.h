@@ -67,4 +67,24 @@ PIXYSLAM_MESSAGE_TRAITS(OptimisedMap, kOptimisedMapTopic, "optimised_map", regis
 
 #undef PIXYSLAM_MESSAGE_TRAITS
 
+// A message type as a value, for generic lambdas: [](auto tag) { using M = typename decltype(tag)::type; }.
+template <class Message>
+struct MessageTag {
+  using type = Message;
+};
+
+// Calls f(MessageTag<M>{}) with the message type M of `topic`; false (and no
+// call) when it is not one of the system's topics. The one place that maps a
+// topic name to its type at run time.
+template <class F>
+bool visit_topic_type(std::string_view topic, F&& f) {
+  if (topic == kOdometryTopic) return f(MessageTag<msg::Odometry>{}), true;
+  if (topic == kLandmarkObservationTopic) return f(MessageTag<msg::LandmarkObservation>{}), true;
+  if (topic == kMapStateTopic) return f(MessageTag<msg::MapState>{}), true;
+  if (topic == kGroundTruthTopic) return f(MessageTag<msg::GroundTruth>{}), true;
+  if (topic == kDiagnosticsTopic) return f(MessageTag<msg::Diagnostics>{}), true;
+  if (topic == kOptimisedMapTopic) return f(MessageTag<msg::OptimisedMap>{}), true;
+  return false;
+}
+
 }  // namespace pixyslam::dds
