@@ -5,7 +5,8 @@
 # (as fast as acknowledged) on a DDS domain of its own, with two estimators
 # (dds.robot_id robot1 and robot2) and `pixyslam_log record` listening. Passes
 # if the recording holds every sample once, seq 1..N per robot and topic, and
-# each estimator took exactly its own robot's samples and counted the other's.
+# each estimator took exactly its own robot's samples and counted the other's,
+# and `pixyslam_log hz --robot robot2` counted robot 2's 80 odometry samples only.
 #   dataset_bridge_test.sh BIN_DIR CONFIG_DIR
 set -euo pipefail
 bin=$1 config=$2
@@ -49,12 +50,22 @@ for r in 1 2; do
   pids+=("$!")
   eval "estimator${r}_pid=$!"
 done
+# `hz --robot`: robot 2's odometry only.
+"$bin/pixyslam_log" hz pixyslam/odometry --robot robot2 --duration 6 --json --domain "$domain" \
+  > "$work/hz.out" 2> "$work/hz.log" &
+hz_pid=$!
+pids+=("$hz_pid")
+sleep 1
 # Readers per topic: the recorder and both estimators (odometry, observations).
 "$bin/dataset_bridge" --config "$config/dataset_bridge.yaml" --dataset "$data" --robots 1,2 --rate 0 \
   --domain "$domain" --set dataset_bridge.wait_readers=3 > "$work/bridge.log" 2>&1 || fail "dataset_bridge: exit $?"
 cat "$work/bridge.log"
 grep -q "published 180 odometry, 18 observations, 180 ground truth" "$work/bridge.log" || fail "bridge counts"
 grep -q "3 robot sightings not published" "$work/bridge.log" || fail "sightings count"
+
+wait "$hz_pid" || fail "pixyslam_log hz --robot robot2: exit $?"
+tail -n 1 "$work/hz.out"
+tail -n 1 "$work/hz.out" | grep -q '"messages":80,' || fail "hz --robot robot2 did not count robot 2's 80 odometry samples"
 
 sleep 0.5
 for r in 1 2; do

@@ -130,6 +130,7 @@ int main(int argc, char** argv) {
   echo.option("topic", echo_request.topic, "the topic").required().type("TOPIC");
   echo.flag("--json", echo_request.json, "one JSON object per line");
   echo.option("--count", count, "stop after N samples (0: no limit)").non_negative().type("N");
+  echo.option("--robot", echo_request.robot, "only this robot's samples (header.robot_id)").type("ID");
   add_duration(echo, "0: until Ctrl-C or --count");
   dds_args.add_to(echo);
 
@@ -137,6 +138,8 @@ int main(int argc, char** argv) {
   app::Cli& hz = cli.subcommand("hz", "a topic's rate, updated every second like ros2 topic hz");
   hz.option("topic", hz_topic, "the topic").required().type("TOPIC");
   hz.flag("--json", json, "a JSON line every second and one for the summary");
+  std::string hz_robot;
+  hz.option("--robot", hz_robot, "only this robot's samples (header.robot_id)").type("ID");
   add_duration(hz, "5");
   dds_args.add_to(hz);
 
@@ -245,7 +248,7 @@ int main(int argc, char** argv) {
     if (participants.chosen()) return log_tool::run_participants(options, seconds < 0 ? 4.0 : seconds, json, std::cout);
     if (topics.chosen()) return log_tool::run_topics(options, seconds < 0 ? 4.0 : seconds, json, std::cout);
     if (diagnostics.chosen()) return log_tool::run_diagnostics(options, seconds < 0 ? 3.0 : seconds, json, std::cout);
-    if (hz.chosen()) return log_tool::run_hz(options, hz_topic, seconds < 0 ? 5.0 : seconds, json, std::cout);
+    if (hz.chosen()) return log_tool::run_hz(options, hz_topic, seconds < 0 ? 5.0 : seconds, json, std::cout, hz_robot);
     echo_request.count = static_cast<std::size_t>(count);
     echo_request.seconds = seconds < 0 ? 0.0 : seconds;
     return log_tool::run_echo(options, echo_request, std::cout);

@@ -388,7 +388,7 @@ int run_echo(const dds::DdsOptions& options, const EchoRequest& request, std::os
       if (first_arrival == Clock::time_point{}) first_arrival = Clock::now();
       pending.push_back({std::move(text), writer_key(m)});
       cv.notify_all();
-    });
+    }, request.robot);
     std::size_t printed = 0;
     bool history_done = false;
     const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(request.seconds));
@@ -446,7 +446,8 @@ int run_diagnostics(const dds::DdsOptions& options, double seconds, bool json, s
   return 0;
 }
 
-int run_hz(const dds::DdsOptions& options, const std::string& topic, double seconds, bool json, std::ostream& out) {
+int run_hz(const dds::DdsOptions& options, const std::string& topic, double seconds, bool json, std::ostream& out,
+           const std::string& robot) {
   return with_topic_type(topic, [&](auto tag) {
     using Message = decltype(tag);
     std::mutex mutex;
@@ -459,7 +460,7 @@ int run_hz(const dds::DdsOptions& options, const std::string& topic, double seco
       std::lock_guard<std::mutex> lock(mutex);
       arrivals_s.push_back(t);
       stamps_s.push_back(static_cast<double>(m.header().stamp_ns()) * 1e-9);
-    });
+    }, robot);
     // A line every second while listening (as ros2 topic hz): the rate over the
     // last second and over everything so far.
     std::size_t reported = 0;

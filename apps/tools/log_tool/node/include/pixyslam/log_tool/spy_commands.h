@@ -29,6 +29,7 @@ struct EchoRequest {
   bool json = false;       // JSON lines instead of YAML documents
   std::size_t count = 0;   // stop after this many samples (0: no limit)
   double seconds = 0.0;    // stop after this long (0: no limit); with count: failure if not reached
+  std::string robot;       // only samples with this header.robot_id ("": every robot)
 };
 int run_echo(const dds::DdsOptions& dds, const EchoRequest& request, std::ostream& out);
 
@@ -36,6 +37,8 @@ int run_echo(const dds::DdsOptions& dds, const EchoRequest& request, std::ostrea
 // The latest pixyslam/diagnostics report of every process heard within `seconds`
 // (diagnostics_table); exit status 1 if none.
 int run_diagnostics(const dds::DdsOptions& dds, double seconds, bool json, std::ostream& out);
-int run_hz(const dds::DdsOptions& dds, const std::string& topic, double seconds, bool json, std::ostream& out);
+// `robot`: only samples with this header.robot_id ("": every robot).
+int run_hz(const dds::DdsOptions& dds, const std::string& topic, double seconds, bool json, std::ostream& out,
+           const std::string& robot = "");
 
 }  // namespace pixyslam::log_tool
