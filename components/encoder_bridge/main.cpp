@@ -36,11 +36,7 @@ int main(int argc, char** argv) {
 
   return app::run_main("encoder_bridge", [&] {
     encoder_node::EncoderNode node(options);
-    // The first samples only once a reader can take them (its writer is volatile):
-    // a bridge started under load published frames before anyone had matched it.
-    if (!node.wait_for_subscribers(1, std::chrono::seconds(3))) {
-      std::fprintf(stderr, "%s: no reader matched after 3 s; publishing anyway\n", "encoder_bridge");
-    }
+    bridge::wait_for_readers(node, options.process, "encoder_bridge");
     node.start();
     while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
     }

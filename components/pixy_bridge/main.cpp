@@ -95,11 +95,7 @@ int main(int argc, char** argv) {
 #endif
     if (!source) source = std::make_unique<bridge::SerialByteSource>(options.serial_device, options.baud);
     pixy_node::PixyNode node(options, std::move(source), bridge::stderr_log("pixy_bridge"));
-    // The first samples only once a reader can take them (its writer is volatile):
-    // a bridge started under load published frames before anyone had matched it.
-    if (!node.wait_for_subscribers(1, std::chrono::seconds(3))) {
-      std::fprintf(stderr, "%s: no reader matched after 3 s; publishing anyway\n", "pixy_bridge");
-    }
+    bridge::wait_for_readers(node, options.process, "pixy_bridge");
     node.start();
     while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
     }
