@@ -168,8 +168,9 @@ class LaunchSession {
     for (std::size_t i = 0; i < group_.size(); ++i) {
       const launcher::ExitStatus& status = group_.status(i);
       const launcher::ProcessSpec& spec = group_.spec(i);
-      std::printf("[launch]   %-16s %s%s%s\n", spec.name.c_str(), status.describe().c_str(),
-                  status.ok() ? "" : "  <- FAILED", spec.optional && !status.ok() ? " (optional)" : "");
+      std::printf("[launch]   %-16s %s%s%s  (%s)\n", spec.name.c_str(), status.describe().c_str(),
+                  status.ok() ? "" : "  <- FAILED", spec.optional && !status.ok() ? " (optional)" : "",
+                  status.resources().c_str());
       if (!status.ok()) ++bad;
     }
     print_health();

@@ -182,6 +182,8 @@ TEST(ProcessGroup, ForwardsOutputWithPrefixAndReportsExitCodes) {
     ProcessGroup group("", out);
     group.start({"ok", {"/bin/sh", "-c", "echo hello; echo world >&2"}, 0.0, false, {}});
     group.start({"bad", {"/bin/sh", "-c", "exit 3"}, 0.0, false, {}});
+    // A child that burns about 0.2 s of CPU: its own time is counted (wait4), not the launcher's.
+    group.start({"busy", {"/bin/sh", "-c", "i=0; while [ $i -lt 20000 ]; do i=$((i+1)); done"}, 0.0, false, {}});
     const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     while (group.any_running() && std::chrono::steady_clock::now() < end) {
       group.poll(std::chrono::milliseconds(50));
@@ -190,6 +192,9 @@ TEST(ProcessGroup, ForwardsOutputWithPrefixAndReportsExitCodes) {
     EXPECT_TRUE(group.status(0).ok());
     EXPECT_FALSE(group.status(1).ok());
     EXPECT_EQ(group.status(1).code, 3);
+    EXPECT_GT(group.status(2).cpu_s, group.status(1).cpu_s);
+    EXPECT_GT(group.status(0).max_rss_kb, 0);
+    EXPECT_NE(group.status(2).resources().find("CPU "), std::string::npos);
   }
   const std::string text = read_all(out);
   std::fclose(out);

@@ -5,6 +5,7 @@
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/stat.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -24,6 +25,12 @@ std::string ExitStatus::describe() const {
   if (exited) return "exit code " + std::to_string(code);
   return std::string("signal ") + std::to_string(code) + " (" + strsignal(code) + ")" +
          (stopped_by_us ? ", stopped by the launcher" : "");
+}
+
+std::string ExitStatus::resources() const {
+  char text[80];
+  std::snprintf(text, sizeof(text), "CPU %.2f s, peak RSS %.1f MB", cpu_s, static_cast<double>(max_rss_kb) / 1024.0);
+  return text;
 }
 
 struct ProcessGroup::Child {
@@ -183,13 +190,17 @@ void ProcessGroup::reap() {
   // Any child: ours, or an orphan adopted as subreaper (its status is not ours).
   for (;;) {
     int status = 0;
-    const pid_t r = waitpid(-1, &status, WNOHANG);
+    struct rusage usage {};
+    const pid_t r = wait4(-1, &status, WNOHANG, &usage);
     if (r <= 0) break;
     for (auto& child : children_) {
       if (!child->running || child->pid != r) continue;
       child->running = false;
       child->status.exited = WIFEXITED(status);
       child->status.code = WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status);
+      child->status.cpu_s = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                            static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) * 1e-6;
+      child->status.max_rss_kb = usage.ru_maxrss;
       drain(*child, true);
     }
   }

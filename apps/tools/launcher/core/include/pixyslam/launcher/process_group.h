@@ -17,9 +17,13 @@ struct ExitStatus {
   bool exited = false;  // false: killed by a signal
   int code = 0;         // exit code, or the signal number
   bool stopped_by_us = false;
+  double cpu_s = 0.0;             // user + system CPU time of the child (wait4)
+  long max_rss_kb = 0;            // its peak resident set size
   // A clean exit, or death by the SIGINT the launcher sent.
   bool ok() const;
   std::string describe() const;
+  // "CPU 12.34 s, peak RSS 45.6 MB".
+  std::string resources() const;
 };
 
 // Child processes with their output (stdout and stderr) forwarded line by line
