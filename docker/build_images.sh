@@ -21,7 +21,7 @@ done
 command -v "$engine" >/dev/null || { echo "SKIP: $engine is not installed"; exit 77; }
 root=$(cd "$(dirname "$0")/.." && pwd)
 export CONTAINERS_CONF=${CONTAINERS_CONF:-$root/docker/containers.conf}
-packages=builder
+packages=builder packages_id=""
 if ((from_source == 0)); then
   build_dir=${build_dir:-$root/build}
   [[ -f $build_dir/CPackConfig.cmake ]] || { echo "$build_dir is not configured: run scripts/build.sh first (or --from-source)" >&2; exit 1; }
@@ -30,6 +30,9 @@ if ((from_source == 0)); then
   cpack --config "$build_dir/CPackConfig.cmake" -G DEB -B "$root/build/packages" > /dev/null
   rm -rf "$root/build/packages/_CPack_Packages"
   packages=context
+  packages_id=$(cat "$root"/build/packages/pixyslam-*.deb | sha256sum | cut -c1-16)
+else
+  packages_id="source-$(date +%s)"  # the builder stage's packages are new: install them again
 fi
 "$root/docker/build_base_image.sh" "$engine"
 start=$(date +%s)
@@ -37,7 +40,8 @@ for role in robot estimator logger viewer; do
   # --network host: only for apt inside the build (the images run without it).
   "$engine" build --network host -q -f "$root/docker/Dockerfile" --target "$role" \
     --build-arg BASE_IMAGE=localhost/pixyslam-base:bookworm --build-arg PACKAGES=$packages \
+    --build-arg PACKAGES_ID="$packages_id" \
     -t "localhost/pixyslam-$role:latest" "$root" > /dev/null
 done
-echo "build_images: packages from $packages, $(($(date +%s) - start)) s"
+echo "build_images: packages from $packages ($packages_id), $(($(date +%s) - start)) s"
 "$engine" images --format '{{.Repository}}:{{.Tag}} {{.Size}}' | grep "pixyslam-" | sort
