@@ -60,8 +60,8 @@ sleep 1
 "$bin/dataset_bridge" --config "$config/dataset_bridge.yaml" --dataset "$data" --robots 1,2 --rate 0 \
   --domain "$domain" --set dataset_bridge.wait_readers=3 > "$work/bridge.log" 2>&1 || fail "dataset_bridge: exit $?"
 cat "$work/bridge.log"
-grep -q "published 180 odometry, 18 observations, 180 ground truth" "$work/bridge.log" || fail "bridge counts"
-grep -q "3 robot sightings not published" "$work/bridge.log" || fail "sightings count"
+grep -q "published 180 odometry, 18 observations, 180 ground truth, 3 robot sightings" "$work/bridge.log" ||
+  fail "bridge counts"
 
 wait "$hz_pid" || fail "pixyslam_log hz --robot robot2: exit $?"
 tail -n 1 "$work/hz.out"
@@ -83,8 +83,14 @@ grep -q "odometry 80 (lost 0), observations 8 (lost 0), other robots' 110," "$wo
   fail "estimator robot2 did not take exactly robot 2's samples"
 
 "$bin/pixyslam_log" check "$work/run.mcap" --expect pixyslam/odometry=180 \
-  --expect pixyslam/landmark_observation=18 --expect pixyslam/ground_truth=180 > "$work/check.log" 2>&1 ||
+  --expect pixyslam/landmark_observation=18 --expect pixyslam/ground_truth=180 --expect pixyslam/robot_sighting=3 \
+  > "$work/check.log" 2>&1 ||
   fail "log check"
 cat "$work/check.log"
 grep -q "robot1: seq 1..100, robot2: seq 1..80" "$work/check.log" || fail "odometry seq per robot"
+# Robot 1's sightings of robot 2, as written.
+"$bin/pixyslam_log" print "$work/run.mcap" --topic pixyslam/robot_sighting --json > "$work/sightings.json" ||
+  fail "print sightings"
+head -n 1 "$work/sightings.json"
+[[ $(grep -c '"seen_robot_id":"robot2"' "$work/sightings.json") == 3 ]] || fail "sightings of robot2"
 echo PASS

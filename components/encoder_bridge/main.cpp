@@ -36,7 +36,6 @@ int main(int argc, char** argv) {
 
   return app::run_main("encoder_bridge", [&] {
     encoder_node::EncoderNode node(options);
-    bridge::wait_for_readers(node, options.process, "encoder_bridge");
     node.start();
     while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
     }

@@ -95,7 +95,6 @@ int main(int argc, char** argv) {
 #endif
     if (!source) source = std::make_unique<bridge::SerialByteSource>(options.serial_device, options.baud);
     pixy_node::PixyNode node(options, std::move(source), bridge::stderr_log("pixy_bridge"));
-    bridge::wait_for_readers(node, options.process, "pixy_bridge");
     node.start();
     while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
     }

@@ -77,12 +77,11 @@ int main(int argc, char** argv) {
     const bool interrupted = stop.exchange(true);
     watcher.join();
     std::fprintf(stderr,
-                 "dataset_bridge: published %llu odometry, %llu observations, %llu ground truth (%.1f s of recording "
-                 "in %.1f s); %llu robot sightings not published (no topic yet), %llu write failures, %llu "
-                 "acknowledgement time-outs%s\n",
+                 "dataset_bridge: published %llu odometry, %llu observations, %llu ground truth, %llu robot sightings "
+                 "(%.1f s of recording in %.1f s); %llu write failures, %llu acknowledgement time-outs%s\n",
                  static_cast<unsigned long long>(c.odometry), static_cast<unsigned long long>(c.observations),
-                 static_cast<unsigned long long>(c.ground_truth), c.recording_time_s, c.wall_time_s,
-                 static_cast<unsigned long long>(c.sightings_skipped),
+                 static_cast<unsigned long long>(c.ground_truth), static_cast<unsigned long long>(c.sightings),
+                 c.recording_time_s, c.wall_time_s,
                  static_cast<unsigned long long>(c.write_failures), static_cast<unsigned long long>(c.ack_timeouts),
                  interrupted ? " (interrupted)" : "");
     return c.write_failures > 0 || c.ack_timeouts > 0 ? 1 : 0;

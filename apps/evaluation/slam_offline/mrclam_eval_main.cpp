@@ -661,7 +661,10 @@ int main(int argc, char** argv) {
              "command line or config, 77 the data set folder is absent (skip).");
   if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("mrclam_eval", [&] {
-    if (cli.given("--robots")) a.robots = app::parse_int_list(robots, "--robots", 1);
+    if (cli.given("--robots")) {
+      a.robots = app::parse_int_list(robots, "--robots", 1);
+      app::check_usage([&] { mrclam::check_robot_list(a.robots, "--robots"); });
+    }
     if (cli.given("--seeds")) a.seeds = app::parse_int_list(seeds, "--seeds", 0);
     return run(a);
   });

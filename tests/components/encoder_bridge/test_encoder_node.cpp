@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <fstream>
 #include <memory>
+#include <mutex>
 #include <random>
 #include <string>
 #include <thread>
@@ -283,6 +284,56 @@ TEST(EncoderNode, PublishesOnePeriodAtATimeWithMappedStampsAndSkipsBadBytes) {
   node.stop();
   EXPECT_EQ(node.counters().empty_periods, 14u);
   EXPECT_TRUE(log.contains("final status", "samples 56")) << log.all();
+}
+
+TEST(EncoderNode, HoldsItsMessagesUntilTheReadersMatchAndLosesNone) {
+  // Given a node that waits for two readers (node.wait_readers) while only the
+  // test's inbox listens, and an Arduino that is already sending,
+  auto script = std::make_shared<bridge::ByteScript>();
+  std::mt19937 prng(3);
+  for (std::uint32_t j = 0; j < 56; ++j) script->add_bytes(encoder::format_line(sample_number(j)), arrival_ns(j, prng));
+  LogLines log;
+  OdometryInbox& inbox = odometry_inbox();
+  inbox.clear();
+  EncoderNodeOptions options = node_options();
+  options.process.wait_readers = 2;
+  options.process.wait_readers_timeout_s = 60.0;
+  EncoderNode node(options, std::make_unique<bridge::ScriptedByteSource>(script), log.sink(),
+                   bridge::ByteScript::clock(script));
+  ASSERT_TRUE(node.wait_for_subscribers(1, std::chrono::seconds(10)));
+  node.start();
+
+  // Then the device is read but nothing goes out,
+  std::this_thread::sleep_for(milliseconds(500));
+  EXPECT_EQ(node.counters().parser.samples, 56u);
+  EXPECT_TRUE(inbox.wait_for(1, milliseconds(1)).empty());
+  EXPECT_EQ(node.counters().published, 0u);
+
+  // and when a second reader matches, both get every period from seq 1 on.
+  std::mutex mutex;
+  std::vector<std::uint64_t> late_seqs;
+  {
+    dds::Participant late_participant(loopback_options(), "late_odometry_reader");
+    dds::Reader<msg::Odometry> late(late_participant, [&](const msg::Odometry& m) {
+      std::lock_guard<std::mutex> lock(mutex);
+      late_seqs.push_back(m.header().seq());
+    });
+    const std::vector<msg::Odometry> got = inbox.wait_for(10, std::chrono::seconds(10));
+    ASSERT_EQ(got.size(), 10u);
+    for (std::size_t k = 0; k < got.size(); ++k) EXPECT_EQ(got[k].header().seq(), k + 1);
+    for (int i = 0; i < 500; ++i) {
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (late_seqs.size() >= 10) break;
+      }
+      std::this_thread::sleep_for(milliseconds(10));
+    }
+  }
+  node.stop();
+  std::lock_guard<std::mutex> lock(mutex);
+  ASSERT_EQ(late_seqs.size(), 10u);
+  for (std::size_t k = 0; k < late_seqs.size(); ++k) EXPECT_EQ(late_seqs[k], k + 1);
+  EXPECT_TRUE(log.contains("2 readers matched: publishing the 10 messages held")) << log.all();
 }
 
 TEST(EncoderNode, MissingAndHungUpDeviceIsLoggedAndReopened) {

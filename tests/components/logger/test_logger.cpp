@@ -104,7 +104,7 @@ TEST(LoggerOptions, TopicPatternsAndRotation) {
   const LoggerOptions o = read_logger_options(root, "/cfg");
   EXPECT_EQ(o.topics,
             (std::vector<std::string>{"pixyslam/odometry", "pixyslam/landmark_observation", "pixyslam/map_state",
-                                      "pixyslam/diagnostics", "pixyslam/optimised_map"}));
+                                      "pixyslam/diagnostics", "pixyslam/optimised_map", "pixyslam/robot_sighting"}));
   EXPECT_EQ(o.rotate_size_bytes, 1000000u);
   EXPECT_DOUBLE_EQ(o.rotate_period_s, 60.0);
   EXPECT_TRUE(rotation_enabled(o));
@@ -382,11 +382,13 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
   dds::Writer<msg::MapState> map_writer(robot);
   dds::Writer<msg::GroundTruth> truth_writer(robot);
   dds::Writer<msg::OptimisedMap> optimised_writer(robot);
+  dds::Writer<msg::RobotSighting> sighting_writer(robot);
   ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
   ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
   ASSERT_TRUE(map_writer.wait_for_readers(1, std::chrono::seconds(10)));
   ASSERT_TRUE(truth_writer.wait_for_readers(1, std::chrono::seconds(10)));
   ASSERT_TRUE(optimised_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(sighting_writer.wait_for_readers(1, std::chrono::seconds(10)));
 
   std::vector<msg::Odometry> odometry_sent;
   std::vector<msg::LandmarkObservation> observations_sent;
@@ -418,6 +420,14 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
       ASSERT_TRUE(optimised_writer.publish(optimised_sent.back()));
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
+    if (i % 100 == 0) {
+      msg::RobotSighting sighting;
+      msg::RobotDetection d;
+      d.seen_robot_id("robot" + std::to_string(i / 100 + 2));
+      d.range_m(1.0 + i / 100);
+      sighting.detections().push_back(d);
+      ASSERT_TRUE(sighting_writer.publish(sighting));
+    }
   }
   ASSERT_EQ(observations_sent.size(), 50u);
   ASSERT_EQ(maps_sent.size(), 100u);
@@ -427,7 +437,7 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
       [&] {
         return received(node, "pixyslam/odometry") == 500 && received(node, "pixyslam/map_state") == 100 &&
                received(node, "pixyslam/landmark_observation") == 50 && received(node, "pixyslam/ground_truth") == 20 &&
-               received(node, "pixyslam/optimised_map") == 10;
+               received(node, "pixyslam/optimised_map") == 10 && received(node, "pixyslam/robot_sighting") == 5;
       },
       std::chrono::seconds(20)))
       << node.counters_text();
@@ -441,8 +451,9 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
                                                          {"pixyslam/map_state", 100},
                                                          {"pixyslam/ground_truth", 20},
                                                          {"pixyslam/diagnostics", 0},
-                                                         {"pixyslam/optimised_map", 10}};
-  ASSERT_EQ(c.topics.size(), 6u);
+                                                         {"pixyslam/optimised_map", 10},
+                                                         {"pixyslam/robot_sighting", 5}};
+  ASSERT_EQ(c.topics.size(), 7u);
   for (const auto& [topic, count] : expected) {
     const TopicCounters& t = topic_counters(c, topic);
     EXPECT_EQ(t.received, count) << topic;
@@ -450,7 +461,7 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
     EXPECT_EQ(t.dropped, 0u) << topic;
     EXPECT_EQ(t.reader.seq_gaps, 0u) << topic;
   }
-  EXPECT_EQ(c.file.messages, 680u);
+  EXPECT_EQ(c.file.messages, 685u);
   EXPECT_GT(c.file.chunks, 1u);
   EXPECT_GT(c.queue_peak_messages, 0u);
   EXPECT_NE(node.counters_text().find("pixyslam/odometry: received 500, written 500, dropped 0, seq gaps 0"),
@@ -460,15 +471,15 @@ TEST(LoggerNode, RecordsEveryTopicExactly) {
   const mcap::McapReader reader(file.path());
   EXPECT_TRUE(reader.clean()) << reader.diagnostics_text();
   ASSERT_TRUE(reader.statistics().has_value());
-  EXPECT_EQ(reader.statistics()->message_count, 680u);
-  EXPECT_EQ(reader.messages().size(), 680u);
+  EXPECT_EQ(reader.statistics()->message_count, 685u);
+  EXPECT_EQ(reader.messages().size(), 685u);
   for (const mcap::McapChunkInfo& chunk : reader.chunks()) {
     EXPECT_EQ(chunk.compression, mcap::mcap_compression_name(default_compression()));
   }
 
   // Channels and schemas.
-  ASSERT_EQ(reader.channels().size(), 6u);
-  ASSERT_EQ(reader.schemas().size(), 6u);
+  ASSERT_EQ(reader.channels().size(), 7u);
+  ASSERT_EQ(reader.schemas().size(), 7u);
   for (const TopicInfo& info : known_topics()) {
     const mcap::McapChannel* channel = reader.find_channel(info.topic);
     ASSERT_NE(channel, nullptr) << info.topic;

@@ -1,6 +1,7 @@
 // The estimator's time-ordered merge of odometry and camera frames.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <variant>
 #include <vector>
@@ -138,6 +139,40 @@ TEST(SensorQueue, BacklogAfterAnOutageIsMergedInStampOrder) {
   EXPECT_EQ(released.size(), 100u);
   EXPECT_TRUE(std::is_sorted(released.begin(), released.end()));
   EXPECT_EQ(queue.counters().late, 0u);
+}
+
+// Both bridges held their first messages until every reader matched: the
+// odometry backlog arrives first, the camera's 0.3 s later; still merged.
+TEST(SensorQueue, BacklogAtTheStartWaitsForTheStreamNotSeenYet) {
+  SensorQueue queue(SensorQueueOptions{});
+  std::vector<double> released;
+  auto drain = [&](double now) {
+    for (const SensorInput& input : queue.pop_ready(now)) released.push_back(stamp_of(input));
+  };
+  double now = 6.0;
+  for (int i = 0; i < 50; ++i) {
+    queue.push(odometry(0.1 * i), now);
+    drain(now);
+  }
+  EXPECT_TRUE(released.empty()) << "odometry went ahead of the camera's backlog";
+  EXPECT_DOUBLE_EQ(queue.next_release_s(), 7.0);
+  now = 6.3;
+  for (int i = 0; i < 50; ++i) {
+    queue.push(frame(0.1 * i + 0.05), now);
+    drain(now);
+  }
+  drain(now + 1.0);
+  EXPECT_EQ(released.size(), 100u);
+  EXPECT_TRUE(std::is_sorted(released.begin(), released.end()));
+  EXPECT_EQ(queue.counters().late, 0u);
+}
+
+// A robot without a camera: its odometry backlog goes after the recovery wait.
+TEST(SensorQueue, BacklogAtTheStartWithoutACameraGoesAfterTheRecoveryWait) {
+  SensorQueue queue(SensorQueueOptions{});
+  for (int i = 0; i < 50; ++i) queue.push(odometry(0.1 * i), 6.0);
+  EXPECT_TRUE(queue.pop_ready(6.99).empty());
+  EXPECT_EQ(queue.pop_ready(7.0).size(), 50u);
 }
 
 // Without arrival times the same burst is released as it comes: late frames.

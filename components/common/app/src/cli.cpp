@@ -222,27 +222,7 @@ void add_verbose(Cli& cli, bool& verbose) {
 
 std::vector<int> parse_int_list(const std::string& text, const std::string& flag, int min) {
   std::vector<int> out;
-  for (const std::string& item : parameters::split_list(text)) {  // "1,2," and "1,,2": no item there
-    // Digits, '_' only between two digits (10_000).
-    std::string digits;
-    bool ok = true;
-    for (std::size_t i = 0; i < item.size(); ++i) {
-      const char c = item[i];
-      if (c == '_' && i > 0 && i + 1 < item.size() && std::isdigit(static_cast<unsigned char>(item[i - 1])) &&
-          std::isdigit(static_cast<unsigned char>(item[i + 1]))) {
-        continue;
-      }
-      if (!std::isdigit(static_cast<unsigned char>(c)) && !(i == 0 && c == '-')) ok = false;
-      digits += c;
-    }
-    char* end = nullptr;
-    const long v = ok ? std::strtol(digits.c_str(), &end, 10) : 0;
-    if (!ok || digits.empty() || *end != '\0' || v < min || v > std::numeric_limits<int>::max()) {
-      throw UsageError(flag + ": '" + item + "' is not an integer >= " + std::to_string(min));
-    }
-    out.push_back(static_cast<int>(v));
-  }
-  if (out.empty()) throw UsageError(flag + ": no value in '" + text + "'");
+  check_usage([&] { out = parameters::parse_int_list(text, flag, min); });
   return out;
 }
 

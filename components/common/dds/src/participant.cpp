@@ -46,6 +46,7 @@ void register_all_type_objects() {
     MessageTraits<msg::GroundTruth>::register_type_object();
     MessageTraits<msg::Diagnostics>::register_type_object();
     MessageTraits<msg::OptimisedMap>::register_type_object();
+    MessageTraits<msg::RobotSighting>::register_type_object();
   });
 }
 

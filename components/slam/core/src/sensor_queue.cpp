@@ -52,11 +52,14 @@ void SensorQueue::push(const ObservationInput& observation, double arrival_s) {
 namespace {
 
 // How far a stream is known: its stamps, and while it keeps arriving nothing
-// more; once silent for `max_delay_s` (stamps and arrivals), up to now - max delay.
+// more; once silent for `max_delay_s` (stamps and arrivals), up to now - max delay;
+// never seen: up to now - max delay, except during a recovery wait.
 double horizon(bool has, double known_until_s, double arrival_s, double max_delay_s, double now_s,
                bool recovering) {
   const double waited = now_s - max_delay_s;
-  if (!has) return waited;
+  // Not seen yet: during a recovery wait it may be the other backlog still on its way (two bridges
+  // that held their messages at start, node.wait_readers), so it holds everything back.
+  if (!has) return recovering ? -kNever : waited;
   if (arrival_s >= waited || recovering) return known_until_s;
   return std::max(known_until_s, waited);
 }

@@ -179,6 +179,9 @@ void EstimatorNode::filter_loop() {
 }
 
 void EstimatorNode::step(const slam::SensorInput& input) {
+  // Only this thread creates the filter, so filter_ is read without the lock here: the wait for
+  // the first ground truth must not hold state_mutex_ (diagnostics and status read under it).
+  if (!filter_ && !start_pose_) start_pose_ = initial_pose();
   std::lock_guard<std::mutex> lock(state_mutex_);
   const auto begin = std::chrono::steady_clock::now();
   if (!filter_) create_filter(slam::input_time(input));
@@ -245,20 +248,21 @@ void EstimatorNode::create_filter(double first_t_s) {
     }
     checkpoint_.reset();
   }
-  slam::Pose2 start = options_.initial_pose;
-  if (!filter_ && truth_reader_) {
-    std::unique_lock<std::mutex> lock(truth_mutex_);
-    if (truth_cv_.wait_for(lock, std::chrono::duration<double>(options_.initial_pose_wait_s),
-                           [this] { return first_truth_.has_value(); })) {
-      start = *first_truth_;
-      std::fprintf(stderr, "slam_estimator: start pose from %s's ground truth: (%.3f, %.3f, %.3f)\n",
-                   options_.dds.robot_id.c_str(), start.x(), start.y(), start.z());
-    } else {
-      std::fprintf(stderr, "slam_estimator: no ground truth of %s after %.1f s: starting from the configured pose\n",
-                   options_.dds.robot_id.c_str(), options_.initial_pose_wait_s);
-    }
+  if (!filter_) filter_ = std::make_unique<slam::FastSlam2>(options_.filter, *start_pose_);
+}
+
+slam::Pose2 EstimatorNode::initial_pose() {
+  if (!truth_reader_) return options_.initial_pose;
+  std::unique_lock<std::mutex> lock(truth_mutex_);
+  if (truth_cv_.wait_for(lock, std::chrono::duration<double>(options_.initial_pose_wait_s),
+                         [this] { return first_truth_.has_value(); })) {
+    std::fprintf(stderr, "slam_estimator: start pose from %s's ground truth: (%.3f, %.3f, %.3f)\n",
+                 options_.dds.robot_id.c_str(), first_truth_->x(), first_truth_->y(), first_truth_->z());
+    return *first_truth_;
   }
-  if (!filter_) filter_ = std::make_unique<slam::FastSlam2>(options_.filter, start);
+  std::fprintf(stderr, "slam_estimator: no ground truth of %s after %.1f s: starting from the configured pose\n",
+               options_.dds.robot_id.c_str(), options_.initial_pose_wait_s);
+  return options_.initial_pose;
 }
 
 void EstimatorNode::write_checkpoint(bool final) {

@@ -68,7 +68,7 @@ TEST(CdrPayload, StrictDecodingRejectsCutPaddedAndMistypedPayloads) {
 
 TEST(CdrPayload, KnownTopicsAreTheSystemsTopicsWithTheirDdsTypeNames) {
   const auto& topics = known_topics();
-  ASSERT_EQ(topics.size(), 6u);
+  ASSERT_EQ(topics.size(), 7u);
   EXPECT_EQ(topics[0].topic, dds::kOdometryTopic);
   EXPECT_EQ(topics[0].type_name, "pixyslam::msg::Odometry");
   EXPECT_EQ(topics[0].idl_stem, "odometry");
@@ -82,6 +82,9 @@ TEST(CdrPayload, KnownTopicsAreTheSystemsTopicsWithTheirDdsTypeNames) {
   EXPECT_EQ(topics[5].type_name, "pixyslam::msg::OptimisedMap");
   EXPECT_EQ(topics[5].idl_stem, "optimised_map");
   ASSERT_NE(find_topic("pixyslam/optimised_map"), nullptr);
+  EXPECT_EQ(topics[6].topic, dds::kRobotSightingTopic);
+  EXPECT_EQ(topics[6].type_name, "pixyslam::msg::RobotSighting");
+  EXPECT_EQ(topics[6].idl_stem, "robot_sighting");
 }
 
 // ---------------------------------------------------------------- topic patterns

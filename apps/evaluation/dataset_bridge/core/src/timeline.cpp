@@ -8,9 +8,9 @@ namespace pixyslam::dataset_bridge {
 RobotStream make_robot_stream(const mrclam::RobotData& data, const offline::MrclamSensorModel& model) {
   RobotStream s;
   s.robot = data.robot;
-  s.robot_id = "robot" + std::to_string(data.robot);
+  s.robot_id = mrclam::robot_id(data.robot);
   s.input = offline::mrclam_input(data, model);
-  s.sightings = data.robot_sightings;
+  for (const mrclam::MeasurementFrame& f : data.robot_sightings) s.sightings.push_back(offline::mrclam_frame(f, model));
   return s;
 }
 

@@ -34,25 +34,10 @@ const parameters::Table<DatasetBridgeOptions>& dataset_bridge_parameters() {
 
 namespace {
 
-std::vector<int> read_robots(const std::vector<std::string>& texts, const std::string& where) {
-  std::vector<int> robots;
-  for (const std::string& t : texts) {
-    std::size_t used = 0;
-    int r = 0;
-    try {
-      r = std::stoi(t, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != t.size() || r < mrclam::kFirstRobot || r > mrclam::kLastRobot) {
-      throw std::invalid_argument(where + ": '" + t + "' is not a robot number 1-5");
-    }
-    for (int seen : robots) {
-      if (seen == r) throw std::invalid_argument(where + ": robot " + t + " given twice");
-    }
-    robots.push_back(r);
-  }
-  if (robots.empty()) throw std::invalid_argument(where + ": no robot");
+// "1,3" (or a YAML list's items joined): robots 1-5, none twice.
+std::vector<int> read_robots(const std::string& text, const std::string& where) {
+  std::vector<int> robots = parameters::parse_int_list(text, where, mrclam::kFirstRobot);
+  mrclam::check_robot_list(robots, where);
   return robots;
 }
 
@@ -71,9 +56,9 @@ DatasetBridgeOptions read_dataset_bridge_options_file(const std::string& path) {
   }
   config::YamlReader y = root.child("dataset_bridge");
   if (y.has("robots")) {
-    std::vector<std::string> texts;
-    for (const std::string& t : y.text_list("robots")) texts.push_back(t);
-    config::check_rules(y, [&] { o.robots = read_robots(texts, "robots"); });
+    std::string text;
+    for (const std::string& t : y.text_list("robots")) text += (text.empty() ? "" : ",") + t;
+    config::check_rules(y, [&] { o.robots = read_robots(text, "robots"); });
   }
   config::read_parameters(y, dataset_bridge_parameters(), o);
   y.finish();
@@ -91,7 +76,7 @@ void apply_overrides(DatasetBridgeOptions& o, const std::vector<std::string>& as
   for (const std::string& a : rest) {
     const std::string robots_key = "dataset_bridge.robots=";
     if (a.rfind(robots_key, 0) == 0) {
-      o.robots = read_robots(parameters::split_list(a.substr(robots_key.size())), "dataset_bridge.robots");
+      o.robots = read_robots(a.substr(robots_key.size()), "dataset_bridge.robots");
       continue;
     }
     parameters::apply_override(o, dataset_bridge_parameters(), "dataset_bridge", a);
@@ -104,13 +89,23 @@ namespace {
 
 std::uint64_t to_ns(double t_s) { return static_cast<std::uint64_t>(std::llround(t_s * 1e9)); }
 
+// Range, bearing and the filter's configured sigmas of one detection (LandmarkDetection, RobotDetection).
+template <class Detection>
+void set_measurement(Detection& d, const slam::RangeBearing& z, const slam::FilterOptions& filter) {
+  d.range_m(z.range_m);
+  d.bearing_rad(z.bearing_rad);
+  d.range_sigma_m(filter.range_sigma_m + filter.range_sigma_per_m * z.range_m);
+  d.bearing_sigma_rad(filter.bearing_sigma_rad);
+}
+
 // One robot's writers.
 struct RobotWriters {
   RobotWriters(dds::Participant& p, const std::string& robot_id)
-      : odometry(p, robot_id), observation(p, robot_id), truth(p, robot_id) {}
+      : odometry(p, robot_id), observation(p, robot_id), truth(p, robot_id), sighting(p, robot_id) {}
   dds::Writer<msg::Odometry> odometry;
   dds::Writer<msg::LandmarkObservation> observation;
   dds::Writer<msg::GroundTruth> truth;
+  dds::Writer<msg::RobotSighting> sighting;
 };
 
 }  // namespace
@@ -173,11 +168,7 @@ PublishCounters publish_recording(const DatasetBridgeOptions& options,
         for (const slam::RangeBearing& z : f.detections) {
           msg::LandmarkDetection d;
           d.landmark_id(z.landmark_id);
-          d.range_m(z.range_m);
-          d.bearing_rad(z.bearing_rad);
-          d.range_sigma_m(options.filter.range_sigma_m +
-                          options.filter.range_sigma_per_m * z.range_m);
-          d.bearing_sigma_rad(options.filter.bearing_sigma_rad);
+          set_measurement(d, z, options.filter);
           m.detections().push_back(d);
         }
         count(w.observation.publish(m));
@@ -203,9 +194,21 @@ PublishCounters publish_recording(const DatasetBridgeOptions& options,
         ++c.ground_truth;
         break;
       }
-      case EventKind::kSighting:
-        ++c.sightings_skipped;
+      case EventKind::kSighting: {
+        const slam::ObservationFrame& f = r.sightings[e.index];
+        msg::RobotSighting m;
+        m.header().stamp_ns(to_ns(f.t_s));
+        m.header().frame_id("camera");
+        for (const slam::RangeBearing& z : f.detections) {
+          msg::RobotDetection d;
+          d.seen_robot_id(mrclam::robot_id(z.landmark_id));
+          set_measurement(d, z, options.filter);
+          m.detections().push_back(d);
+        }
+        count(w.sighting.publish(m));
+        ++c.sightings;
         break;
+      }
     }
     if (!pacer.paced() && ++since_flow >= static_cast<std::size_t>(options.flow_batch)) {
       since_flow = 0;
@@ -214,6 +217,7 @@ PublishCounters publish_recording(const DatasetBridgeOptions& options,
         if (!rw->odometry.wait_for_acknowledgments(timeout)) ++c.ack_timeouts;
         if (!rw->observation.wait_for_acknowledgments(timeout)) ++c.ack_timeouts;
         if (!rw->truth.wait_for_acknowledgments(timeout)) ++c.ack_timeouts;
+        if (!rw->sighting.wait_for_acknowledgments(timeout)) ++c.ack_timeouts;
       }
     }
   }

@@ -297,4 +297,17 @@ void write_robot(const std::string& dataset_dir, const RobotData& data) {
   }
 }
 
+void check_robot_list(const std::vector<int>& robots, const std::string& what) {
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    if (robots[i] < kFirstRobot || robots[i] > kLastRobot) {
+      throw std::invalid_argument(what + ": " + std::to_string(robots[i]) + " is not a robot number " +
+                                  std::to_string(kFirstRobot) + "-" + std::to_string(kLastRobot));
+    }
+    if (std::find(robots.begin(), robots.begin() + static_cast<std::ptrdiff_t>(i), robots[i]) !=
+        robots.begin() + static_cast<std::ptrdiff_t>(i)) {
+      throw std::invalid_argument(what + ": robot " + std::to_string(robots[i]) + " given twice");
+    }
+  }
+}
+
 }  // namespace pixyslam::mrclam

@@ -278,19 +278,21 @@ RunInput mrclam_input(const mrclam::RobotData& d, const MrclamSensorModel& model
     const double speed_factor = std::max(0.0, model.speed_scale - model.speed_loss_per_radps * std::abs(o.w_radps));
     in.odometry.push_back({o.t_s + model.odometry_delay_s, o.v_mps * speed_factor, o.w_radps});
   }
-  for (const mrclam::MeasurementFrame& f : d.frames) {
-    slam::ObservationFrame frame{f.t_s, {}};
-    for (const mrclam::Detection& det : f.detections) {
-      slam::RangeBearing z;
-      z.landmark_id = det.subject;
-      z.range_m = det.range_m / (model.range_scale *
-                                 std::pow(std::cos(det.bearing_rad), model.range_cos_bearing_exponent));
-      z.bearing_rad = det.bearing_rad;
-      frame.detections.push_back(z);
-    }
-    in.frames.push_back(std::move(frame));
-  }
+  for (const mrclam::MeasurementFrame& f : d.frames) in.frames.push_back(mrclam_frame(f, model));
   return in;
+}
+
+slam::ObservationFrame mrclam_frame(const mrclam::MeasurementFrame& f, const MrclamSensorModel& model) {
+  slam::ObservationFrame frame{f.t_s, {}};
+  for (const mrclam::Detection& det : f.detections) {
+    slam::RangeBearing z;
+    z.landmark_id = det.subject;
+    z.range_m = det.range_m / (model.range_scale *
+                               std::pow(std::cos(det.bearing_rad), model.range_cos_bearing_exponent));
+    z.bearing_rad = det.bearing_rad;
+    frame.detections.push_back(z);
+  }
+  return frame;
 }
 
 }  // namespace pixyslam::offline

@@ -355,6 +355,21 @@ Value to_value(const msg::OptimisedMap& m) {
   return v;
 }
 
+Value to_value(const msg::RobotSighting& m) {
+  Value v = Value::structure();
+  v.add("header", header_value(m.header()))
+      .add("detections", list_of(m.detections(), [](const msg::RobotDetection& d) {
+             Value e = Value::structure();
+             e.add("seen_robot_id", Value::string(d.seen_robot_id()))
+                 .add("range_m", Value::number(d.range_m()))
+                 .add("bearing_rad", Value::number(d.bearing_rad()))
+                 .add("range_sigma_m", Value::number(d.range_sigma_m()))
+                 .add("bearing_sigma_rad", Value::number(d.bearing_sigma_rad()));
+             return e;
+           }));
+  return v;
+}
+
 std::string diagnostics_table(std::vector<msg::Diagnostics> reports) {
   std::sort(reports.begin(), reports.end(), [](const msg::Diagnostics& a, const msg::Diagnostics& b) {
     return std::make_tuple(a.header().robot_id(), a.process(), a.pid()) <

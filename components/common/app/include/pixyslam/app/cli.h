@@ -27,6 +27,18 @@ class UsageError : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+// Runs f(); a std::invalid_argument it throws (a value checked outside Cli) becomes a UsageError.
+template <class F>
+void check_usage(F&& f) {
+  try {
+    f();
+  } catch (const UsageError&) {
+    throw;
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+}
+
 class Cli {
  public:
   // One declared option; its methods refine it and return it.

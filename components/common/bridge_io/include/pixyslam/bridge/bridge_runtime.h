@@ -25,6 +25,11 @@ namespace pixyslam::bridge {
 // the log every status_period_s and (prefixed "final ") at stop(), and the
 // start/stop life cycle.
 //
+// node.wait_readers: from start() on the device is read as usual (stamps are
+// the read times), but the messages are held until that many readers matched
+// or node.wait_readers_timeout_s passed, then written in order: every reader
+// gets the run from seq 1, and no sensor data is lost meanwhile.
+//
 // Locking: the node owns `mutex` and holds it to read its own state; the
 // runtime holds it around every handler call, so handlers, publish() and the
 // counters run under it. The node declares its runtime after every member its
@@ -51,6 +56,9 @@ class BridgeRuntime {
       : process_(process),
         mutex_(mutex),
         status_period_s_(options.status_period_s),
+        hold_readers_(options.wait_readers),
+        hold_timeout_(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+            std::chrono::duration<double>(options.wait_readers_timeout_s))),
         log_(log ? std::move(log) : stderr_log(process)),
         participant_(dds_options, process),
         writer_(participant_),
@@ -67,6 +75,8 @@ class BridgeRuntime {
       started_ = true;
       handlers_ = std::move(handlers);
       schedule_status();
+      holding_ = hold_readers_ > 0;
+      hold_deadline_ = std::chrono::steady_clock::now() + hold_timeout_;
     }
     log_(start_line);
     DeviceReader::Handlers locked;
@@ -83,6 +93,7 @@ class BridgeRuntime {
     locked.on_poll = [this](std::uint64_t now_ns) {
       std::lock_guard<std::mutex> lock(mutex_);
       handlers_.on_poll(now_ns);
+      if (holding_) release_hold();
       if (status_period_s_ > 0.0 && std::chrono::steady_clock::now() >= next_status_) {
         for (const std::string& line : handlers_.status_lines()) log_(line);
         schedule_status();
@@ -100,16 +111,19 @@ class BridgeRuntime {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!started_ || stopped_) return;
     stopped_ = true;
+    if (holding_ && !held_.empty()) {
+      log_("stopped before node.wait_readers was met: " + std::to_string(held_.size()) + " held messages not sent");
+    }
     for (const std::string& line : handlers_.status_lines()) log_("final " + line);
   }
 
-  // Publishes `message` and counts the outcome; call with `mutex` held.
+  // Publishes `message` (or holds it, see node.wait_readers) and counts the outcome; call with `mutex` held.
   void publish(Message& message) {
-    if (writer_.publish(message)) {
-      ++published_;
-    } else {
-      ++publish_failures_;
+    if (holding_ && !release_hold()) {
+      held_.push_back(message);
+      return;
     }
+    write(message);
   }
   // Messages written and writes DDS refused; read with `mutex` held.
   std::uint64_t published() const { return published_; }
@@ -146,6 +160,36 @@ class BridgeRuntime {
     return s;
   }
 
+  void write(Message& message) {
+    if (writer_.publish(message)) {
+      ++published_;
+    } else {
+      ++publish_failures_;
+    }
+  }
+
+  // Ends the hold when the readers matched, at the time-out, or at kMaxHeld
+  // messages, writing the held ones; true once released. With `mutex` held.
+  bool release_hold() {
+    static constexpr std::size_t kMaxHeld = 10000;
+    const int matched = writer_.matched_readers();
+    const bool timed_out = std::chrono::steady_clock::now() >= hold_deadline_;
+    if (matched < hold_readers_ && !timed_out && held_.size() < kMaxHeld) return false;
+    holding_ = false;
+    if (matched < hold_readers_) {
+      log_(std::to_string(matched) + " of " + std::to_string(hold_readers_) + " readers matched (node.wait_readers) " +
+           (timed_out ? "at the time-out" : "with " + std::to_string(kMaxHeld) + " messages held") +
+           "; publishing anyway, " + std::to_string(held_.size()) + " held messages first");
+    } else if (!held_.empty()) {
+      log_(std::to_string(matched) + " readers matched: publishing the " + std::to_string(held_.size()) +
+           " messages held meanwhile");
+    }
+    for (Message& m : held_) write(m);
+    held_.clear();
+    held_.shrink_to_fit();
+    return true;
+  }
+
   void schedule_status() {
     next_status_ = std::chrono::steady_clock::now() +
                    std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -160,6 +204,11 @@ class BridgeRuntime {
   std::chrono::steady_clock::time_point next_status_;
   std::uint64_t published_ = 0;
   std::uint64_t publish_failures_ = 0;
+  const int hold_readers_;
+  const std::chrono::steady_clock::duration hold_timeout_;
+  bool holding_ = false;
+  std::chrono::steady_clock::time_point hold_deadline_;
+  std::vector<Message> held_;
   bool started_ = false;
   bool stopped_ = false;
 

@@ -15,6 +15,8 @@
 #include "odometryPubSubTypes.h"
 #include "optimised_map.h"
 #include "optimised_mapPubSubTypes.h"
+#include "robot_sighting.h"
+#include "robot_sightingPubSubTypes.h"
 
 // The generated TypeObject registration functions (declared here rather than
 // by including the generated *TypeObject.h headers: those put
@@ -26,6 +28,7 @@ void registermap_stateTypes();
 void registerground_truthTypes();
 void registerdiagnosticsTypes();
 void registeroptimised_mapTypes();
+void registerrobot_sightingTypes();
 
 namespace pixyslam::msg {
 // IDL of idl/<stem>.idl with its includes inlined (an `omgidl` schema); "" if unknown.
@@ -43,6 +46,7 @@ inline constexpr std::string_view kMapStateTopic = "pixyslam/map_state";
 inline constexpr std::string_view kGroundTruthTopic = "pixyslam/ground_truth";
 inline constexpr std::string_view kDiagnosticsTopic = "pixyslam/diagnostics";
 inline constexpr std::string_view kOptimisedMapTopic = "pixyslam/optimised_map";
+inline constexpr std::string_view kRobotSightingTopic = "pixyslam/robot_sighting";
 
 // Message type -> its topic, generated TopicDataType and IDL file.
 template <class Message>
@@ -64,6 +68,7 @@ PIXYSLAM_MESSAGE_TRAITS(MapState, kMapStateTopic, "map_state", registermap_state
 PIXYSLAM_MESSAGE_TRAITS(GroundTruth, kGroundTruthTopic, "ground_truth", registerground_truthTypes)
 PIXYSLAM_MESSAGE_TRAITS(Diagnostics, kDiagnosticsTopic, "diagnostics", registerdiagnosticsTypes)
 PIXYSLAM_MESSAGE_TRAITS(OptimisedMap, kOptimisedMapTopic, "optimised_map", registeroptimised_mapTypes)
+PIXYSLAM_MESSAGE_TRAITS(RobotSighting, kRobotSightingTopic, "robot_sighting", registerrobot_sightingTypes)
 
 #undef PIXYSLAM_MESSAGE_TRAITS
 
@@ -84,6 +89,7 @@ bool visit_topic_type(std::string_view topic, F&& f) {
   if (topic == kGroundTruthTopic) return f(MessageTag<msg::GroundTruth>{}), true;
   if (topic == kDiagnosticsTopic) return f(MessageTag<msg::Diagnostics>{}), true;
   if (topic == kOptimisedMapTopic) return f(MessageTag<msg::OptimisedMap>{}), true;
+  if (topic == kRobotSightingTopic) return f(MessageTag<msg::RobotSighting>{}), true;
   return false;
 }
 

@@ -6,6 +6,8 @@
 // `--set path=value` overrides and the help text all come from the table
 // (YAML reading: pixyslam/config/parameters_yaml.h). Pure (std only).
 #include <algorithm>
+#include <cctype>
+#include <cstdlib>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -141,6 +143,34 @@ inline std::vector<std::string> split_list(const std::string& text) {
     start = comma + 1;
   }
   return items;
+}
+
+// "1, 2,10_000": comma-separated integers (blanks around an item and '_'
+// between two digits allowed, empty items skipped), each at least `min`;
+// std::invalid_argument naming `what` for a bad item ("1 2") or an empty list.
+inline std::vector<int> parse_int_list(const std::string& text, const std::string& what, int min) {
+  std::vector<int> out;
+  for (const std::string& item : split_list(text)) {
+    std::string digits;
+    bool ok = true;
+    for (std::size_t i = 0; i < item.size(); ++i) {
+      const char c = item[i];
+      if (c == '_' && i > 0 && i + 1 < item.size() && std::isdigit(static_cast<unsigned char>(item[i - 1])) &&
+          std::isdigit(static_cast<unsigned char>(item[i + 1]))) {
+        continue;
+      }
+      if (!std::isdigit(static_cast<unsigned char>(c)) && !(i == 0 && c == '-')) ok = false;
+      digits += c;
+    }
+    char* end = nullptr;
+    const long v = ok ? std::strtol(digits.c_str(), &end, 10) : 0;
+    if (!ok || digits.empty() || *end != '\0' || v < min || v > std::numeric_limits<int>::max()) {
+      throw std::invalid_argument(what + ": '" + item + "' is not an integer >= " + std::to_string(min));
+    }
+    out.push_back(static_cast<int>(v));
+  }
+  if (out.empty()) throw std::invalid_argument(what + ": no value in '" + text + "'");
+  return out;
 }
 
 // A list of texts: a YAML sequence, or comma-separated on a command line or

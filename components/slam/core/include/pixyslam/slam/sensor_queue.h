@@ -41,6 +41,9 @@ struct SensorQueueOptions {
   // its stamp), a silent stream still holds the other back this long: the
   // streams' backlogs come back at different times (reliable DDS resends on
   // its heartbeat), and are merged in stamp order if both arrive within it.
+  // A stream not seen yet holds the other back during this wait too (bridges
+  // that held their first messages until every reader matched release their
+  // backlogs at slightly different times).
   double recovery_wait_s = 1.0;
 };
 

@@ -69,6 +69,8 @@ class EstimatorNode {
   void step(const slam::SensorInput& input);
   // The filter, from the checkpoint when there is a fresh one (state_mutex_ held).
   void create_filter(double first_t_s);
+  // The configured start pose, or the robot's first ground truth (estimator.initial_pose.source).
+  slam::Pose2 initial_pose();
   void publish_map_state();  // state_mutex_ held
   void write_checkpoint(bool final);
   void log_status() const;
@@ -82,6 +84,7 @@ class EstimatorNode {
   std::mutex truth_mutex_;
   std::condition_variable truth_cv_;
   std::optional<slam::Pose2> first_truth_;
+  std::optional<slam::Pose2> start_pose_;  // filter thread only
   std::unique_ptr<dds::Reader<msg::GroundTruth>> truth_reader_;
   std::unique_ptr<dds::Reader<msg::Odometry>> odometry_reader_;
   std::unique_ptr<dds::Reader<msg::LandmarkObservation>> observation_reader_;

@@ -15,12 +15,12 @@ namespace pixyslam::dataset_bridge {
 
 // One robot of the recording: its samples as the filter gets them (the data
 // set's sensor corrections applied: offline::mrclam_input), and the other
-// robots it saw.
+// robots it saw (the same corrections; landmark_id = the robot seen).
 struct RobotStream {
   int robot = 0;                 // the data set's subject number
   std::string robot_id;          // "robot<N>", the header's robot_id
   offline::RunInput input;       // odometry, frames, truth, landmarks, start pose and time
-  std::vector<mrclam::MeasurementFrame> sightings;
+  std::vector<slam::ObservationFrame> sightings;
 };
 
 RobotStream make_robot_stream(const mrclam::RobotData& data, const offline::MrclamSensorModel& model);

@@ -34,15 +34,14 @@ DatasetBridgeOptions read_dataset_bridge_options_file(const std::string& path);
 void apply_overrides(DatasetBridgeOptions& options, const std::vector<std::string>& assignments);
 
 struct PublishCounters {
-  std::uint64_t odometry = 0, observations = 0, ground_truth = 0;
-  std::uint64_t sightings_skipped = 0;  // robot sightings: no topic for them yet
+  std::uint64_t odometry = 0, observations = 0, ground_truth = 0, sightings = 0;
   std::uint64_t write_failures = 0;     // DDS refused a sample
   std::uint64_t ack_timeouts = 0;       // rate 0: readers that did not acknowledge in time
   double wall_time_s = 0.0;
   double recording_time_s = 0.0;        // first to last sample
 };
 
-// Publishes every robot's Odometry, LandmarkObservation and GroundTruth (one
+// Publishes every robot's Odometry, LandmarkObservation, GroundTruth and RobotSighting (one
 // DDS writer per robot and topic, header.robot_id "robot<N>", header seq 1..N
 // per writer, stamps = the recording's times) in time order, paced by
 // `options.rate`. Returns when done or when `stop` becomes true.

@@ -11,6 +11,10 @@ namespace pixyslam::mrclam {
 // The robots of an MRCLAM data set are subjects kFirstRobot..kLastRobot.
 constexpr int kFirstRobot = 1;
 constexpr int kLastRobot = 5;
+// Robot `robot`'s name on the topics (MessageHeader robot_id): "robot<N>".
+inline std::string robot_id(int robot) { return "robot" + std::to_string(robot); }
+// std::invalid_argument naming `what` unless every robot is kFirstRobot..kLastRobot and none is given twice.
+void check_robot_list(const std::vector<int>& robots, const std::string& what);
 
 // Reader for the UTIAS Multi-Robot Cooperative Localization and Mapping
 // (MRCLAM) data sets: one folder per data set with whitespace-separated text

@@ -88,6 +88,7 @@ RunInput restart_at_truth(const RunInput& input, double start_s);
 
 namespace pixyslam::mrclam {
 struct RobotData;
+struct MeasurementFrame;
 }
 namespace pixyslam::config {
 class YamlReader;
@@ -116,4 +117,6 @@ MrclamSensorModel read_mrclam_sensor_model(config::YamlReader& root);
 // MRCLAM robot data as filter input: started at the first ground-truth pose when
 // there is one, else at the origin at the first odometry time.
 RunInput mrclam_input(const mrclam::RobotData& data, const MrclamSensorModel& model = {});
+// One camera image's detections with the model's range correction (subject as landmark_id).
+slam::ObservationFrame mrclam_frame(const mrclam::MeasurementFrame& frame, const MrclamSensorModel& model);
 }  // namespace pixyslam::offline
