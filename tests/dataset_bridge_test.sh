@@ -6,7 +6,8 @@
 # (dds.robot_id robot1 and robot2) and `pixyslam_log record` listening. Passes
 # if the recording holds every sample once, seq 1..N per robot and topic, and
 # each estimator took exactly its own robot's samples and counted the other's,
-# and `pixyslam_log hz --robot robot2` counted robot 2's 80 odometry samples only.
+# and `pixyslam_log hz --robot robot2` counted robot 2's 80 odometry samples only;
+# the recording's robot sightings print, and map_view draws both robots.
 #   dataset_bridge_test.sh BIN_DIR CONFIG_DIR
 set -euo pipefail
 bin=$1 config=$2
@@ -93,4 +94,10 @@ grep -q "robot1: seq 1..100, robot2: seq 1..80" "$work/check.log" || fail "odome
   fail "print sightings"
 head -n 1 "$work/sightings.json"
 [[ $(grep -c '"seen_robot_id":"robot2"' "$work/sightings.json") == 3 ]] || fail "sightings of robot2"
+# Both robots in one picture (map_view is built whenever OpenCV is there).
+if [[ -x $bin/map_view ]]; then
+  "$bin/map_view" render "$work/run.mcap" --out "$work/map.png" > "$work/render.log" 2>&1 || fail "map_view render"
+  cat "$work/render.log"
+  grep -q "; robots robot1, robot2 -> " "$work/render.log" || fail "map_view did not draw both robots"
+fi
 echo PASS

@@ -489,6 +489,7 @@ msg::MapState map_state(std::uint64_t stamp_ns, double x, int landmarks) {
 msg::GroundTruth ground_truth(std::uint64_t stamp_ns, double x) {
   msg::GroundTruth g;
   g.header().stamp_ns(stamp_ns);
+  g.header().robot_id("robot1");
   g.pose().x_m(x);
   g.pose().y_m(0.5 * x + 0.01);
   g.pose().theta_rad(0.2);
@@ -585,6 +586,50 @@ TEST(MsgConversion, OptimisedMapReplacesTheOptimisedSolution) {
   EXPECT_FALSE(builder.add(optimised_map(t0 + 250'000'000ULL, 2, 9.0)));
   EXPECT_EQ(builder.state().optimised_trajectory.size(), 6u);
   EXPECT_EQ(builder.optimised_maps(), 2u);
+}
+
+TEST(FleetView, EveryRobotIsDrawnInOnePictureInItsOwnColour) {
+  // Given two robots' states and ground truth on one domain,
+  FleetViewBuilder fleet;
+  for (int i = 0; i < 10; ++i) {
+    msg::MapState a = map_state(1000 + 100000000ULL * i, 0.1 * i, 2);
+    msg::MapState b = map_state(1000 + 100000000ULL * i, -0.1 * i, 3);
+    b.header().robot_id("robot2");
+    msg::GroundTruth tb = ground_truth(1000 + 100000000ULL * i, -0.1 * i);
+    tb.header().robot_id("robot2");
+    EXPECT_TRUE(fleet.add(b));
+    EXPECT_TRUE(fleet.add(a));
+    fleet.add(tb);
+  }
+  // then the view is robot1's with robot2 beside it, each with its own path,
+  EXPECT_EQ(fleet.robots(), 2u);
+  EXPECT_EQ(fleet.map_states(), 20u);
+  EXPECT_EQ(fleet.ground_truths(), 10u);
+  const MapViewState s = fleet.state();
+  EXPECT_EQ(s.robot_id, "robot1");
+  EXPECT_EQ(s.mean_trajectory.size(), 10u);
+  EXPECT_EQ(s.landmarks.size(), 2u);
+  EXPECT_TRUE(s.true_trajectory.empty());
+  ASSERT_EQ(s.other_robots.size(), 1u);
+  const MapViewState& b = s.other_robots[0];
+  EXPECT_EQ(b.robot_id, "robot2");
+  EXPECT_EQ(b.landmarks.size(), 3u);
+  EXPECT_EQ(b.true_trajectory.size(), 10u);
+  EXPECT_NEAR(b.current_pose->x_m, -0.9, 1e-12);
+  // the view holds both,
+  const WorldBox box = content_bounds(s, 2.0, true);
+  EXPECT_LE(box.min_x_m, -0.9);
+  EXPECT_GE(box.max_x_m, 0.9);
+  // and robot2 is drawn (and named in the legend) in robot_colour(0), robot1 in the usual colours.
+  RenderOptions o;
+  const cv::Mat both = render_map(s, o);
+  MapViewState alone = s;
+  alone.other_robots.clear();
+  const cv::Mat one = render_map(alone, o);
+  EXPECT_GT(count_colour(both, robot_colour(0), 10), 100);
+  EXPECT_EQ(count_colour(one, robot_colour(0), 10), 0);
+  EXPECT_GT(count_colour(both, o.colours.trajectory, 10), 50);
+  EXPECT_NE(robot_colour(0), robot_colour(1));
 }
 
 TEST(MsgConversion, TrajectoryDecimation) {

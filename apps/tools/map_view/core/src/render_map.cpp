@@ -184,6 +184,19 @@ void draw_content(cv::Mat& map, const MapViewState& s, const ViewTransform& view
   }
 }
 
+// `o` with every colour of an estimate (trajectory, pose, particles,
+// landmarks, optimised map) set from `colour`: another robot's.
+RenderOptions with_robot_colour(const RenderOptions& o, const cv::Scalar& colour) {
+  RenderOptions r = o;
+  const cv::Scalar light = (colour + cv::Scalar(255, 255, 255)) * 0.5;
+  r.colours.trajectory = colour;
+  r.colours.pose = colour * 0.6;
+  r.colours.landmark = colour;
+  r.colours.particle = light;
+  r.colours.optimised = colour;
+  return r;
+}
+
 // Legend entries left to right from x; an entry that does not fit before
 // `limit_x` is left out. Returns the end.
 int draw_legend(cv::Mat& img, const MapViewState& s, const RenderOptions& o, int x, int baseline, int limit_x) {
@@ -228,6 +241,14 @@ int draw_legend(cv::Mat& img, const MapViewState& s, const RenderOptions& o, int
       line(img, {x0, mid}, {x0 + sample_w, mid}, c.optimised, 2);
       diamond(img, {x0 + sample_w / 2.0, mid}, 5.0, c.optimised);
     });
+  }
+  if (!s.other_robots.empty() && !s.robot_id.empty()) {
+    entry(s.robot_id, [&](double x0) { line(img, {x0, mid}, {x0 + sample_w, mid}, c.trajectory, 3); });
+  }
+  for (std::size_t k = 0; k < s.other_robots.size(); ++k) {
+    const std::string& id = s.other_robots[k].robot_id;
+    entry(id.empty() ? "robot " + std::to_string(k + 2) : id,
+          [&](double x0) { line(img, {x0, mid}, {x0 + sample_w, mid}, robot_colour(k), 3); });
   }
   return x;
 }
@@ -335,9 +356,30 @@ cv::Mat render_map(const MapViewState& state, const RenderOptions& options) {
   // Drawing into the map's own region clips everything to it.
   cv::Mat map = image(cv::Rect(0, 0, options.width_px, options.height_px - options.footer_px));
   if (options.grid) draw_grid(map, view, options);
+  for (std::size_t k = 0; k < state.other_robots.size(); ++k) {
+    draw_content(map, state.other_robots[k], view, with_robot_colour(options, robot_colour(k)));
+  }
   draw_content(map, state, view, options);
   if (options.footer_px > 0) draw_footer(image, state, view, options);
   return image;
+}
+
+cv::Scalar robot_colour(std::size_t index) {
+  static const cv::Scalar kPalette[] = {
+      {160, 30, 150},  // purple
+      {140, 140, 0},   // teal
+      {20, 90, 160},   // brown
+      {200, 0, 220},   // magenta
+      {0, 130, 130},   // olive
+      {90, 90, 90},    // grey
+      {220, 150, 0},   // sky blue
+      {60, 60, 180},   // brick
+      {120, 0, 80},    // indigo
+      {0, 200, 200},   // dark yellow
+      {150, 80, 230},  // pink
+      {100, 160, 60},  // sage
+  };
+  return kPalette[index % (sizeof kPalette / sizeof kPalette[0])];
 }
 
 }  // namespace pixyslam::map_view

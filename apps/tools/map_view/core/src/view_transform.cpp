@@ -106,6 +106,11 @@ WorldBox content_bounds(const MapViewState& state, double sigma_scale, bool incl
     if (state.true_pose) box.extend(state.true_pose->x_m, state.true_pose->y_m);
     for (const TrueLandmarkView& l : state.true_landmarks) box.extend(l.x_m, l.y_m);
   }
+  for (const MapViewState& other : state.other_robots) {
+    MapViewState alone = other;
+    alone.other_robots.clear();
+    box.extend(content_bounds(alone, sigma_scale, include_truth));
+  }
   return box;
 }
 

@@ -1,4 +1,4 @@
-// map_view live: DDS readers -> MapViewBuilder (under a mutex) -> render on the
+// map_view live: DDS readers -> FleetViewBuilder (under a mutex) -> render on the
 // main thread every period -> window and/or DIR/map_latest.png.
 #include <sys/types.h>
 #include <sys/wait.h>
@@ -89,7 +89,7 @@ bool window_alive(int wait_ms) {
 
 struct Shared {
   std::mutex mutex;
-  MapViewBuilder builder;
+  FleetViewBuilder builder;  // every robot on the domain
   bool changed = false;
   explicit Shared(double min_step_m) : builder(min_step_m) {}
 };

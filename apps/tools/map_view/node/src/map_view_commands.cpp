@@ -34,9 +34,12 @@ int run_render(const MapViewOptions& options, const RenderRequest& request) {
   }
   const std::string optimised =
       log.optimised_maps().empty() ? "" : ", " + std::to_string(log.optimised_maps().size()) + " optimised maps";
-  std::printf("map_view: %s: %zu map states, %zu ground-truth messages%s, %zu landmarks -> %s (%dx%d)\n",
+  std::string robots;  // named when there are several
+  for (const MapViewState& other : state.other_robots) robots += ", " + other.robot_id;
+  if (!robots.empty()) robots = "; robots " + state.robot_id + robots;
+  std::printf("map_view: %s: %zu map states, %zu ground-truth messages%s, %zu landmarks%s -> %s (%dx%d)\n",
               request.log.c_str(), log.map_states().size(), log.ground_truths().size(), optimised.c_str(),
-              state.landmarks.size(), request.out.c_str(), image.cols, image.rows);
+              state.landmarks.size(), robots.c_str(), request.out.c_str(), image.cols, image.rows);
   return 0;
 }
 

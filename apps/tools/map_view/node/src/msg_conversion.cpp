@@ -107,4 +107,30 @@ bool MapViewBuilder::add(const msg::OptimisedMap& m) {
   return true;
 }
 
+MapViewBuilder& FleetViewBuilder::robot(const std::string& robot_id) {
+  return robots_.try_emplace(robot_id, min_step_m_).first->second;
+}
+
+MapViewState FleetViewBuilder::state() const {
+  MapViewState out;
+  bool first = true;
+  for (const auto& [id, builder] : robots_) {
+    MapViewState one = builder.state();
+    one.robot_id = id;
+    if (first) {
+      out = std::move(one);
+    } else {
+      out.other_robots.push_back(std::move(one));
+    }
+    first = false;
+  }
+  return out;
+}
+
+std::size_t FleetViewBuilder::total(std::size_t (MapViewBuilder::*count)() const) const {
+  std::size_t n = 0;
+  for (const auto& entry : robots_) n += (entry.second.*count)();
+  return n;
+}
+
 }  // namespace pixyslam::map_view

@@ -53,6 +53,11 @@ struct MapViewState {
   std::vector<Point2> optimised_trajectory;       // the map optimiser's keyframes (optional)
   std::vector<LandmarkView> optimised_landmarks;  // its landmarks; non-finite covariance: no ellipse
   std::string caption;                    // one line under the map, e.g. "t = 12.3 s  ..."
+  std::string robot_id;                   // whose state this is ("" : one robot, not named)
+  // More robots on the same map (several on one domain, or a fleet log): each
+  // drawn like this one in a colour of its own, under it; their own
+  // other_robots are ignored.
+  std::vector<MapViewState> other_robots;
 };
 
 // Appends `p` to `path` unless it is closer than `min_step_m` to the last point

@@ -71,8 +71,15 @@ double nice_grid_step_m(double pixels_per_metre, double min_px);
 // as a line and its landmarks as outlined diamonds with n-sigma ellipses (only
 // finite covariances), the current pose as a filled arrow, then the footer: a
 // legend row (items present only, those that fit), then the caption with the
-// scale bar on its right (a footer under 40 px has no legend row). Pure and single-threaded: same input, same pixels. Throws
-// std::invalid_argument for options that fail validate().
+// scale bar on its right (a footer under 40 px has no legend row). The
+// state's other_robots are drawn first, each in one colour of robot_colour()
+// (its estimate, landmarks and optimised map; ground truth stays green), and
+// the legend names them. Pure and single-threaded: same input, same pixels.
+// Throws std::invalid_argument for options that fail validate().
 cv::Mat render_map(const MapViewState& state, const RenderOptions& options);
+
+// The colour of other_robots[index] (BGR), from a palette unlike the main
+// robot's blue and red; it repeats after a dozen robots.
+cv::Scalar robot_colour(std::size_t index);
 
 }  // namespace pixyslam::map_view

@@ -66,20 +66,20 @@ class MapLog {
   std::string recovery_note_;
 };
 
-// Replays a MapLog into a MapViewBuilder up to a log time. Holds a reference
-// to the log. Thread-compatible.
+// Replays a MapLog into a FleetViewBuilder (every robot of the log) up to a
+// log time. Holds a reference to the log. Thread-compatible.
 class LogPlayer {
  public:
   LogPlayer(const MapLog& log, double trajectory_min_step_m);
   // Feeds every entry with time <= time_ns not fed yet.
   void advance_to(std::uint64_t time_ns);
   void advance_to_end();
-  const MapViewState& state() const { return builder_.state(); }
-  const MapViewBuilder& builder() const { return builder_; }
+  MapViewState state() const { return builder_.state(); }
+  const FleetViewBuilder& builder() const { return builder_; }
 
  private:
   const MapLog& log_;
-  MapViewBuilder builder_;
+  FleetViewBuilder builder_;
   std::size_t next_ = 0;
 };
 

@@ -2,6 +2,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "map_state.h"
@@ -55,6 +57,33 @@ class MapViewBuilder {
   std::uint64_t start_ns_ = 0;
   std::uint64_t last_map_ns_ = 0;
   std::uint64_t last_optimised_ns_ = 0;
+};
+
+// One MapViewBuilder per robot (header.robot_id): several robots on one
+// domain or in one log are drawn in one picture. state() is the first robot's
+// (by id) with the others in other_robots; each robot's times count from its
+// own first stamp. Thread-compatible.
+class FleetViewBuilder {
+ public:
+  explicit FleetViewBuilder(double trajectory_min_step_m = 0.0) : min_step_m_(trajectory_min_step_m) {}
+
+  bool add(const msg::MapState& state) { return robot(state.header().robot_id()).add(state); }
+  void add(const msg::GroundTruth& truth) { robot(truth.header().robot_id()).add(truth); }
+  bool add(const msg::OptimisedMap& map) { return robot(map.header().robot_id()).add(map); }
+
+  MapViewState state() const;
+  std::size_t robots() const { return robots_.size(); }
+  // Totals over the robots.
+  std::size_t map_states() const { return total(&MapViewBuilder::map_states); }
+  std::size_t ground_truths() const { return total(&MapViewBuilder::ground_truths); }
+  std::size_t optimised_maps() const { return total(&MapViewBuilder::optimised_maps); }
+
+ private:
+  MapViewBuilder& robot(const std::string& robot_id);
+  std::size_t total(std::size_t (MapViewBuilder::*count)() const) const;
+
+  double min_step_m_;
+  std::map<std::string, MapViewBuilder> robots_;
 };
 
 }  // namespace pixyslam::map_view
