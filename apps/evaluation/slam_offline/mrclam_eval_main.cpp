@@ -50,6 +50,7 @@
 #include "pixyslam/app/cli.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/offline/blind_return.h"
+#include "pixyslam/fleet_map/map_fusion.h"
 #include "pixyslam/mrclam/mrclam_dataset.h"
 #include "pixyslam/mrclam/mrclam_fit.h"
 #include "pixyslam/offline/offline_run.h"
@@ -465,6 +466,64 @@ class CsvOutput {
   std::ofstream runs_;
 };
 
+// The robots' final maps of one seed, fused into the fleet map (fleet_map::fuse_maps).
+struct FleetRuns {
+  std::vector<fleet_map::RobotMap> maps;
+  std::vector<std::pair<int, double>> single_rmse;  // robot, its landmark RMSE
+  std::vector<eval::LandmarkPoint> truth;
+  void add(int robot, const offline::RunResult& res, const offline::Report& rep,
+           const std::vector<eval::LandmarkPoint>& true_landmarks) {
+    fleet_map::RobotMap m;
+    m.robot_id = mrclam::robot_id(robot);
+    for (const eval::LandmarkRow& l : res.landmarks) {
+      fleet_map::LandmarkEstimate e;
+      e.id = l.id;
+      e.mean = {l.x_m, l.y_m};
+      e.cov << l.cov_xx, l.cov_xy, l.cov_xy, l.cov_yy;
+      m.landmarks.push_back(e);
+    }
+    maps.push_back(std::move(m));
+    if (rep.has_landmarks) single_rmse.emplace_back(robot, rep.landmarks.rmse_m);
+    if (truth.empty()) truth = true_landmarks;
+  }
+};
+
+// Per seed: the fleet map's landmark RMSE beside the best and the mean single robot's.
+void print_fleet(const std::map<int, FleetRuns>& fleet) {
+  if (fleet.empty() || fleet.begin()->second.maps.size() < 2 || fleet.begin()->second.truth.empty()) return;
+  std::printf("\nFLEET MAP: the robots' final maps fused (covariance weighted, frames checked; fleet_map::fuse_maps)\n");
+  double sum_fleet = 0.0, sum_best = 0.0, sum_mean = 0.0;
+  for (const auto& [seed, runs] : fleet) {
+    const fleet_map::FleetMap f = fleet_map::fuse_maps(runs.maps);
+    std::vector<eval::LandmarkPoint> fused;
+    for (const fleet_map::FusedLandmark& l : f.landmarks) fused.push_back({l.id, l.mean.x(), l.mean.y()});
+    const eval::LandmarkErrors e = eval::compare_landmarks(fused, runs.truth);
+    std::pair<int, double> best{0, 1e300};
+    double mean = 0.0;
+    for (const auto& [robot, rmse] : runs.single_rmse) {
+      if (rmse < best.second) best = {robot, rmse};
+      mean += rmse / static_cast<double>(runs.single_rmse.size());
+    }
+    std::string checks;
+    for (const fleet_map::FrameCheck& c : f.robots) {
+      char one[200];
+      std::snprintf(one, sizeof one, "%s%s %s (%zu shared, F %.1f / %.1f, offset %.2f m, %.1f deg, residual %.2f m)",
+                    checks.empty() ? "" : "; ", c.robot_id.c_str(), fleet_map::to_string(c.verdict), c.common,
+                    c.f_statistic, c.threshold, c.offset_m, c.rotation_rad * 180.0 / M_PI, c.residual_m);
+      checks += one;
+    }
+    std::printf("fleet seed %d: landmarks %.3f m raw / %.3f m aligned (%zu mapped, %zu missing); best robot %d %.3f m, "
+                "mean of robots %.3f m\n  frames: %s\n",
+                seed, e.rmse_m, e.rmse_aligned_m, e.matched, e.missing, best.first, best.second, mean, checks.c_str());
+    sum_fleet += e.rmse_m;
+    sum_best += best.second;
+    sum_mean += mean;
+  }
+  const double n = static_cast<double>(fleet.size());
+  std::printf("FLEET MEAN over %zu seeds: landmarks %.3f m fused, best single robot %.3f m, mean single robot %.3f m\n",
+              fleet.size(), sum_fleet / n, sum_best / n, sum_mean / n);
+}
+
 struct EvalArguments {
   std::string dataset, config_path, association = "known_id", out_dir;
   std::vector<int> robots{1, 2, 3, 4, 5}, seeds{1, 2, 3};
@@ -517,6 +576,7 @@ int run(const EvalArguments& args) {
   std::vector<std::pair<int, offline::RunInput>> inputs;  // kept for the segments
   std::map<int, std::vector<RunScore>> config_scores;     // kept for --loro
   std::map<int, std::vector<Segment>> config_segments;
+  std::map<int, FleetRuns> fleet;                          // by seed: the robots' final maps
   for (int robot : robots) {
     const mrclam::RobotData data = mrclam::load_robot(dataset, robot);
     const offline::RunInput input = offline::mrclam_input(data, model);
@@ -534,6 +594,7 @@ int run(const EvalArguments& args) {
                   100.0 * rep.nees.fraction_below_upper());
       std::fflush(stdout);
       config_scores[robot].push_back({rep.filter.ate_rmse_m, rep.filter.heading_rmse_rad * kDeg});
+      fleet[seed].add(robot, res, rep, input.landmarks);
       csv.run(robot, seed, input, res, rep);
       if (const auto opt = optimised(optimise, options, input, res)) {
         const offline::Report o = offline::evaluate(input, *opt);
@@ -568,6 +629,7 @@ int run(const EvalArguments& args) {
               "%.3f m aligned, %.2f s per run\n",
               runs, sum_ate / runs, sum_ate_aligned / runs, sum_head / runs, sum_lm / runs, sum_lma / runs, sum_wall / runs);
   if (nees_all.steps + nees_all.singular > 0) print_nees("POOLED over the full runs: pose", nees_all);
+  print_fleet(fleet);
   if (opt_sum.runs > 0) {
     const double n = opt_sum.runs;
     std::printf("MEAN over %d runs, map optimiser: ATE %.3f m (%.3f m after SE(2) alignment, worst run %.3f m), "
