@@ -22,7 +22,7 @@ set(pixyslam_robot_programs
 if(TARGET foxglove_bridge)
   list(APPEND pixyslam_robot_programs foxglove_bridge)
 endif()
-set(pixyslam_station_programs slam_offline pixyslam_calibrate dataset_bridge)
+set(pixyslam_station_programs slam_offline pixyslam_calibrate dataset_bridge fleet_map)
 foreach(optional map_view map_optimizer)
   if(TARGET ${optional})
     list(APPEND pixyslam_station_programs ${optional})

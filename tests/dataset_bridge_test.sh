@@ -7,7 +7,8 @@
 # if the recording holds every sample once, seq 1..N per robot and topic, and
 # each estimator took exactly its own robot's samples and counted the other's,
 # and `pixyslam_log hz --robot robot2` counted robot 2's 80 odometry samples only;
-# the recording's robot sightings print, and map_view draws both robots.
+# the recording's robot sightings print, fleet_map fused both robots' maps,
+# and map_view draws both robots.
 #   dataset_bridge_test.sh BIN_DIR CONFIG_DIR
 set -euo pipefail
 bin=$1 config=$2
@@ -51,6 +52,11 @@ for r in 1 2; do
   pids+=("$!")
   eval "estimator${r}_pid=$!"
 done
+# The fleet map of both estimators' maps.
+"$bin/fleet_map" --config "$config/fleet_map.yaml" --domain "$domain" --set fleet_map.period_s=0.2 \
+  > "$work/fleet_map.log" 2>&1 &
+fleet_pid=$!
+pids+=("$fleet_pid")
 # `hz --robot`: robot 2's odometry only.
 "$bin/pixyslam_log" hz pixyslam/odometry --robot robot2 --duration 6 --json --domain "$domain" \
   > "$work/hz.out" 2> "$work/hz.log" &
@@ -74,6 +80,8 @@ for r in 1 2; do
   kill -INT "${!pid_var}"
   wait "${!pid_var}" || fail "slam_estimator robot$r: exit $?"
 done
+kill -INT "$fleet_pid"
+wait "$fleet_pid" || fail "fleet_map: exit $?"
 kill -INT "$record_pid"
 wait "$record_pid" || fail "pixyslam_log record: exit $?"
 grep "slam_estimator: odometry" "$work/estimator1.log" "$work/estimator2.log"
@@ -94,6 +102,11 @@ grep -q "robot1: seq 1..100, robot2: seq 1..80" "$work/check.log" || fail "odome
   fail "print sightings"
 head -n 1 "$work/sightings.json"
 [[ $(grep -c '"seen_robot_id":"robot2"' "$work/sightings.json") == 3 ]] || fail "sightings of robot2"
+# The fleet map: the one landmark both robots mapped, fused from both.
+"$bin/pixyslam_log" print "$work/run.mcap" --topic pixyslam/fleet_map --json > "$work/fleet.json" || fail "print fleet"
+tail -n 1 "$work/fleet.json" | cut -c1-300
+tail -n 1 "$work/fleet.json" | grep -q '"landmark_id":6,.*"robots":2}' || fail "fleet map did not fuse both robots"
+tail -n 1 "$work/fleet.json" | grep -q '"robot_id":"robot1".*"robot_id":"robot2"' || fail "fleet map robots"
 # Both robots in one picture (map_view is built whenever OpenCV is there).
 if [[ -x $bin/map_view ]]; then
   "$bin/map_view" render "$work/run.mcap" --out "$work/map.png" > "$work/render.log" 2>&1 || fail "map_view render"

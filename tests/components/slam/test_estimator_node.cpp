@@ -328,7 +328,9 @@ TEST(EstimatorNode, TwoRobotsOnOneDomainEachEstimatorReadsItsOwn) {
     s.t_s = 0.1 * i;
     msg::Odometry m = test_support::odometry_msg(s, 0.1, to_stamp_ns(s.t_s, base_ns));
     ASSERT_TRUE(odometry_a.publish(m));
-    if (i < 20) ASSERT_TRUE(odometry_b.publish(m));
+    if (i < 20) {
+      ASSERT_TRUE(odometry_b.publish(m));
+    }
     if (i < 5) {
       msg::LandmarkObservation f = test_support::observation_msg(slam::ObservationFrame{s.t_s, {}}, m.header().stamp_ns());
       ASSERT_TRUE(frames_b.publish(f));

@@ -111,7 +111,8 @@ const std::vector<Entry>& entries() {
       {topic_info<msg::GroundTruth>(), &decode_strict<msg::GroundTruth>},
       {topic_info<msg::Diagnostics>(), &decode_strict<msg::Diagnostics>},
       {topic_info<msg::OptimisedMap>(), &decode_strict<msg::OptimisedMap>},
-      {topic_info<msg::RobotSighting>(), &decode_strict<msg::RobotSighting>}};
+      {topic_info<msg::RobotSighting>(), &decode_strict<msg::RobotSighting>},
+      {topic_info<msg::FleetMap>(), &decode_strict<msg::FleetMap>}};
   return table;
 }
 

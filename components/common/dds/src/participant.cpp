@@ -47,6 +47,7 @@ void register_all_type_objects() {
     MessageTraits<msg::Diagnostics>::register_type_object();
     MessageTraits<msg::OptimisedMap>::register_type_object();
     MessageTraits<msg::RobotSighting>::register_type_object();
+    MessageTraits<msg::FleetMap>::register_type_object();
   });
 }
 

@@ -630,6 +630,26 @@ TEST(FleetView, EveryRobotIsDrawnInOnePictureInItsOwnColour) {
   EXPECT_EQ(count_colour(one, robot_colour(0), 10), 0);
   EXPECT_GT(count_colour(both, o.colours.trajectory, 10), 50);
   EXPECT_NE(robot_colour(0), robot_colour(1));
+
+  // A fleet map goes on top, in its own colour, and only its newest counts.
+  msg::FleetMap fleet_map;
+  fleet_map.header().stamp_ns(5000);
+  msg::FleetLandmark l;
+  l.landmark_id(20);
+  l.x_m(0.3);
+  l.y_m(1.0);
+  l.cov_xx_m2(0.01);
+  l.cov_yy_m2(0.01);
+  l.robots(2);
+  fleet_map.landmarks().push_back(l);
+  EXPECT_TRUE(fleet.add(fleet_map));
+  fleet_map.header().stamp_ns(4000);
+  EXPECT_FALSE(fleet.add(fleet_map));
+  EXPECT_EQ(fleet.fleet_maps(), 1u);
+  const MapViewState with_fleet = fleet.state();
+  ASSERT_EQ(with_fleet.fleet_landmarks.size(), 1u);
+  EXPECT_EQ(with_fleet.fleet_landmarks[0].times_observed, 2u);
+  EXPECT_GT(count_colour(render_map(with_fleet, o), o.colours.fleet, 10), count_colour(both, o.colours.fleet, 10) + 20);
 }
 
 TEST(MsgConversion, TrajectoryDecimation) {

@@ -370,6 +370,40 @@ Value to_value(const msg::RobotSighting& m) {
   return v;
 }
 
+Value to_value(const msg::FleetMap& m) {
+  Value v = Value::structure();
+  v.add("header", header_value(m.header()))
+      .add("landmarks", list_of(m.landmarks(), [](const msg::FleetLandmark& l) {
+             Value e = Value::structure();
+             e.add("landmark_id", Value::integer(l.landmark_id()))
+                 .add("x_m", Value::number(l.x_m()))
+                 .add("y_m", Value::number(l.y_m()))
+                 .add("cov_xx_m2", Value::number(l.cov_xx_m2()))
+                 .add("cov_xy_m2", Value::number(l.cov_xy_m2()))
+                 .add("cov_yy_m2", Value::number(l.cov_yy_m2()))
+                 .add("robots", Value::unsigned_integer(l.robots()));
+             return e;
+           }))
+      .add("robots", list_of(m.robots(), [](const msg::RobotFrameCheck& c) {
+             Value e = Value::structure();
+             e.add("robot_id", Value::string(c.robot_id()))
+                 .add("map_stamp_ns", Value::unsigned_integer(c.map_stamp_ns()))
+                 .add("landmarks", Value::unsigned_integer(c.landmarks()))
+                 .add("common", Value::unsigned_integer(c.common()))
+                 .add("verdict", Value::string(c.verdict()))
+                 .add("f_statistic", Value::number(c.f_statistic()))
+                 .add("threshold", Value::number(c.threshold()))
+                 .add("offset_m", Value::number(c.offset_m()))
+                 .add("rotation_rad", Value::number(c.rotation_rad()))
+                 .add("residual_m", Value::number(c.residual_m()))
+                 .add("fused", Value::boolean(c.fused()))
+                 .add("moved_rotation_rad", Value::number(c.moved_rotation_rad()))
+                 .add("moved_shift_m", Value::number(c.moved_shift_m()));
+             return e;
+           }));
+  return v;
+}
+
 std::string diagnostics_table(std::vector<msg::Diagnostics> reports) {
   std::sort(reports.begin(), reports.end(), [](const msg::Diagnostics& a, const msg::Diagnostics& b) {
     return std::make_tuple(a.header().robot_id(), a.process(), a.pid()) <

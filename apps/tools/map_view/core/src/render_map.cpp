@@ -184,6 +184,23 @@ void draw_content(cv::Mat& map, const MapViewState& s, const ViewTransform& view
   }
 }
 
+// The fleet map: squares with their n-sigma ellipses, over everything else.
+void draw_fleet(cv::Mat& map, const MapViewState& s, const ViewTransform& view, const RenderOptions& o) {
+  const double ppm = view.pixels_per_metre();
+  for (const LandmarkView& l : s.fleet_landmarks) {
+    if (!finite(l.x_m, l.y_m)) continue;
+    const cv::Point2d at = view.to_pixel(l.x_m, l.y_m);
+    if (finite_covariance(l)) {
+      landmark_ellipse(map, at, covariance_ellipse(l.cov_xx_m2, l.cov_xy_m2, l.cov_yy_m2, o.sigma_scale), ppm,
+                       o.colours.fleet);
+    }
+    line(map, {at.x - 4, at.y - 4}, {at.x + 4, at.y - 4}, o.colours.fleet, 2);
+    line(map, {at.x + 4, at.y - 4}, {at.x + 4, at.y + 4}, o.colours.fleet, 2);
+    line(map, {at.x + 4, at.y + 4}, {at.x - 4, at.y + 4}, o.colours.fleet, 2);
+    line(map, {at.x - 4, at.y + 4}, {at.x - 4, at.y - 4}, o.colours.fleet, 2);
+  }
+}
+
 // `o` with every colour of an estimate (trajectory, pose, particles,
 // landmarks, optimised map) set from `colour`: another robot's.
 RenderOptions with_robot_colour(const RenderOptions& o, const cv::Scalar& colour) {
@@ -240,6 +257,15 @@ int draw_legend(cv::Mat& img, const MapViewState& s, const RenderOptions& o, int
     entry("optimised", [&](double x0) {
       line(img, {x0, mid}, {x0 + sample_w, mid}, c.optimised, 2);
       diamond(img, {x0 + sample_w / 2.0, mid}, 5.0, c.optimised);
+    });
+  }
+  if (!s.fleet_landmarks.empty()) {
+    entry("fleet map", [&](double x0) {
+      const double cx = x0 + sample_w / 2.0;
+      line(img, {cx - 4, mid - 4}, {cx + 4, mid - 4}, c.fleet, 2);
+      line(img, {cx + 4, mid - 4}, {cx + 4, mid + 4}, c.fleet, 2);
+      line(img, {cx + 4, mid + 4}, {cx - 4, mid + 4}, c.fleet, 2);
+      line(img, {cx - 4, mid + 4}, {cx - 4, mid - 4}, c.fleet, 2);
     });
   }
   if (!s.other_robots.empty() && !s.robot_id.empty()) {
@@ -360,6 +386,7 @@ cv::Mat render_map(const MapViewState& state, const RenderOptions& options) {
     draw_content(map, state.other_robots[k], view, with_robot_colour(options, robot_colour(k)));
   }
   draw_content(map, state, view, options);
+  draw_fleet(map, state, view, options);
   if (options.footer_px > 0) draw_footer(image, state, view, options);
   return image;
 }

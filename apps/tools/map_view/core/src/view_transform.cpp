@@ -101,6 +101,9 @@ WorldBox content_bounds(const MapViewState& state, double sigma_scale, bool incl
   for (const LandmarkView& l : state.optimised_landmarks) {
     if (std::isfinite(l.x_m) && std::isfinite(l.y_m)) box.extend(ellipse_bounds(l, sigma_scale));
   }
+  for (const LandmarkView& l : state.fleet_landmarks) {
+    if (std::isfinite(l.x_m) && std::isfinite(l.y_m)) box.extend(ellipse_bounds(l, sigma_scale));
+  }
   if (include_truth) {
     for (const Point2& p : state.true_trajectory) box.extend(p.x_m, p.y_m);
     if (state.true_pose) box.extend(state.true_pose->x_m, state.true_pose->y_m);

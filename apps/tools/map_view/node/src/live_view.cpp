@@ -119,6 +119,10 @@ int run_live(const MapViewOptions& options, const LiveRequest& request) {
     std::lock_guard<std::mutex> lock(shared.mutex);
     shared.changed = shared.builder.add(m) || shared.changed;
   });
+  dds::Reader<msg::FleetMap> fleet(participant, [&](const msg::FleetMap& m) {
+    std::lock_guard<std::mutex> lock(shared.mutex);
+    shared.changed = shared.builder.add(m) || shared.changed;
+  });
   std::fprintf(stderr, "map_view: listening on DDS domain %d; %s%s%s\n", options.dds.domain_id,
                window ? "window" : "no window", snapshots ? ", snapshots to " : "", snapshots ? latest.c_str() : "");
 

@@ -72,6 +72,10 @@ MapLog MapLog::read(const std::string& path) {
     decode_channel(*reader, *optimised_channel, Kind::kOptimisedMap, log.optimised_maps_, log.entries_,
                    log.undecodable_);
   }
+  if (const mcap::McapChannel* fleet_channel = reader->find_channel(std::string(dds::kFleetMapTopic))) {
+    check_encoding(path, *fleet_channel);
+    decode_channel(*reader, *fleet_channel, Kind::kFleetMap, log.fleet_maps_, log.entries_, log.undecodable_);
+  }
   std::stable_sort(log.entries_.begin(), log.entries_.end(),
                    [](const Entry& a, const Entry& b) { return a.time_ns < b.time_ns; });
   if (!reader->clean()) {
@@ -93,6 +97,7 @@ void LogPlayer::advance_to(std::uint64_t time_ns) {
       case MapLog::Kind::kMapState: builder_.add(log_.map_states()[e.index]); break;
       case MapLog::Kind::kGroundTruth: builder_.add(log_.ground_truths()[e.index]); break;
       case MapLog::Kind::kOptimisedMap: builder_.add(log_.optimised_maps()[e.index]); break;
+      case MapLog::Kind::kFleetMap: builder_.add(log_.fleet_maps()[e.index]); break;
     }
   }
 }
@@ -118,6 +123,11 @@ WorldBox run_bounds(const MapLog& log, double sigma_scale, bool include_truth) {
     MapViewState one;
     one.optimised_trajectory = to_trajectory(m);
     one.optimised_landmarks = to_landmarks(m);
+    box.extend(content_bounds(one, sigma_scale, false));
+  }
+  for (const msg::FleetMap& m : log.fleet_maps()) {
+    MapViewState one;
+    one.fleet_landmarks = to_landmarks(m);
     box.extend(content_bounds(one, sigma_scale, false));
   }
   if (include_truth) {

@@ -32,8 +32,9 @@ int run_render(const MapViewOptions& options, const RenderRequest& request) {
   } catch (const std::runtime_error& e) {
     throw InputError(std::string("--out: ") + e.what());
   }
-  const std::string optimised =
+  std::string optimised =
       log.optimised_maps().empty() ? "" : ", " + std::to_string(log.optimised_maps().size()) + " optimised maps";
+  if (!log.fleet_maps().empty()) optimised += ", " + std::to_string(log.fleet_maps().size()) + " fleet maps";
   std::string robots;  // named when there are several
   for (const MapViewState& other : state.other_robots) robots += ", " + other.robot_id;
   if (!robots.empty()) robots = "; robots " + state.robot_id + robots;

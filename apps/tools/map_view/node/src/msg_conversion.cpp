@@ -107,6 +107,23 @@ bool MapViewBuilder::add(const msg::OptimisedMap& m) {
   return true;
 }
 
+std::vector<LandmarkView> to_landmarks(const msg::FleetMap& map) {
+  std::vector<LandmarkView> out;
+  out.reserve(map.landmarks().size());
+  for (const msg::FleetLandmark& l : map.landmarks()) {
+    out.push_back({l.landmark_id(), l.x_m(), l.y_m(), l.cov_xx_m2(), l.cov_xy_m2(), l.cov_yy_m2(), l.robots()});
+  }
+  return out;
+}
+
+bool FleetViewBuilder::add(const msg::FleetMap& map) {
+  if (fleet_maps_ > 0 && map.header().stamp_ns() < last_fleet_ns_) return false;
+  last_fleet_ns_ = map.header().stamp_ns();
+  ++fleet_maps_;
+  fleet_landmarks_ = to_landmarks(map);
+  return true;
+}
+
 MapViewBuilder& FleetViewBuilder::robot(const std::string& robot_id) {
   return robots_.try_emplace(robot_id, min_step_m_).first->second;
 }
@@ -124,6 +141,7 @@ MapViewState FleetViewBuilder::state() const {
     }
     first = false;
   }
+  out.fleet_landmarks = fleet_landmarks_;
   return out;
 }
 

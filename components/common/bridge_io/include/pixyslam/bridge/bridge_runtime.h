@@ -56,10 +56,10 @@ class BridgeRuntime {
       : process_(process),
         mutex_(mutex),
         status_period_s_(options.status_period_s),
+        log_(log ? std::move(log) : stderr_log(process)),
         hold_readers_(options.wait_readers),
         hold_timeout_(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
             std::chrono::duration<double>(options.wait_readers_timeout_s))),
-        log_(log ? std::move(log) : stderr_log(process)),
         participant_(dds_options, process),
         writer_(participant_),
         reader_(std::move(source), device_reader_options(options), log_,

@@ -17,6 +17,8 @@
 #include "optimised_mapPubSubTypes.h"
 #include "robot_sighting.h"
 #include "robot_sightingPubSubTypes.h"
+#include "fleet_map.h"
+#include "fleet_mapPubSubTypes.h"
 
 // The generated TypeObject registration functions (declared here rather than
 // by including the generated *TypeObject.h headers: those put
@@ -29,6 +31,7 @@ void registerground_truthTypes();
 void registerdiagnosticsTypes();
 void registeroptimised_mapTypes();
 void registerrobot_sightingTypes();
+void registerfleet_mapTypes();
 
 namespace pixyslam::msg {
 // IDL of idl/<stem>.idl with its includes inlined (an `omgidl` schema); "" if unknown.
@@ -47,6 +50,7 @@ inline constexpr std::string_view kGroundTruthTopic = "pixyslam/ground_truth";
 inline constexpr std::string_view kDiagnosticsTopic = "pixyslam/diagnostics";
 inline constexpr std::string_view kOptimisedMapTopic = "pixyslam/optimised_map";
 inline constexpr std::string_view kRobotSightingTopic = "pixyslam/robot_sighting";
+inline constexpr std::string_view kFleetMapTopic = "pixyslam/fleet_map";
 
 // Message type -> its topic, generated TopicDataType and IDL file.
 template <class Message>
@@ -69,6 +73,7 @@ PIXYSLAM_MESSAGE_TRAITS(GroundTruth, kGroundTruthTopic, "ground_truth", register
 PIXYSLAM_MESSAGE_TRAITS(Diagnostics, kDiagnosticsTopic, "diagnostics", registerdiagnosticsTypes)
 PIXYSLAM_MESSAGE_TRAITS(OptimisedMap, kOptimisedMapTopic, "optimised_map", registeroptimised_mapTypes)
 PIXYSLAM_MESSAGE_TRAITS(RobotSighting, kRobotSightingTopic, "robot_sighting", registerrobot_sightingTypes)
+PIXYSLAM_MESSAGE_TRAITS(FleetMap, kFleetMapTopic, "fleet_map", registerfleet_mapTypes)
 
 #undef PIXYSLAM_MESSAGE_TRAITS
 
@@ -90,6 +95,7 @@ bool visit_topic_type(std::string_view topic, F&& f) {
   if (topic == kDiagnosticsTopic) return f(MessageTag<msg::Diagnostics>{}), true;
   if (topic == kOptimisedMapTopic) return f(MessageTag<msg::OptimisedMap>{}), true;
   if (topic == kRobotSightingTopic) return f(MessageTag<msg::RobotSighting>{}), true;
+  if (topic == kFleetMapTopic) return f(MessageTag<msg::FleetMap>{}), true;
   return false;
 }
 

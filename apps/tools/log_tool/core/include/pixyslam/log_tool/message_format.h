@@ -11,6 +11,7 @@
 #include "map_state.h"
 #include "odometry.h"
 #include "optimised_map.h"
+#include "fleet_map.h"
 #include "robot_sighting.h"
 
 namespace pixyslam::log_tool {
@@ -64,6 +65,7 @@ Value to_value(const msg::GroundTruth& m);
 Value to_value(const msg::Diagnostics& m);
 Value to_value(const msg::OptimisedMap& m);
 Value to_value(const msg::RobotSighting& m);
+Value to_value(const msg::FleetMap& m);
 
 // One report per process (sorted by robot, process, pid): a line "robot process
 // (pid P): LEVEL, up S s[: status]", then its counters, wrapped at 100 columns.

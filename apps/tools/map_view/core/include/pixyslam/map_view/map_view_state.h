@@ -54,6 +54,7 @@ struct MapViewState {
   std::vector<LandmarkView> optimised_landmarks;  // its landmarks; non-finite covariance: no ellipse
   std::string caption;                    // one line under the map, e.g. "t = 12.3 s  ..."
   std::string robot_id;                   // whose state this is ("" : one robot, not named)
+  std::vector<LandmarkView> fleet_landmarks;  // the robots' maps fused (fleet_map), optional
   // More robots on the same map (several on one domain, or a fleet log): each
   // drawn like this one in a colour of its own, under it; their own
   // other_robots are ignored.

@@ -24,6 +24,7 @@ struct MapColours {
   cv::Scalar landmark{20, 20, 210};
   cv::Scalar truth{40, 150, 40};
   cv::Scalar optimised{0, 140, 240};
+  cv::Scalar fleet{30, 30, 30};  // the fleet map
 };
 
 // How render_map draws. Sizes are pixels of the whole image; the map area is
@@ -74,7 +75,8 @@ double nice_grid_step_m(double pixels_per_metre, double min_px);
 // scale bar on its right (a footer under 40 px has no legend row). The
 // state's other_robots are drawn first, each in one colour of robot_colour()
 // (its estimate, landmarks and optimised map; ground truth stays green), and
-// the legend names them. Pure and single-threaded: same input, same pixels.
+// the legend names them. The fleet map's landmarks (fleet_landmarks) go on
+// top as dark squares with their n-sigma ellipses. Pure and single-threaded: same input, same pixels.
 // Throws std::invalid_argument for options that fail validate().
 cv::Mat render_map(const MapViewState& state, const RenderOptions& options);
 

@@ -27,18 +27,18 @@ class LogError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// The MapState, GroundTruth and OptimisedMap messages of an MCAP log (the
+// The MapState, GroundTruth, OptimisedMap and FleetMap messages of an MCAP log (the
 // logger's run.mcap), decoded, in log-time order (MCAP log_time, ties in file order). Other
 // topics are ignored; payloads that do not decode are skipped and counted. A
 // file cut short (killed logger) is read as far as it is complete. Immutable
 // after read(); thread-safe for const use.
 class MapLog {
  public:
-  enum class Kind { kMapState, kGroundTruth, kOptimisedMap };
+  enum class Kind { kMapState, kGroundTruth, kOptimisedMap, kFleetMap };
   struct Entry {
     std::uint64_t time_ns = 0;
     Kind kind = Kind::kMapState;
-    std::size_t index = 0;  // into map_states(), ground_truths() or optimised_maps()
+    std::size_t index = 0;  // into map_states(), ground_truths(), optimised_maps() or fleet_maps()
   };
 
   // Throws LogError naming the file: unreadable or not MCAP, no
@@ -50,6 +50,7 @@ class MapLog {
   const std::vector<msg::MapState>& map_states() const { return map_states_; }
   const std::vector<msg::GroundTruth>& ground_truths() const { return ground_truths_; }
   const std::vector<msg::OptimisedMap>& optimised_maps() const { return optimised_maps_; }
+  const std::vector<msg::FleetMap>& fleet_maps() const { return fleet_maps_; }
   std::size_t undecodable() const { return undecodable_; }
   // "" for a complete file, else what the reader had to skip (one line).
   const std::string& recovery_note() const { return recovery_note_; }
@@ -62,6 +63,7 @@ class MapLog {
   std::vector<msg::MapState> map_states_;
   std::vector<msg::GroundTruth> ground_truths_;
   std::vector<msg::OptimisedMap> optimised_maps_;
+  std::vector<msg::FleetMap> fleet_maps_;
   std::size_t undecodable_ = 0;
   std::string recovery_note_;
 };

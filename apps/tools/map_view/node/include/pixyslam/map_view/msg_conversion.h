@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "map_state.h"
+#include "fleet_map.h"
 #include "ground_truth.h"
 #include "optimised_map.h"
 #include "pixyslam/map_view/map_view_state.h"
@@ -21,6 +22,7 @@ std::vector<TrueLandmarkView> to_true_landmarks(const msg::GroundTruth& truth);
 LandmarkView to_landmark(const msg::OptimisedLandmark& landmark);  // times_observed = observations
 std::vector<LandmarkView> to_landmarks(const msg::OptimisedMap& map);
 std::vector<Point2> to_trajectory(const msg::OptimisedMap& map);    // the keyframes' positions
+std::vector<LandmarkView> to_landmarks(const msg::FleetMap& map);   // times_observed = robots fused
 
 // Builds the MapViewState from a stream of MapState, OptimisedMap and
 // GroundTruth messages: the latest map, particles and poses, and the mean and
@@ -70,6 +72,8 @@ class FleetViewBuilder {
   bool add(const msg::MapState& state) { return robot(state.header().robot_id()).add(state); }
   void add(const msg::GroundTruth& truth) { robot(truth.header().robot_id()).add(truth); }
   bool add(const msg::OptimisedMap& map) { return robot(map.header().robot_id()).add(map); }
+  // The newest fleet map (older ones are ignored: false).
+  bool add(const msg::FleetMap& map);
 
   MapViewState state() const;
   std::size_t robots() const { return robots_.size(); }
@@ -77,6 +81,7 @@ class FleetViewBuilder {
   std::size_t map_states() const { return total(&MapViewBuilder::map_states); }
   std::size_t ground_truths() const { return total(&MapViewBuilder::ground_truths); }
   std::size_t optimised_maps() const { return total(&MapViewBuilder::optimised_maps); }
+  std::size_t fleet_maps() const { return fleet_maps_; }
 
  private:
   MapViewBuilder& robot(const std::string& robot_id);
@@ -84,6 +89,9 @@ class FleetViewBuilder {
 
   double min_step_m_;
   std::map<std::string, MapViewBuilder> robots_;
+  std::vector<LandmarkView> fleet_landmarks_;
+  std::size_t fleet_maps_ = 0;
+  std::uint64_t last_fleet_ns_ = 0;
 };
 
 }  // namespace pixyslam::map_view

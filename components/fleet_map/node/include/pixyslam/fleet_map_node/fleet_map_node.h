@@ -1,0 +1,92 @@
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fleet_map.h"
+#include "map_state.h"
+#include "pixyslam/dds/dds_options.h"
+#include "pixyslam/fleet_map/map_fusion.h"
+#include "pixyslam/parameters/parameters.h"
+
+namespace pixyslam::dds {
+class Participant;
+template <class Message>
+class Reader;
+template <class Message>
+class Writer;
+}  // namespace pixyslam::dds
+
+namespace pixyslam::fleet_map_node {
+
+// config/fleet_map.yaml.
+struct FleetMapOptions {
+  double period_s = 1.0;  // `fleet_map.period_s`: a fleet map this often while some robot's map changed
+  fleet_map::FusionOptions fusion;  // `fleet_map.min_common_landmarks`, `agreement_probability`, `disagreement`
+  dds::DdsOptions dds;    // dds.robot_id names the fleet map's writer (e.g. "fleet")
+};
+
+const parameters::Table<FleetMapOptions>& fleet_map_parameters();
+// Reads `fleet_map:` and `dds:`; throws config::ConfigError naming the file and key.
+FleetMapOptions read_fleet_map_options_file(const std::string& path);
+// "fleet_map.KEY=V", "dds.KEY=V"; validated; DDS settings resolved.
+void apply_overrides(FleetMapOptions& options, const std::vector<std::string>& assignments);
+std::string to_yaml(const FleetMapOptions& options);
+
+// Conversions (pure).
+fleet_map::RobotMap to_robot_map(const msg::MapState& state);
+msg::FleetMap to_fleet_map_msg(const fleet_map::FleetMap& fleet, const std::vector<fleet_map::RobotMap>& maps,
+                               std::uint64_t stamp_ns);
+
+struct FleetMapCounters {
+  std::uint64_t map_states = 0;       // received, every robot
+  std::uint64_t stale = 0;            // older than the robot's newest: ignored
+  std::uint64_t fleet_maps = 0;       // published
+  std::uint64_t publish_failures = 0;
+  std::size_t robots = 0;
+};
+
+// Reads every robot's MapState (whatever its robot_id), keeps each robot's
+// newest, and every period_s in which one changed fuses them
+// (fleet_map::fuse_maps) and publishes a FleetMap stamped with the newest
+// MapState's stamp. A robot's frame verdict that changes is logged.
+class FleetMapNode {
+ public:
+  explicit FleetMapNode(const FleetMapOptions& options);
+  ~FleetMapNode();
+  FleetMapNode(const FleetMapNode&) = delete;
+  FleetMapNode& operator=(const FleetMapNode&) = delete;
+
+  void start();
+  void stop();  // joins the fusion thread after a last fleet map; idempotent
+  FleetMapCounters counters() const;
+
+ private:
+  void on_map_state(const msg::MapState& state);
+  void loop();
+  void fuse_and_publish();
+
+  const FleetMapOptions options_;
+  mutable std::mutex mutex_;
+  std::condition_variable cv_;
+  std::map<std::string, fleet_map::RobotMap> maps_;  // newest per robot
+  std::map<std::string, std::string> verdicts_;      // last logged per robot
+  bool changed_ = false;
+  bool stopping_ = false;
+  std::uint64_t newest_stamp_ns_ = 0;
+  FleetMapCounters counters_;
+  std::thread thread_;
+
+  std::unique_ptr<dds::Participant> participant_;
+  std::unique_ptr<dds::Writer<msg::FleetMap>> writer_;
+  std::unique_ptr<dds::Reader<msg::MapState>> reader_;  // last: its callback uses the above
+};
+
+}  // namespace pixyslam::fleet_map_node

@@ -1,0 +1,205 @@
+#include "pixyslam/fleet_map_node/fleet_map_node.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "pixyslam/config/parameters_yaml.h"
+#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/dds/endpoints.h"
+#include "pixyslam/dds/participant.h"
+
+namespace pixyslam::fleet_map_node {
+
+const parameters::Table<FleetMapOptions>& fleet_map_parameters() {
+  using O = FleetMapOptions;
+  using D = fleet_map::FusionOptions::Disagreement;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::real<O>("period_s", 0.05, 3600.0, "s", "a fleet map this often while some robot's map changed",
+                 [](O& o) -> double& { return o.period_s; }),
+      P::integer<O, int>("min_common_landmarks", 3, 100000, "",
+                         "landmarks a robot must share with the others for its frame to be checked (and aligned)",
+                         [](O& o) -> int& { return o.fusion.min_common_landmarks; }),
+      P::real<O>("agreement_probability", 0.5, 0.999999, "",
+                 "frames agree below the rigid-offset F test's quantile at this probability",
+                 [](O& o) -> double& { return o.fusion.agreement_probability; }),
+      P::choice<O, D>("disagreement", {{"align", D::kAlign}, {"set_aside", D::kSetAside}},
+                      "robots whose frames disagree: align (move every map onto the robots' mean frame) or "
+                      "set_aside (fuse only robots that agree)",
+                      [](O& o) -> D& { return o.fusion.disagreement; }),
+  };
+  return table;
+}
+
+FleetMapOptions read_fleet_map_options_file(const std::string& path) {
+  config::YamlReader root = config::YamlReader::from_file(path);
+  FleetMapOptions o;
+  config::YamlReader y = root.child("fleet_map");
+  config::read_parameters(y, fleet_map_parameters(), o);
+  y.finish();
+  if (root.has("dds")) {
+    config::YamlReader dds = root.child("dds");
+    o.dds = dds::read_dds_options(dds, config::folder_of(path));
+  }
+  root.finish();
+  return o;
+}
+
+void apply_overrides(FleetMapOptions& o, const std::vector<std::string>& assignments) {
+  std::vector<std::string> rest = assignments;
+  const std::vector<std::string> dds = parameters::take_section(rest, "dds");
+  for (const std::string& a : rest) parameters::apply_override(o, fleet_map_parameters(), "fleet_map", a);
+  parameters::check_ranges(o, fleet_map_parameters(), "fleet_map");
+  dds::resolve_settings(o.dds, dds);
+}
+
+std::string to_yaml(const FleetMapOptions& o) {
+  return parameters::to_yaml(o, fleet_map_parameters(), "fleet_map") + dds::to_yaml(o.dds);
+}
+
+fleet_map::RobotMap to_robot_map(const msg::MapState& state) {
+  fleet_map::RobotMap m;
+  m.robot_id = state.header().robot_id();
+  m.stamp_ns = state.header().stamp_ns();
+  for (const msg::LandmarkEstimate& l : state.landmarks()) {
+    fleet_map::LandmarkEstimate e;
+    e.id = l.landmark_id();
+    e.mean = {l.x_m(), l.y_m()};
+    e.cov << l.cov_xx_m2(), l.cov_xy_m2(), l.cov_xy_m2(), l.cov_yy_m2();
+    m.landmarks.push_back(e);
+  }
+  return m;
+}
+
+msg::FleetMap to_fleet_map_msg(const fleet_map::FleetMap& fleet, const std::vector<fleet_map::RobotMap>& maps,
+                               std::uint64_t stamp_ns) {
+  msg::FleetMap m;
+  m.header().stamp_ns(stamp_ns);
+  m.header().frame_id("map");
+  for (const fleet_map::FusedLandmark& l : fleet.landmarks) {
+    msg::FleetLandmark f;
+    f.landmark_id(l.id);
+    f.x_m(l.mean.x());
+    f.y_m(l.mean.y());
+    f.cov_xx_m2(l.cov(0, 0));
+    f.cov_xy_m2(l.cov(0, 1));
+    f.cov_yy_m2(l.cov(1, 1));
+    f.robots(static_cast<std::uint32_t>(l.robots));
+    m.landmarks().push_back(f);
+  }
+  for (std::size_t r = 0; r < fleet.robots.size(); ++r) {
+    const fleet_map::FrameCheck& c = fleet.robots[r];
+    msg::RobotFrameCheck k;
+    k.robot_id(c.robot_id);
+    k.map_stamp_ns(r < maps.size() ? maps[r].stamp_ns : 0);
+    k.landmarks(static_cast<std::uint32_t>(c.landmarks));
+    k.common(static_cast<std::uint32_t>(c.common));
+    k.verdict(fleet_map::to_string(c.verdict));
+    k.f_statistic(c.f_statistic);
+    k.threshold(c.threshold);
+    k.offset_m(c.offset_m);
+    k.rotation_rad(c.rotation_rad);
+    k.residual_m(c.residual_m);
+    k.fused(c.fused);
+    k.moved_rotation_rad(c.moved_rotation_rad);
+    k.moved_shift_m(c.moved_shift_m);
+    m.robots().push_back(k);
+  }
+  return m;
+}
+
+FleetMapNode::FleetMapNode(const FleetMapOptions& options) : options_(options) {
+  participant_ = std::make_unique<dds::Participant>(options_.dds, "fleet_map");
+  writer_ = std::make_unique<dds::Writer<msg::FleetMap>>(*participant_);
+  // Every robot's map: no robot filter.
+  reader_ = std::make_unique<dds::Reader<msg::MapState>>(*participant_,
+                                                         [this](const msg::MapState& m) { on_map_state(m); }, "");
+}
+
+FleetMapNode::~FleetMapNode() { stop(); }
+
+void FleetMapNode::start() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (thread_.joinable() || stopping_) return;
+  thread_ = std::thread([this] { loop(); });
+}
+
+void FleetMapNode::stop() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+  reader_.reset();  // no callback after this
+}
+
+FleetMapCounters FleetMapNode::counters() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  FleetMapCounters c = counters_;
+  c.robots = maps_.size();
+  return c;
+}
+
+void FleetMapNode::on_map_state(const msg::MapState& state) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++counters_.map_states;
+  const auto it = maps_.find(state.header().robot_id());
+  if (it != maps_.end() && state.header().stamp_ns() < it->second.stamp_ns) {
+    ++counters_.stale;
+    return;
+  }
+  maps_[state.header().robot_id()] = to_robot_map(state);
+  newest_stamp_ns_ = std::max(newest_stamp_ns_, state.header().stamp_ns());
+  changed_ = true;
+}
+
+void FleetMapNode::loop() {
+  const auto period = std::chrono::duration<double>(options_.period_s);
+  for (;;) {
+    bool last = false;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      cv_.wait_for(lock, period, [this] { return stopping_; });
+      last = stopping_;
+    }
+    fuse_and_publish();
+    if (last) return;
+  }
+}
+
+void FleetMapNode::fuse_and_publish() {
+  std::vector<fleet_map::RobotMap> maps;
+  std::uint64_t stamp = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!changed_) return;
+    changed_ = false;
+    for (const auto& entry : maps_) maps.push_back(entry.second);
+    stamp = newest_stamp_ns_;
+  }
+  const fleet_map::FleetMap fleet = fleet_map::fuse_maps(maps, options_.fusion);
+  msg::FleetMap message = to_fleet_map_msg(fleet, maps, stamp);
+  const bool ok = writer_->publish(message);
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++(ok ? counters_.fleet_maps : counters_.publish_failures);
+  for (const fleet_map::FrameCheck& c : fleet.robots) {
+    const std::string verdict = fleet_map::to_string(c.verdict);
+    std::string& logged = verdicts_[c.robot_id];
+    if (logged == verdict) continue;
+    logged = verdict;
+    std::fprintf(stderr,
+                 "fleet_map: %s's frame %s with the others' (%zu shared landmarks, F %.1f / %.1f; offset %.2f m, "
+                 "rotation %.1f deg, residual %.2f m)%s\n",
+                 c.robot_id.c_str(), verdict.c_str(), c.common, c.f_statistic, c.threshold, c.offset_m,
+                 c.rotation_rad * 180.0 / M_PI, c.residual_m,
+                 c.fused ? (c.verdict == fleet_map::FrameVerdict::kDisagrees &&
+                                    options_.fusion.disagreement == fleet_map::FusionOptions::Disagreement::kAlign
+                                ? ": aligned"
+                                : "")
+                         : ": set aside");
+  }
+}
+
+}  // namespace pixyslam::fleet_map_node

@@ -1,0 +1,127 @@
+// The fleet_map process's node: every robot's MapState in over DDS, one
+// FleetMap out; its options and message conversions.
+#include <chrono>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "dds_test_support.h"
+#include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/dds/endpoints.h"
+#include "pixyslam/dds/participant.h"
+#include "pixyslam/fleet_map_node/fleet_map_node.h"
+
+namespace pixyslam::fleet_map_node {
+namespace {
+
+dds::DdsOptions loopback_options() { return test_support::loopback_options(200, 30, "fleet_test_"); }
+
+msg::MapState map_state(std::uint64_t stamp_ns, double dx) {
+  msg::MapState m;
+  m.header().stamp_ns(stamp_ns);
+  for (int i = 0; i < 6; ++i) {
+    msg::LandmarkEstimate l;
+    l.landmark_id(10 + i);
+    l.x_m((i % 3) * 1.5 + dx);
+    l.y_m((i / 3) * 2.0 + 0.01 * i);
+    l.cov_xx_m2(0.01);
+    l.cov_xy_m2(0.0);
+    l.cov_yy_m2(0.01);
+    m.landmarks().push_back(l);
+  }
+  return m;
+}
+
+TEST(FleetMapOptions, ShippedConfigLoadsAndBadKeysAreNamed) {
+  const FleetMapOptions o = read_fleet_map_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/fleet_map.yaml");
+  EXPECT_DOUBLE_EQ(o.period_s, 1.0);
+  EXPECT_EQ(o.fusion.min_common_landmarks, 4);
+  EXPECT_EQ(o.fusion.disagreement, fleet_map::FusionOptions::Disagreement::kAlign);
+  EXPECT_EQ(o.dds.robot_id, "fleet");
+  FleetMapOptions changed = o;
+  apply_overrides(changed, {"fleet_map.disagreement=set_aside", "dds.domain_id=7"});
+  EXPECT_EQ(changed.fusion.disagreement, fleet_map::FusionOptions::Disagreement::kSetAside);
+  EXPECT_EQ(changed.dds.domain_id, 7);
+  EXPECT_NE(to_yaml(changed).find("disagreement: set_aside"), std::string::npos) << to_yaml(changed);
+  try {
+    apply_overrides(changed, {"fleet_map.min_common_landmarks=2"});
+    ADD_FAILURE() << "no error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("fleet_map.min_common_landmarks"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FleetMapConversions, MessageCarriesLandmarksAndVerdicts) {
+  fleet_map::RobotMap a = to_robot_map(map_state(5, 0.0));
+  a.robot_id = "robot1";
+  ASSERT_EQ(a.landmarks.size(), 6u);
+  EXPECT_EQ(a.stamp_ns, 5u);
+  EXPECT_DOUBLE_EQ(a.landmarks[4].mean.x(), 1.5);
+  fleet_map::RobotMap b = a;
+  b.robot_id = "robot2";
+  const fleet_map::FleetMap fused = fleet_map::fuse_maps({a, b});
+  const msg::FleetMap m = to_fleet_map_msg(fused, {a, b}, 99);
+  EXPECT_EQ(m.header().stamp_ns(), 99u);
+  EXPECT_EQ(m.header().frame_id(), "map");
+  ASSERT_EQ(m.landmarks().size(), 6u);
+  EXPECT_EQ(m.landmarks()[0].robots(), 2u);
+  EXPECT_NEAR(m.landmarks()[0].cov_xx_m2(), 0.005, 1e-12);
+  ASSERT_EQ(m.robots().size(), 2u);
+  EXPECT_EQ(m.robots()[1].robot_id(), "robot2");
+  EXPECT_EQ(m.robots()[1].verdict(), "agrees");
+  EXPECT_EQ(m.robots()[1].map_stamp_ns(), 5u);
+}
+
+TEST(FleetMapNode, FusesEveryRobotsMapFromDds) {
+  // Given the node and two robots' estimators on one domain,
+  FleetMapOptions options;
+  options.period_s = 0.1;
+  options.dds = loopback_options();
+  options.dds.robot_id = "fleet";
+  FleetMapNode node(options);
+  node.start();
+  dds::Participant robots(loopback_options(), "test_estimators");
+  dds::Writer<msg::MapState> robot1(robots, "robot1"), robot2(robots, "robot2");
+  std::mutex mutex;
+  std::vector<msg::FleetMap> got;
+  dds::Reader<msg::FleetMap> fleet(robots, [&](const msg::FleetMap& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    got.push_back(m);
+  });
+  ASSERT_TRUE(robot1.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(robot2.wait_for_readers(1, std::chrono::seconds(10)));
+  // when both publish their maps (robot2's twice, the newest 2 cm to the right),
+  msg::MapState one = map_state(1000, 0.0), two = map_state(1000, 0.0), newer = map_state(2000, 0.02);
+  ASSERT_TRUE(robot1.publish(one));
+  ASSERT_TRUE(robot2.publish(two));
+  ASSERT_TRUE(robot2.publish(newer));
+  // then a fleet map arrives with both robots' landmarks fused.
+  for (int i = 0; i < 300; ++i) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!got.empty() && got.back().robots().size() == 2 && got.back().header().stamp_ns() == 2000) break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  node.stop();
+  std::lock_guard<std::mutex> lock(mutex);
+  ASSERT_FALSE(got.empty());
+  const msg::FleetMap& last = got.back();
+  EXPECT_EQ(last.header().robot_id(), "fleet");
+  ASSERT_EQ(last.robots().size(), 2u);
+  EXPECT_EQ(last.robots()[0].robot_id(), "robot1");
+  EXPECT_EQ(last.robots()[1].map_stamp_ns(), 2000u);
+  ASSERT_EQ(last.landmarks().size(), 6u);
+  EXPECT_EQ(last.landmarks()[0].robots(), 2u);
+  EXPECT_NEAR(last.landmarks()[0].x_m(), 0.01, 0.011);  // between the two
+  const FleetMapCounters c = node.counters();
+  EXPECT_EQ(c.map_states, 3u);
+  EXPECT_EQ(c.robots, 2u);
+  EXPECT_GE(c.fleet_maps, 1u);
+}
+
+}  // namespace
+}  // namespace pixyslam::fleet_map_node
