@@ -68,7 +68,7 @@ TEST(CdrPayload, StrictDecodingRejectsCutPaddedAndMistypedPayloads) {
 
 TEST(CdrPayload, KnownTopicsAreTheSystemsTopicsWithTheirDdsTypeNames) {
   const auto& topics = known_topics();
-  ASSERT_EQ(topics.size(), 7u);
+  ASSERT_EQ(topics.size(), 8u);
   EXPECT_EQ(topics[0].topic, dds::kOdometryTopic);
   EXPECT_EQ(topics[0].type_name, "pixyslam::msg::Odometry");
   EXPECT_EQ(topics[0].idl_stem, "odometry");
@@ -85,6 +85,8 @@ TEST(CdrPayload, KnownTopicsAreTheSystemsTopicsWithTheirDdsTypeNames) {
   EXPECT_EQ(topics[6].topic, dds::kRobotSightingTopic);
   EXPECT_EQ(topics[6].type_name, "pixyslam::msg::RobotSighting");
   EXPECT_EQ(topics[6].idl_stem, "robot_sighting");
+  EXPECT_EQ(topics[7].topic, dds::kFleetMapTopic);
+  EXPECT_EQ(topics[7].type_name, "pixyslam::msg::FleetMap");
 }
 
 // ---------------------------------------------------------------- topic patterns
