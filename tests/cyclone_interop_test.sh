@@ -83,7 +83,7 @@ pids=()
 cat "$work/relay.log"
 
 topics=(pixyslam/odometry pixyslam/landmark_observation pixyslam/map_state pixyslam/ground_truth
-  pixyslam/diagnostics pixyslam/optimised_map)
+  pixyslam/diagnostics pixyslam/optimised_map pixyslam/robot_sighting pixyslam/fleet_map)
 expect=()
 for t in "${topics[@]}"; do expect+=(--expect "$t=$count"); done
 for name in direct relayed; do

@@ -107,7 +107,8 @@ awk -v r="$rate" 'BEGIN { exit !(r > 5 && r < 40) }' || fail "hz rate $rate Hz n
 
 echo "== record (like ros2 bag record): two topics by pattern, --duration"
 "$spy" record 'pixyslam/*' '!pixyslam/diagnostics' '!pixyslam/ground_truth' '!pixyslam/landmark_observation' \
-  '!pixyslam/optimised_map' --domain "$domain" --duration 2.5 --out "$work/rec.mcap" 2> "$work/record.log" \
+  '!pixyslam/optimised_map' '!pixyslam/robot_sighting' '!pixyslam/fleet_map' --domain "$domain" --duration 2.5 \
+  --out "$work/rec.mcap" 2> "$work/record.log" \
   || { status=$?; cat "$work/record.log"; fail "record exited $status"; }
 cat "$work/record.log"
 grep -q "recording 2 topics to $work/rec.mcap" "$work/record.log" || fail "record did not select 2 topics"

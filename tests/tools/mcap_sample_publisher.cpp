@@ -118,6 +118,39 @@ msg::OptimisedMap optimised_map(std::uint64_t i) {
   return m;
 }
 
+msg::RobotSighting robot_sighting(std::uint64_t i) {
+  msg::RobotSighting m;
+  m.header().stamp_ns(dds::now_ns());
+  m.header().frame_id("camera");
+  msg::RobotDetection d;
+  d.seen_robot_id("robot" + std::to_string(2 + i % 4));
+  d.range_m(1.0 + 0.001 * static_cast<double>(i % 1000));
+  d.bearing_rad(-0.3);
+  d.range_sigma_m(0.1);
+  d.bearing_sigma_rad(0.05);
+  m.detections().push_back(d);
+  return m;
+}
+
+msg::FleetMap fleet_map(std::uint64_t i) {
+  msg::FleetMap m;
+  m.header().stamp_ns(dds::now_ns());
+  m.header().frame_id("map");
+  msg::FleetLandmark l;
+  l.landmark_id(10);
+  l.x_m(1.0 + 0.0001 * static_cast<double>(i));
+  l.cov_xx_m2(0.002);
+  l.cov_yy_m2(0.002);
+  l.robots(2);
+  m.landmarks().push_back(l);
+  msg::RobotFrameCheck c;
+  c.robot_id("robot1");
+  c.verdict("agrees");
+  c.fused(true);
+  m.robots().push_back(c);
+  return m;
+}
+
 msg::Diagnostics diagnostics(std::uint64_t i) {
   msg::Diagnostics m;
   m.header().stamp_ns(dds::now_ns());
@@ -188,6 +221,8 @@ int run(int argc, char** argv) {
     publishers.push_back(topic_publisher(participant, &map_state));
     publishers.push_back(topic_publisher(participant, &ground_truth));
     publishers.push_back(topic_publisher(participant, &optimised_map));
+    publishers.push_back(topic_publisher(participant, &robot_sighting));
+    publishers.push_back(topic_publisher(participant, &fleet_map));
   }
   if (with_diagnostics) publishers.push_back(topic_publisher(participant, &diagnostics));
   const auto wait = std::chrono::milliseconds(static_cast<long>(wait_s * 1000.0));

@@ -3,7 +3,7 @@
 // (range and bearing after the data set's corrections, with the filter's
 // sigmas) and GroundTruth, header.robot_id "robot<N>", on the recording's
 // timeline at --rate times its speed (0: as fast as the readers acknowledge).
-//   dataset_bridge --config config/dataset_bridge.yaml --dataset DIR [--robots 1,2] [--rate R]
+//   dataset_bridge --config config/dataset_bridge.yaml --dataset DIR [--robots 1,2] [--rate R] [--duration S]
 //                  [--set KEY=VALUE ...] [--domain N]
 // Exit status: 0 when every sample was published, 1 when DDS refused some or
 // readers did not acknowledge in time (counted), 2 for a usage, configuration
@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
   std::string config, dataset, robots;
-  double rate = -1.0;
+  double rate = -1.0, duration_s = 0.0;
   std::vector<std::string> overrides, domain;
   app::Cli cli{"dataset_bridge",
                "A multi-robot recording (MRCLAM data set) onto the live topics: each robot's Odometry, "
@@ -36,6 +36,11 @@ int main(int argc, char** argv) {
   cli.option("--rate", rate, "times the recording's speed (overrides dataset_bridge.rate; 0: as fast as acknowledged)")
       .non_negative()
       .type("R");
+  cli.option("--duration", duration_s,
+             "only the first S seconds of each robot's recording from its start (default: all; as slam_offline "
+             "mrclam --duration)")
+      .non_negative()
+      .type("S");
   app::add_set(cli, overrides, "dataset_bridge.wait_readers=2");
   app::add_domain(cli, domain);
   cli.footer("dataset_bridge parameters (dataset_bridge:; robots apart):\n" +
@@ -55,6 +60,7 @@ int main(int argc, char** argv) {
     for (int r : options.robots) {
       try {
         streams.push_back(dataset_bridge::make_robot_stream(mrclam::load_robot(dataset, r), options.sensor_model));
+        dataset_bridge::keep_first_seconds(streams.back(), duration_s);
       } catch (const std::runtime_error& e) {
         throw std::invalid_argument(e.what());  // a data set that does not read is the user's input
       }

@@ -43,6 +43,7 @@ struct Args {
   std::string write_dataset;  // sim
   std::string dataset;        // mrclam
   int robot = 0;              // mrclam
+  double mrclam_duration_s = 0.0;  // mrclam: 0 = all
   std::string sim_config;     // hardware
   double duration_s = 85.0;   // hardware
 };
@@ -158,6 +159,7 @@ int run(const Args& args) {
     const int robot = args.robot;
     const mrclam::RobotData data = mrclam::load_robot(dataset, robot);
     input = offline::mrclam_input(data, model);
+    offline::keep_first_seconds(input, args.mrclam_duration_s);
     std::printf("MRCLAM %s robot %d: %zu odometry rows, %zu frames, landmarks from %s\n", dataset.c_str(), robot,
                 data.odometry.size(), data.frames.size(), data.landmark_file.c_str());
     std::printf("dropped rows           %zu robot (subjects 1-5), %zu unknown barcode\n", data.counts.robot_rows,
@@ -226,6 +228,11 @@ int main(int argc, char** argv) {
       .required()
       .type("DIR");
   mrclam.option("--robot", args.robot, "the robot, 1-5").required().range(mrclam::kFirstRobot, mrclam::kLastRobot).type("N");
+  mrclam.option("--duration", args.mrclam_duration_s,
+                "only the first S seconds of the recording from the robot's start (default: all; as dataset_bridge "
+                "--duration)")
+      .non_negative()
+      .type("S");
   app::Cli& hardware = cli.subcommand(
       "hardware", "the robot_sim hardware decoded by the bridges' parsers (their configs beside --sim-config)");
   common(hardware);

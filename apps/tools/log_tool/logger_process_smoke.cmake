@@ -46,7 +46,7 @@ expect_match("logger counts" "${err}" "pixyslam/odometry: received 0, written 0,
 execute_process(COMMAND ${LOG_TOOL} info ${out} RESULT_VARIABLE rc OUTPUT_VARIABLE info)
 expect_status("pixyslam_log info on the logger's file" "${rc}" 0)
 expect_match("pixyslam_log info on the logger's file" "${info}" "status: +complete")
-expect_match("pixyslam_log info on the logger's file" "${info}" "schemas: +6")  # every topic of config/logger.yaml
+expect_match("pixyslam_log info on the logger's file" "${info}" "schemas: +8")  # every topic of config/logger.yaml
 execute_process(COMMAND ${LOG_TOOL} check ${out} --expect pixyslam/odometry=0 RESULT_VARIABLE rc OUTPUT_VARIABLE check)
 expect_status("pixyslam_log check on the logger's empty file:\n${check}" "${rc}" 0)
 

@@ -21,7 +21,9 @@
 #include "landmark_observation.h"
 #include "map_state.h"
 #include "odometry.h"
+#include "fleet_map.h"
 #include "optimised_map.h"
+#include "robot_sighting.h"
 
 typedef struct {
   const char* topic;
@@ -38,6 +40,8 @@ static route_t routes[] = {
     {"pixyslam/ground_truth", &pixyslam_msg_GroundTruth_desc, 0, 0, 0},
     {"pixyslam/diagnostics", &pixyslam_msg_Diagnostics_desc, 0, 0, 0},
     {"pixyslam/optimised_map", &pixyslam_msg_OptimisedMap_desc, 0, 0, 0},
+    {"pixyslam/robot_sighting", &pixyslam_msg_RobotSighting_desc, 0, 0, 0},
+    {"pixyslam/fleet_map", &pixyslam_msg_FleetMap_desc, 0, 0, 0},
 };
 enum { kRoutes = sizeof(routes) / sizeof(routes[0]), kBatch = 32 };
 

@@ -141,6 +141,12 @@ DdsOptions read_dds_options(config::YamlReader& reader, const std::string& confi
   return o;
 }
 
+DdsOptions read_dds_section(config::YamlReader& root, const std::string& config_dir, const DdsOptions& fallback) {
+  if (!root.has("dds")) return fallback;
+  config::YamlReader dds = root.child("dds");
+  return read_dds_options(dds, config_dir);
+}
+
 std::string default_profiles_file() {
   // A program of the build tree uses its checkout's file; an installed one the
   // package's (/etc/pixyslam/dds/profiles.xml, the file the services use).

@@ -45,10 +45,7 @@ EncoderNodeOptions read_encoder_node_options(config::YamlReader& root, const std
     config::read_parameters(node, node_parameters(), o);
     node.finish();
   }
-  if (root.has("dds")) {
-    config::YamlReader dds = root.child("dds");
-    o.dds = dds::read_dds_options(dds, config_dir);
-  }
+  o.dds = dds::read_dds_section(root, config_dir);
   root.finish();
   return o;
 }

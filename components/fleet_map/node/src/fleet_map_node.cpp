@@ -38,10 +38,7 @@ FleetMapOptions read_fleet_map_options_file(const std::string& path) {
   config::YamlReader y = root.child("fleet_map");
   config::read_parameters(y, fleet_map_parameters(), o);
   y.finish();
-  if (root.has("dds")) {
-    config::YamlReader dds = root.child("dds");
-    o.dds = dds::read_dds_options(dds, config::folder_of(path));
-  }
+  o.dds = dds::read_dds_section(root, config::folder_of(path));
   root.finish();
   return o;
 }

@@ -55,10 +55,7 @@ BridgeOptions read_bridge_options(config::YamlReader& root, const std::string& c
   config::read_parameters(section, bridge_parameters(), o);
   config::check_rules(section, [&] { parameters::check_ranges(o, bridge_parameters(), "foxglove_bridge"); });
   section.finish();
-  if (root.has("dds")) {
-    config::YamlReader dds = root.child("dds");
-    o.dds = dds::read_dds_options(dds, config_dir);
-  }
+  o.dds = dds::read_dds_section(root, config_dir);
   root.finish();
   return o;
 }

@@ -100,10 +100,7 @@ LoggerOptions read_logger_options(config::YamlReader& root, const std::string& c
   config::check_rules(section, [&] { validate(o); });
   section.finish();
 
-  if (root.has("dds")) {
-    config::YamlReader dds = root.child("dds");
-    o.dds = dds::read_dds_options(dds, config_dir);
-  }
+  o.dds = dds::read_dds_section(root, config_dir);
   root.finish();
   return o;
 }

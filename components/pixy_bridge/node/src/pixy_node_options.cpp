@@ -82,10 +82,7 @@ PixyNodeOptions read_pixy_node_options(config::YamlReader& root, const std::stri
   }
   config::YamlReader pixy = root.child("pixy");
   o.pixy = pixy::read_pixy_options(pixy);
-  if (root.has("dds")) {
-    config::YamlReader dds = root.child("dds");
-    o.dds = dds::read_dds_options(dds, config_dir);
-  }
+  o.dds = dds::read_dds_section(root, config_dir);
   if (root.has("camera")) {
     if (!read_camera) {
       root.fail("camera", "this pixy_bridge was built without the camera backend "

@@ -101,10 +101,7 @@ EstimatorOptions read_estimator_options_file(const std::string& path) {
   if (!k.file.empty() && k.file.front() != '/') k.file = config::folder_of(path) + "/" + k.file;
   estimator.finish();
 
-  if (root.has("dds")) {
-    config::YamlReader dds = root.child("dds");
-    o.dds = dds::read_dds_options(dds, config::folder_of(path));
-  }
+  o.dds = dds::read_dds_section(root, config::folder_of(path));
   root.finish();
   return o;
 }

@@ -81,6 +81,23 @@ TEST(Timeline, EqualTimesGoTruthOdometryFramesSightingsThenByRobot) {
   EXPECT_EQ(at[4].kind, EventKind::kSighting);
 }
 
+TEST(RobotStream, KeepsTheFirstSecondsFromItsStart) {
+  RobotStream s = make_robot_stream(robot_data(1, 100.0), {});
+  RobotStream all = s;
+  keep_first_seconds(all, 0.0);  // <= 0: everything
+  EXPECT_EQ(all.input.odometry.size(), 3u);
+  keep_first_seconds(s, 0.6);  // start 101.0: up to 101.6
+  ASSERT_EQ(s.input.truth.size(), 1u);
+  ASSERT_EQ(s.input.odometry.size(), 3u);  // 100.2 and 100.9 (before the start: the held control) and 101.5
+  ASSERT_EQ(s.input.frames.size(), 2u);    // 100.5 (skipped later, before the start) and 101.5
+  EXPECT_TRUE(s.sightings.size() == 1u && s.sightings[0].t_s == 100.7);
+  // The offline runner's cut is the same one.
+  offline::RunInput in = offline::mrclam_input(robot_data(1, 100.0), {});
+  offline::keep_first_seconds(in, 0.6);
+  EXPECT_EQ(in.odometry.size(), s.input.odometry.size());
+  EXPECT_EQ(in.frames.size(), s.input.frames.size());
+}
+
 TEST(Pacer, SpreadsTheRecordingOverWallTimeAtTheRate) {
   const auto start = Pacer::Clock::now();
   const Pacer ten(10.0, 100.0, start);

@@ -62,10 +62,7 @@ DatasetBridgeOptions read_dataset_bridge_options_file(const std::string& path) {
   }
   config::read_parameters(y, dataset_bridge_parameters(), o);
   y.finish();
-  if (root.has("dds")) {
-    config::YamlReader dds = root.child("dds");
-    o.dds = dds::read_dds_options(dds, config::folder_of(path));
-  }
+  o.dds = dds::read_dds_section(root, config::folder_of(path));
   root.finish();
   return o;
 }

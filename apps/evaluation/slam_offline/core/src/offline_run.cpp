@@ -282,6 +282,21 @@ RunInput mrclam_input(const mrclam::RobotData& d, const MrclamSensorModel& model
   return in;
 }
 
+void keep_first_seconds(RunInput& input, double duration_s) {
+  if (duration_s <= 0.0) return;
+  const double end_s = input.start_time_s + duration_s;
+  const auto after = [end_s](double t_s) { return t_s > end_s; };
+  input.truth.erase(std::remove_if(input.truth.begin(), input.truth.end(),
+                                   [&](const eval::TimedPose& p) { return after(p.t_s); }),
+                    input.truth.end());
+  input.odometry.erase(std::remove_if(input.odometry.begin(), input.odometry.end(),
+                                      [&](const slam::OdometrySample& o) { return after(o.t_s); }),
+                       input.odometry.end());
+  input.frames.erase(std::remove_if(input.frames.begin(), input.frames.end(),
+                                    [&](const slam::ObservationFrame& f) { return after(f.t_s); }),
+                     input.frames.end());
+}
+
 slam::ObservationFrame mrclam_frame(const mrclam::MeasurementFrame& f, const MrclamSensorModel& model) {
   slam::ObservationFrame frame{f.t_s, {}};
   for (const mrclam::Detection& det : f.detections) {

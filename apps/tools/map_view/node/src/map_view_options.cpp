@@ -53,10 +53,7 @@ MapViewOptions read_map_view_options(config::YamlReader& root, const std::string
     s.finish();
     config::check_rules(s, [&] { validate(o.render); });
   }
-  if (root.has("dds")) {
-    config::YamlReader dds = root.child("dds");
-    o.dds = dds::read_dds_options(dds, config_dir);
-  }
+  o.dds = dds::read_dds_section(root, config_dir, o.dds);
   root.finish();
   return o;
 }

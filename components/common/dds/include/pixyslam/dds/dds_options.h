@@ -56,6 +56,10 @@ bool announces_identity(const DdsOptions& options, bool secure);
 // `config_dir` resolves a relative profiles_file and security_dir. Throws config::ConfigError.
 DdsOptions read_dds_options(config::YamlReader& reader, const std::string& config_dir);
 
+// The optional `dds:` mapping of a config file's `root` (read_dds_options), or
+// `fallback` when the file has none.
+DdsOptions read_dds_section(config::YamlReader& root, const std::string& config_dir, const DdsOptions& fallback = {});
+
 // The profiles file a tool uses without --config: for a program in its build
 // tree config/dds/profiles.xml of the checkout, for an installed one the
 // package's /etc/pixyslam/dds/profiles.xml (the checkout's if that is absent).

@@ -25,6 +25,10 @@ struct RobotStream {
 
 RobotStream make_robot_stream(const mrclam::RobotData& data, const offline::MrclamSensorModel& model);
 
+// The first `duration_s` seconds of the stream from its start (sightings too;
+// offline::keep_first_seconds); <= 0 keeps everything.
+void keep_first_seconds(RobotStream& stream, double duration_s);
+
 enum class EventKind { kGroundTruth, kOdometry, kFrame, kSighting };
 
 // One sample to publish: robots[robot].input.<kind>[index] (sightings: .sightings).

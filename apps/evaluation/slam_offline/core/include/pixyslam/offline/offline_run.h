@@ -117,6 +117,9 @@ MrclamSensorModel read_mrclam_sensor_model(config::YamlReader& root);
 // MRCLAM robot data as filter input: started at the first ground-truth pose when
 // there is one, else at the origin at the first odometry time.
 RunInput mrclam_input(const mrclam::RobotData& data, const MrclamSensorModel& model = {});
+// Keeps the first `duration_s` seconds of `input` from its start_time_s (the
+// truth, odometry and frames stamped after that go); <= 0 keeps everything.
+void keep_first_seconds(RunInput& input, double duration_s);
 // One camera image's detections with the model's range correction (subject as landmark_id).
 slam::ObservationFrame mrclam_frame(const mrclam::MeasurementFrame& frame, const MrclamSensorModel& model);
 }  // namespace pixyslam::offline
