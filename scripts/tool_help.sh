@@ -6,7 +6,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${BUILD_DIR:-$root/build}/bin
 tools=(encoder_bridge pixy_bridge slam_estimator map_optimizer logger foxglove_bridge pixyslam_launch pixyslam_spy pixyslam_play
   map_view robot_sim sim_evaluator slam_offline mrclam_eval pixyslam_calibrate paper_experiments camera_eval
-  dataset_bridge bench_latency bench_logger_throughput bench_map_optimizer bench_mrclam_frame link_emulator)
+  dataset_bridge fleet_map bench_latency bench_logger_throughput bench_map_optimizer bench_mrclam_frame link_emulator)
 cat <<'TEXT'
 # Every executable's command line
 

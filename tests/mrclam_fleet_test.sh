@@ -11,7 +11,7 @@
 # data set (../shared is not part of a clone).
 #   mrclam_fleet_test.sh BIN_DIR CONFIG_DIR DATASET_DIR [DURATION_S] [MAX_DIFF_M]
 set -euo pipefail
-bin=$1 config=$2 dataset=$3 duration=${4:-60} max_diff=${5:-0.01}
+bin=$1 config=$2 dataset=$3 duration=${4:-60} max_diff=${5:-0.001}
 if [[ ! -f $dataset/Robot1_Odometry.dat ]]; then
   echo "SKIP: no MRCLAM data set at $dataset"
   exit 77
