@@ -23,7 +23,7 @@ cp -r "$config" "$work/config"
 domain=$((60 + $$ % 100))
 sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/config/*.yaml
 sed -i "s/^  duration_s: [0-9.]* /  duration_s: $duration /" "$work/config/robot_sim.yaml"
-sed -i "s/--max-ate, '0.10'/--max-ate, '$max_ate'/" "$work/config/launch_sim.yaml"
+sed -i -E "s/--max-ate, '[0-9.]+'/--max-ate, '$max_ate'/" "$work/config/launch_sim.yaml"
 sed -i "s#command: \[slam_estimator, #command: [qemu-arm-static, -L, '$sysroot', -E, 'LD_PRELOAD=$shim', '$armhf_build/bin/slam_estimator', #" \
   "$work/config/launch_sim.yaml"
 grep -q "qemu-arm-static" "$work/config/launch_sim.yaml" || { echo "FAIL: could not put the armhf estimator in"; exit 1; }

@@ -99,7 +99,7 @@ echo "namespaces ${tag}_{${hosts[*]}, sw}, network 10.200.$net.0/24, profile $pr
 
 cp -r "$config" "$work/config"
 sed -i "s/^  duration_s: [0-9.]* /  duration_s: $sim_s /" "$work/config/robot_sim.yaml"
-sed -i "s/--max-ate, '0.10'/--max-ate, '$max_ate'/" "$work/config/launch_sim.yaml"
+sed -i -E "s/--max-ate, '[0-9.]+'/--max-ate, '$max_ate'/" "$work/config/launch_sim.yaml"
 extra=""
 if [[ $profile == discovery_client ]]; then extra="  discovery_server: {host: server, port: 11811, id: 0}"; fi
 if [[ $profile == secure ]]; then

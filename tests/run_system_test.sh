@@ -21,7 +21,7 @@ cp -r "$config" "$work/config"
 domain=$((120 + $$ % 100))
 sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/config/*.yaml
 sed -i "s/^  duration_s: [0-9.]* /  duration_s: $duration /" "$work/config/robot_sim.yaml"
-sed -i "s/--max-ate, '0.10'/--max-ate, '$max_ate'/" "$work/config/$launch"
+sed -i -E "s/--max-ate, '[0-9.]+'/--max-ate, '$max_ate'/" "$work/config/$launch"
 
 status=0
 "$bin/pixyslam_launch" "$work/config/$launch" "${launch_args[@]}" --run-dir "$work/run" > "$work/out.log" 2>&1 &
