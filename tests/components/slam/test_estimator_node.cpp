@@ -101,7 +101,7 @@ TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
   ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
 
   // About 700 messages a second: a MapState reader starved for a while (a busy
-  // host) is still within the 256 states both sides keep. Unpaced, the estimator
+  // host) is still within the 1024 states both sides keep. Unpaced, the estimator
   // answered at ~1600 states a second and a loaded CI run lost 68 of 1138.
   feed(run, 0.0, world.duration_s, base_ns, odometry_writer, observation_writer, std::chrono::microseconds(1500));
   ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
