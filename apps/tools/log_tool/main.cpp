@@ -33,6 +33,7 @@
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
+#include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/parameters/parameters.h"
 #include "pixyslam/log_tool/spy_commands.h"
 #include "pixyslam/logger_node/logger_run.h"
@@ -58,9 +59,24 @@ void add_expectation(const std::string& text, pixyslam::log_tool::CheckRequest& 
   }
 }
 
-constexpr const char* kTopics =
-    "TOPIC: pixyslam/odometry, pixyslam/landmark_observation, pixyslam/map_state, pixyslam/ground_truth,\n"
-    "       pixyslam/diagnostics, pixyslam/optimised_map";
+// "TOPIC: pixyslam/odometry, ..." for the help footers: every topic of the system, wrapped.
+std::string topics_help() {
+  std::string out = "TOPIC: ", line = out;
+  const auto& topics = pixyslam::dds::known_topics();
+  for (std::size_t i = 0; i < topics.size(); ++i) {
+    const std::string item = std::string(topics[i].topic) + (i + 1 < topics.size() ? "," : "");
+    if (line.size() + item.size() + 1 > 100) {
+      out += "\n       ";
+      line = "       ";
+    } else if (i > 0) {
+      out += " ";
+      line += " ";
+    }
+    out += item;
+    line += item;
+  }
+  return out;
+}
 
 // The DDS settings of a live command: --config FILE, --domain N.
 struct DdsArguments {
@@ -100,7 +116,7 @@ int main(int argc, char** argv) {
   app::Cli cli{PIXYSLAM_TOOL_NAME,
                "Inspects the live system (participants, topics, echo, hz, diagnostics), records it (record) and "
                "reads its recordings (info, check, print, compare), decoding with the project's own types."};
-  cli.footer(std::string(kTopics) + "\nExit status: 0 ok, 1 check failed / too few samples / file unreadable or "
+  cli.footer(topics_help() + "\nExit status: 0 ok, 1 check failed / too few samples / file unreadable or "
                                     "damaged, 2 command-line or config error.");
   DdsArguments dds_args;
   bool json = false;  // --json of participants, topics, diagnostics, hz, info
@@ -158,7 +174,7 @@ int main(int argc, char** argv) {
   add_duration(record, "0: until Ctrl-C");
   app::add_set(record, record_sets, "logger.compression=lz4");
   dds_args.add_to(record);
-  record.footer(std::string(kTopics) + "\nParameters for --set (and dds.KEY: the logger's --help):\n" +
+  record.footer(topics_help() + "\nParameters for --set (and dds.KEY: the logger's --help):\n" +
                 parameters::help_text(logger_node::logger_parameters(), "logger") +
                 "Exit status: 0 stopped by Ctrl-C or --duration, 1 the recording failed or lost samples to write "
                 "failures, 2 command-line or config error.");
