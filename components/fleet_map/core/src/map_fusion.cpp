@@ -109,50 +109,71 @@ std::map<int, Information> fuse(const Clean& maps, const std::vector<bool>& use)
   return out;
 }
 
+// The landmarks `mine` shares with `fleet`: (mine, fleet's estimate) by id.
+using Pairs = std::vector<std::pair<LandmarkEstimate, LandmarkEstimate>>;
+Pairs shared_with(const std::map<int, LandmarkEstimate>& mine, const std::map<int, Information>& fleet) {
+  Pairs shared;
+  for (const auto& [id, l] : mine) {
+    const auto it = fleet.find(id);
+    if (it != fleet.end()) shared.emplace_back(l, it->second.estimate(id));
+  }
+  return shared;
+}
+
+// A pair's weight: 1 / trace of the summed covariance.
+double weight(const LandmarkEstimate& a, const LandmarkEstimate& b) { return 1.0 / (a.cov + b.cov).trace(); }
+
+// The weighted least-squares rigid fit of the first of each pair onto the
+// second, about `centre`: the weighted centroids (relative to centre) and the
+// rotation between them (0 with fewer than two pairs).
+struct RigidFit {
+  double w_sum = 0.0;
+  Eigen::Vector2d a_bar = Eigen::Vector2d::Zero(), b_bar = Eigen::Vector2d::Zero();
+  double angle = 0.0;
+};
+
+RigidFit fit_rigid(const Pairs& shared, const Eigen::Vector2d& centre) {
+  RigidFit f;
+  for (const auto& [a, b] : shared) {
+    const double w = weight(a, b);
+    f.w_sum += w;
+    f.a_bar += w * (a.mean - centre);
+    f.b_bar += w * (b.mean - centre);
+  }
+  f.a_bar /= f.w_sum;
+  f.b_bar /= f.w_sum;
+  double dot = 0.0, cross = 0.0;
+  for (const auto& [a, b] : shared) {
+    const double w = weight(a, b);
+    const Eigen::Vector2d p = a.mean - centre - f.a_bar, q = b.mean - centre - f.b_bar;
+    dot += w * p.dot(q);
+    cross += w * (p.x() * q.y() - p.y() * q.x());
+  }
+  f.angle = shared.size() >= 2 ? std::atan2(cross, dot) : 0.0;
+  return f;
+}
+
 FrameCheck check(const std::string& robot_id, const std::map<int, LandmarkEstimate>& mine,
                  const std::map<int, Information>& others, const FusionOptions& options) {
   FrameCheck c;
   c.robot_id = robot_id;
   c.landmarks = mine.size();
-  std::vector<std::pair<LandmarkEstimate, LandmarkEstimate>> shared;
-  for (const auto& [id, l] : mine) {
-    const auto it = others.find(id);
-    if (it != others.end()) shared.emplace_back(l, it->second.estimate(id));
-  }
+  const Pairs shared = shared_with(mine, others);
   c.common = shared.size();
   if (c.common == 0) return c;
-  // Centroids and the rigid fit, weighted by 1 / trace of the summed covariance.
-  double w_sum = 0.0;
-  Eigen::Vector2d a_bar = Eigen::Vector2d::Zero(), b_bar = Eigen::Vector2d::Zero();
-  for (const auto& [a, b] : shared) {
-    const double w = 1.0 / (a.cov + b.cov).trace();
-    w_sum += w;
-    a_bar += w * a.mean;
-    b_bar += w * b.mean;
-  }
-  a_bar /= w_sum;
-  b_bar /= w_sum;
-  c.offset_m = (b_bar - a_bar).norm();
-  if (shared.size() >= 2) {
-    double dot = 0.0, cross = 0.0;
-    for (const auto& [a, b] : shared) {
-      const double w = 1.0 / (a.cov + b.cov).trace();
-      const Eigen::Vector2d p = a.mean - a_bar, q = b.mean - b_bar;
-      dot += w * p.dot(q);
-      cross += w * (p.x() * q.y() - p.y() * q.x());
-    }
-    c.rotation_rad = std::atan2(cross, dot);
-  }
+  const RigidFit fit = fit_rigid(shared, Eigen::Vector2d::Zero());
+  c.offset_m = (fit.b_bar - fit.a_bar).norm();
+  c.rotation_rad = fit.angle;
   // Weighted residual sums without the motion (rss0) and after the rigid fit (rss1).
   const Eigen::Rotation2Dd rotation(c.rotation_rad);
-  const Eigen::Vector2d shift = b_bar - rotation * a_bar;
+  const Eigen::Vector2d shift = fit.b_bar - rotation * fit.a_bar;
   double rss0 = 0.0, rss1 = 0.0;
   for (const auto& [a, b] : shared) {
-    const double w = 1.0 / (a.cov + b.cov).trace();
+    const double w = weight(a, b);
     rss0 += w * (b.mean - a.mean).squaredNorm();
     rss1 += w * (b.mean - (rotation * a.mean + shift)).squaredNorm();
   }
-  c.residual_m = std::sqrt(rss1 / w_sum);
+  c.residual_m = std::sqrt(rss1 / fit.w_sum);
   const int n = static_cast<int>(c.common);
   if (n < std::max(3, options.min_common_landmarks)) return c;
   c.f_statistic = rss1 > 0.0 ? ((rss0 - rss1) / 3.0) / (rss1 / (2 * n - 3)) : (rss0 > 0.0 ? 1e300 : 0.0);
@@ -160,10 +181,6 @@ FrameCheck check(const std::string& robot_id, const std::map<int, LandmarkEstima
   c.verdict = c.f_statistic <= c.threshold ? FrameVerdict::kAgrees : FrameVerdict::kDisagrees;
   return c;
 }
-
-}  // namespace
-
-namespace {
 
 // A rigid motion about the point `centre`: p -> R(angle) (p - centre) + centre + shift.
 struct Motion {
@@ -175,30 +192,11 @@ struct Motion {
 // shared landmarks; false with fewer than `min_common` shared.
 bool fit_motion(const std::map<int, LandmarkEstimate>& mine, const std::map<int, Information>& fleet,
                 const Eigen::Vector2d& centre, int min_common, Motion& motion) {
-  std::vector<std::pair<LandmarkEstimate, LandmarkEstimate>> shared;
-  for (const auto& [id, l] : mine) {
-    const auto it = fleet.find(id);
-    if (it != fleet.end()) shared.emplace_back(l, it->second.estimate(id));
-  }
+  const Pairs shared = shared_with(mine, fleet);
   if (shared.size() < static_cast<std::size_t>(min_common)) return false;
-  double w_sum = 0.0, dot = 0.0, cross = 0.0;
-  Eigen::Vector2d a_bar = Eigen::Vector2d::Zero(), b_bar = Eigen::Vector2d::Zero();
-  for (const auto& [a, b] : shared) {
-    const double w = 1.0 / (a.cov + b.cov).trace();
-    w_sum += w;
-    a_bar += w * (a.mean - centre);
-    b_bar += w * (b.mean - centre);
-  }
-  a_bar /= w_sum;
-  b_bar /= w_sum;
-  for (const auto& [a, b] : shared) {
-    const double w = 1.0 / (a.cov + b.cov).trace();
-    const Eigen::Vector2d p = a.mean - centre - a_bar, q = b.mean - centre - b_bar;
-    dot += w * p.dot(q);
-    cross += w * (p.x() * q.y() - p.y() * q.x());
-  }
-  motion.angle = std::atan2(cross, dot);
-  motion.shift = b_bar - Eigen::Rotation2Dd(motion.angle) * a_bar;
+  const RigidFit fit = fit_rigid(shared, centre);
+  motion.angle = fit.angle;
+  motion.shift = fit.b_bar - Eigen::Rotation2Dd(motion.angle) * fit.a_bar;
   return true;
 }
 

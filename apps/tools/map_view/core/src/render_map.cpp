@@ -77,6 +77,15 @@ void diamond(cv::Mat& img, const cv::Point2d& at, double half_px, const cv::Scal
   cv::polylines(img, corners, true, colour, 2, cv::LINE_AA, kShift);
 }
 
+// An outlined square: the fleet map's landmarks' marker.
+void square(cv::Mat& img, const cv::Point2d& at, double half_px, const cv::Scalar& colour) {
+  const double h = half_px;
+  line(img, {at.x - h, at.y - h}, {at.x + h, at.y - h}, colour, 2);
+  line(img, {at.x + h, at.y - h}, {at.x + h, at.y + h}, colour, 2);
+  line(img, {at.x + h, at.y + h}, {at.x - h, at.y + h}, colour, 2);
+  line(img, {at.x - h, at.y + h}, {at.x - h, at.y - h}, colour, 2);
+}
+
 bool finite_covariance(const LandmarkView& l) {
   return std::isfinite(l.cov_xx_m2) && std::isfinite(l.cov_xy_m2) && std::isfinite(l.cov_yy_m2);
 }
@@ -194,10 +203,7 @@ void draw_fleet(cv::Mat& map, const MapViewState& s, const ViewTransform& view, 
       landmark_ellipse(map, at, covariance_ellipse(l.cov_xx_m2, l.cov_xy_m2, l.cov_yy_m2, o.sigma_scale), ppm,
                        o.colours.fleet);
     }
-    line(map, {at.x - 4, at.y - 4}, {at.x + 4, at.y - 4}, o.colours.fleet, 2);
-    line(map, {at.x + 4, at.y - 4}, {at.x + 4, at.y + 4}, o.colours.fleet, 2);
-    line(map, {at.x + 4, at.y + 4}, {at.x - 4, at.y + 4}, o.colours.fleet, 2);
-    line(map, {at.x - 4, at.y + 4}, {at.x - 4, at.y - 4}, o.colours.fleet, 2);
+    square(map, at, 4.0, o.colours.fleet);
   }
 }
 
@@ -260,13 +266,7 @@ int draw_legend(cv::Mat& img, const MapViewState& s, const RenderOptions& o, int
     });
   }
   if (!s.fleet_landmarks.empty()) {
-    entry("fleet map", [&](double x0) {
-      const double cx = x0 + sample_w / 2.0;
-      line(img, {cx - 4, mid - 4}, {cx + 4, mid - 4}, c.fleet, 2);
-      line(img, {cx + 4, mid - 4}, {cx + 4, mid + 4}, c.fleet, 2);
-      line(img, {cx + 4, mid + 4}, {cx - 4, mid + 4}, c.fleet, 2);
-      line(img, {cx - 4, mid + 4}, {cx - 4, mid - 4}, c.fleet, 2);
-    });
+    entry("fleet map", [&](double x0) { square(img, {x0 + sample_w / 2.0, mid}, 4.0, c.fleet); });
   }
   if (!s.other_robots.empty() && !s.robot_id.empty()) {
     entry(s.robot_id, [&](double x0) { line(img, {x0, mid}, {x0 + sample_w, mid}, c.trajectory, 3); });
