@@ -6,7 +6,9 @@
 # (dds.robot_id robot1 and robot2) and `pixyslam_log record` listening. Passes
 # if the recording holds every sample once, seq 1..N per robot and topic, and
 # each estimator took exactly its own robot's samples and counted the other's,
-# and `pixyslam_log hz --robot robot2` counted robot 2's 80 odometry samples only;
+# and `pixyslam_log hz --robot robot2` counted robot 2's 80 odometry samples only
+# (the bridge waits for it: a second recorder on the other topics gives each
+# topic four readers, and records just those two topics);
 # the recording's robot sightings print, fleet_map fused both robots' maps,
 # and map_view draws both robots.
 #   dataset_bridge_test.sh BIN_DIR CONFIG_DIR
@@ -57,15 +59,23 @@ done
   > "$work/fleet_map.log" 2>&1 &
 fleet_pid=$!
 pids+=("$fleet_pid")
-# `hz --robot`: robot 2's odometry only.
+# `hz --robot`: robot 2's odometry only. The bridge waits for it too: a
+# second recorder on the other two topics makes every topic's reader count 4
+# (its own robot_id, so that its diagnostics are not taken for the first's).
+"$bin/pixyslam_log" record pixyslam/landmark_observation pixyslam/ground_truth --out "$work/others.mcap" \
+  --set dds.robot_id=second_logger \
+  --domain "$domain" > "$work/record_others.log" 2>&1 &
+others_pid=$!
+pids+=("$others_pid")
 "$bin/pixyslam_log" hz pixyslam/odometry --robot robot2 --duration 6 --json --domain "$domain" \
   > "$work/hz.out" 2> "$work/hz.log" &
 hz_pid=$!
 pids+=("$hz_pid")
 sleep 1
-# Readers per topic: the recorder and both estimators (odometry, observations).
+# Readers per topic: the recorder, both estimators, and hz (odometry) or the
+# second recorder (observations, ground truth).
 "$bin/dataset_bridge" --config "$config/dataset_bridge.yaml" --dataset "$data" --robots 1,2 --rate 0 \
-  --domain "$domain" --set dataset_bridge.wait_readers=3 > "$work/bridge.log" 2>&1 || fail "dataset_bridge: exit $?"
+  --domain "$domain" --set dataset_bridge.wait_readers=4 > "$work/bridge.log" 2>&1 || fail "dataset_bridge: exit $?"
 cat "$work/bridge.log"
 grep -q "published 180 odometry, 18 observations, 180 ground truth, 3 robot sightings" "$work/bridge.log" ||
   fail "bridge counts"
@@ -82,8 +92,9 @@ for r in 1 2; do
 done
 kill -INT "$fleet_pid"
 wait "$fleet_pid" || fail "fleet_map: exit $?"
-kill -INT "$record_pid"
+kill -INT "$record_pid" "$others_pid"
 wait "$record_pid" || fail "pixyslam_log record: exit $?"
+wait "$others_pid" || fail "pixyslam_log record (two topics): exit $?"
 grep "slam_estimator: odometry" "$work/estimator1.log" "$work/estimator2.log"
 # Each estimator: its own robot's samples, none lost; the other robot's counted.
 grep -q "odometry 100 (lost 0), observations 10 (lost 0), other robots' 88," "$work/estimator1.log" ||
@@ -97,6 +108,10 @@ grep -q "odometry 80 (lost 0), observations 8 (lost 0), other robots' 110," "$wo
   fail "log check"
 cat "$work/check.log"
 grep -q "robot1: seq 1..100, robot2: seq 1..80" "$work/check.log" || fail "odometry seq per robot"
+# The second recorder: its two topics, every sample, nothing else.
+"$bin/pixyslam_log" check "$work/others.mcap" --expect pixyslam/landmark_observation=18 \
+  --expect pixyslam/ground_truth=180 > "$work/check_others.log" 2>&1 || fail "log check (two topics)"
+if grep -q "pixyslam/odometry" "$work/check_others.log"; then fail "the two-topic recording holds odometry"; fi
 # Robot 1's sightings of robot 2, as written.
 "$bin/pixyslam_log" print "$work/run.mcap" --topic pixyslam/robot_sighting --json > "$work/sightings.json" ||
   fail "print sightings"
