@@ -5,18 +5,28 @@
 # multicast: no traffic leaves it; root needed), with simple multicast
 # discovery or through a `fastdds discovery` server. The bridges' devices do not
 # exist (they retry), so what flows is discovery and the 1 Hz diagnostics.
+# With --sim, once every reader matched, a robot_sim per robot (world.seed =
+# the robot's number, ground truth on DDS: 4N participants) drives SETTLE_S
+# simulated seconds in real time: then the sensor data flows too, and each
+# estimator's input counts (its own robot's samples, the others' it dropped)
+# are printed from its final line.
 # Prints: the time until every estimator's Odometry reader matched all N
 # encoder_bridge writers (seen by pixyslam_spy topics), CPU time and peak RSS
 # per process kind over SETTLE_S seconds, and the bytes on the namespace's
 # loopback (start-up and steady state per second).
-#   scripts/fleet_scale.sh N multicast|server [SETTLE_S]      (docs/deployment.md)
+#   scripts/fleet_scale.sh N multicast|server [SETTLE_S] [--sim]     (docs/deployment.md)
 # Exit status: 0 measured, 1 the readers did not all match within 120 s, 2 usage,
 # 77 not root (skipped).
 set -euo pipefail
-usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; }
 case ${1:-} in -h | --help) usage; exit 0 ;; esac
-(($# >= 2)) || { usage >&2; exit 2; }
+sim=0
+args=()
+for a in "$@"; do if [[ $a == --sim ]]; then sim=1; else args+=("$a"); fi; done
+set -- "${args[@]}"
+(($# >= 2 && $# <= 3)) || { usage >&2; exit 2; }
 n=$1 mode=$2 settle=${3:-30}
+[[ $settle =~ ^[0-9]+$ ]] && ((settle >= 1)) || { echo "fleet_scale: SETTLE_S must be a whole number of seconds >= 1" >&2; exit 2; }
 [[ $n =~ ^[0-9]+$ ]] && ((n >= 1 && n <= 200)) || { echo "fleet_scale: N must be 1..200" >&2; exit 2; }
 [[ $mode == multicast || $mode == server ]] || { echo "fleet_scale: mode must be multicast or server" >&2; exit 2; }
 ((EUID == 0)) || { echo "fleet_scale: needs root (it makes a network namespace); skipped" >&2; exit 77; }
@@ -33,7 +43,7 @@ cleanup() {
   # Anything still in the namespace (a process that outlived its parent) goes with it.
   ip netns pids "$ns" 2>/dev/null | xargs -r kill -KILL 2>/dev/null || true
   ip netns del "$ns" 2>/dev/null || true
-  rm -rf "$work"
+  if [[ -n ${KEEP_WORK:-} ]]; then echo "kept $work"; else rm -rf "$work"; fi
 }
 trap cleanup EXIT
 trap 'exit 130' INT TERM
@@ -59,10 +69,10 @@ declare -A kind_of
 for r in $(seq "$n"); do
   set_robot=(--set "dds.robot_id=robot$r" --set dds.diagnostics_period_s=1)
   ip netns exec "$ns" env "${env_common[@]}" "$bin/encoder_bridge" --config "$root/config/encoder_bridge.yaml" \
-    --device "$work/none_arduino$r" "${set_robot[@]}" --set node.wait_readers=0 > "$work/enc$r.log" 2>&1 &
+    --device "$work/arduino$r" "${set_robot[@]}" --set node.wait_readers=0 > "$work/enc$r.log" 2>&1 &
   pids+=($!); kind_of[$!]=encoder_bridge
   ip netns exec "$ns" env "${env_common[@]}" "$bin/pixy_bridge" --config "$root/config/pixy_bridge.yaml" \
-    --device "$work/none_pixy$r" "${set_robot[@]}" --set node.wait_readers=0 > "$work/pixy$r.log" 2>&1 &
+    --device "$work/pixy$r" "${set_robot[@]}" --set node.wait_readers=0 > "$work/pixy$r.log" 2>&1 &
   pids+=($!); kind_of[$!]=pixy_bridge
   ip netns exec "$ns" env "${env_common[@]}" "$bin/slam_estimator" --config "$root/config/slam_estimator.yaml" \
     "${set_robot[@]}" > "$work/est$r.log" 2>&1 &
@@ -89,12 +99,26 @@ ticks=$(getconf CLK_TCK)
 cpu_of() { awk '{print $14 + $15}' "/proc/$1/stat" 2>/dev/null || echo 0; }
 for pid in "${!kind_of[@]}"; do cpu0[$pid]=$(cpu_of "$pid"); done
 settle_bytes0=$(rx_bytes)
+if ((sim)); then
+  # Each robot drives (its bridges open the pseudo-terminals within reopen_period_s); measured
+  # over SETTLE_S s while all drive, then stopped.
+  sims=()
+  for r in $(seq "$n"); do
+    ip netns exec "$ns" env "${env_common[@]}" "$bin/robot_sim" --config "$root/config/robot_sim.yaml" --duration $((settle + 60)) \
+      --arduino-link "$work/arduino$r" --pixy-link "$work/pixy$r" --set "world.seed=$r" --set "dds.robot_id=robot$r" \
+      > "$work/sim$r.log" 2>&1 &
+    pids+=($!); kind_of[$!]=robot_sim; cpu0[$!]=0; sims+=($!)
+  done
+fi
 sleep "$settle"
 settle_bytes=$(($(rx_bytes) - settle_bytes0))
-echo "fleet_scale: $n robots, $((3 * n)) participants (+ the spy), $mode discovery, namespace loopback"
+participants=$((3 * n))
+traffic="discovery + 1 Hz diagnostics"
+if ((sim)); then participants=$((4 * n)) traffic="discovery, diagnostics and every robot's sensor data"; fi
+echo "fleet_scale: $n robots, $participants participants (+ the spy), $mode discovery, namespace loopback"
 echo "  every estimator's Odometry reader matched all $n writers after $matched_s s (spy polls of 1 s)"
-echo "  loopback traffic: $((startup_bytes / 1024)) KiB until then, $((settle_bytes / settle / 1024)) KiB/s over the next ${settle} s (discovery + 1 Hz diagnostics)"
-for kind in encoder_bridge pixy_bridge slam_estimator; do
+echo "  loopback traffic: $((startup_bytes / 1024)) KiB until then, $((settle_bytes / settle / 1024)) KiB/s over the next ${settle} s ($traffic)"
+for kind in encoder_bridge pixy_bridge slam_estimator robot_sim; do
   cpu=0 rss=0 count=0
   for pid in "${!kind_of[@]}"; do
     [[ ${kind_of[$pid]} == "$kind" ]] || continue
@@ -102,6 +126,24 @@ for kind in encoder_bridge pixy_bridge slam_estimator; do
     m=$(awk '/VmHWM/ {print $2}' "/proc/$pid/status" 2>/dev/null || echo 0)
     cpu=$((cpu + c)) rss=$((rss + m)) count=$((count + 1))
   done
+  ((count > 0)) || continue
   awk -v k="$kind" -v c="$cpu" -v t="$ticks" -v s="$settle" -v r="$rss" -v n="$count" \
     'BEGIN { printf "  %-15s x%-3d CPU %.2f %% of a core each (steady), peak RSS %.1f MB each\n", k, n, 100 * c / t / s / n, r / n / 1024 }'
 done
+if ((sim)); then
+  # The estimators' input: stop the robots, then the estimators, and read their final lines.
+  for pid in "${sims[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
+  for pid in "${sims[@]}"; do wait "$pid" 2>/dev/null || true; done
+  sleep 1
+  for pid in "${!kind_of[@]}"; do [[ ${kind_of[$pid]} == slam_estimator ]] && kill -INT "$pid" 2>/dev/null; done
+  for pid in "${!kind_of[@]}"; do [[ ${kind_of[$pid]} == slam_estimator ]] && { wait "$pid" 2>/dev/null || true; }; done
+  for f in "$work"/est*.log; do grep "slam_estimator: odometry" "$f" | tail -n 1; done | sed -n "s/.*slam_estimator: odometry \([0-9]*\) (lost \([0-9]*\)), observations \([0-9]*\) (lost \([0-9]*\)), other robots' \([0-9]*\), steps \([0-9]*\), late \([0-9]*\).*/\1 \2 \3 \4 \5 \6 \7/p" |
+    awk -v n="$n" '
+      function span(v, k) { if (!(k in lo) || v < lo[k]) lo[k] = v; if (!(k in hi) || v > hi[k]) hi[k] = v }
+      { span($1, "odo"); span($3, "obs"); span($5, "other"); lost += $2 + $4; late += $7; own += $1 + $3; others += $5 }
+      END {
+        if (NR != n) { printf "  estimators: %d of %d final lines\n", NR, n; exit 1 }
+        printf "  each estimator took its own robot: odometry %d-%d, observations %d-%d (lost %d, late %d in all)\n", lo["odo"], hi["odo"], lo["obs"], hi["obs"], lost, late
+        printf "  and dropped the other robots%s samples: %d-%d each (%.1f per own sample)\n", "\047", lo["other"], hi["other"], others / own
+      }' || { echo "fleet_scale: not every estimator reported its input"; exit 1; }
+fi

@@ -29,21 +29,7 @@ trap 'exit 130' INT TERM
 fail() { echo "FAIL: $*"; for f in "$work"/*.log; do echo "== $f"; tail -n 15 "$f"; done; exit 1; }
 
 data=$work/Dataset
-mkdir -p "$data"
-printf '# Subject #\tBarcode #\n1\t11\n2\t12\n3\t13\n4\t14\n5\t15\n6\t16\n7\t17\n' > "$data/Barcodes.dat"
-printf '# Subject\tx\ty\tsx\tsy\n6\t2.0\t1.0\t0\t0\n7\t-1.0\t2.0\t0\t0\n' > "$data/Landmark_Groundtruth.dat"
-make_robot() {  # ROBOT ODOMETRY_ROWS FRAMES SIGHTINGS
-  local r=$1 rows=$2 frames=$3 sightings=$4
-  awk -v n="$rows" 'BEGIN { print "# t v w"; for (i = 0; i < n; ++i) printf "%.3f\t0.2\t0.1\n", 1000 + 0.1 * i }' \
-    > "$data/Robot${r}_Odometry.dat"
-  awk -v n="$rows" 'BEGIN { print "# t x y th"; for (i = 0; i < n; ++i) printf "%.3f\t%.4f\t0.0\t%.4f\n", 1000 + 0.1 * i, 0.02 * i, 0.01 * i }' \
-    > "$data/Robot${r}_Groundtruth.dat"
-  awk -v f="$frames" -v s="$sightings" 'BEGIN { print "# t barcode range bearing";
-    for (i = 0; i < f; ++i) printf "%.3f\t16\t2.0\t0.3\n", 1000.05 + i;
-    for (i = 0; i < s; ++i) printf "%.3f\t12\t1.5\t-0.2\n", 1000.55 + i }' > "$data/Robot${r}_Measurement.dat"
-}
-make_robot 1 100 10 3
-make_robot 2 80 8 0
+"$(dirname "$0")/support/make_mrclam_dataset.sh" "$data"
 
 "$bin/pixyslam_log" record --out "$work/run.mcap" --domain "$domain" > "$work/record.log" 2>&1 &
 record_pid=$!
@@ -72,11 +58,13 @@ pids+=("$others_pid")
 hz_pid=$!
 pids+=("$hz_pid")
 sleep 1
-# Readers per topic: the recorder, both estimators, and hz (odometry) or the
-# second recorder (observations, ground truth).
+# Readers per topic: the recorder, and hz (odometry) or the second recorder
+# (observations, ground truth), and per robot its estimator.
 "$bin/dataset_bridge" --config "$config/dataset_bridge.yaml" --dataset "$data" --robots 1,2 --rate 0 \
-  --domain "$domain" --set dataset_bridge.wait_readers=4 > "$work/bridge.log" 2>&1 || fail "dataset_bridge: exit $?"
+  --domain "$domain" --set dataset_bridge.wait_readers=2 --set dataset_bridge.wait_readers_per_robot=1 \
+  > "$work/bridge.log" 2>&1 || fail "dataset_bridge: exit $?"
 cat "$work/bridge.log"
+if grep -q "fewer than" "$work/bridge.log"; then fail "the bridge did not see its 4 readers per topic"; fi
 grep -q "published 180 odometry, 18 observations, 180 ground truth, 3 robot sightings" "$work/bridge.log" ||
   fail "bridge counts"
 

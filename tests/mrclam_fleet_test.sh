@@ -29,26 +29,11 @@ grep -E "dataset_bridge: published|pose ATE RMSE|landmarks +[0-9]+ mapped|receiv
   "$work/launch.log" | grep -v "status" | head -n 60
 if grep -E "received, [1-9][0-9]* lost" "$work/launch.log"; then fail "messages lost"; fi
 grep -q "check passed" "$work/launch.log" || fail "the log check"
+# The bridge saw its readers (the logger, each robot's estimator and evaluator) without its time-out.
+if grep "fewer than" "$work/launch.log"; then fail "the dataset bridge started before all its readers matched"; fi
 
-for r in 1 2; do
-  "$bin/slam_offline" mrclam --config "$config/slam_mrclam.yaml" --dataset "$dataset" --robot "$r" --seed 1 \
-    --duration "$duration" --out-dir "$work/offline$r" > "$work/offline$r.log" 2>&1 || fail "slam_offline robot $r"
-  grep "pose ATE RMSE" "$work/offline$r.log" | sed "s/^/offline robot $r: /"
-  # The live evaluator scored the same estimates (every MapState reached it) as the offline runner.
-  live_ate=$(sed -n "s/^\[evaluator_robot$r\] *pose ATE RMSE *\([0-9.]*\) m.*/\1/p" "$work/launch.log")
-  offline_ate=$(sed -n 's/^pose ATE RMSE *\([0-9.]*\) m.*/\1/p' "$work/offline$r.log")
-  awk -v a="$live_ate" -v b="$offline_ate" 'BEGIN { exit !(a != "" && b != "" && a - b < 0.0015 && b - a < 0.0015) }' ||
-    fail "robot $r: live evaluator ATE '$live_ate' m, offline '$offline_ate' m"
-  # Step by step: the same number of steps, the largest position difference.
-  paste -d, "$work/run/robot$r/trajectory.csv" "$work/offline$r/trajectory.csv" | awk -F, -v r="$r" -v max="$max_diff" '
-    NR == 1 { next }
-    $1 == "" || $5 == "" { uneven = 1; next }
-    { n++; d = sqrt(($2 - $6) ^ 2 + ($3 - $7) ^ 2); if (d > worst) worst = d }
-    END {
-      printf "robot %s: %d steps, largest position difference live vs offline %.4f m\n", r, n, worst
-      if (uneven || n == 0 || worst > max) exit 1
-    }' || fail "robot $r: live and offline differ (steps or more than $max_diff m)"
-done
+"$(dirname "$0")/support/live_vs_offline.sh" "$bin" "$config" "$dataset" "$work/run" "$work/launch.log" 1,2 1 \
+  "$duration" "$max_diff" || fail "live and offline differ"
 
 "$bin/pixyslam_log" print "$work/run/run.mcap" --topic pixyslam/fleet_map --json > "$work/fleet.json" ||
   fail "print the fleet map"

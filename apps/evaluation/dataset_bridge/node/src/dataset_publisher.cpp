@@ -22,6 +22,9 @@ const parameters::Table<DatasetBridgeOptions>& dataset_bridge_parameters() {
                  [](O& o) -> double& { return o.rate; }),
       P::integer<O, int>("wait_readers", 0, 100, "", "matched readers per topic to wait for before the first sample",
                          [](O& o) -> int& { return o.wait_readers; }),
+      P::integer<O, int>("wait_readers_per_robot", 0, 100, "",
+                         "... and this many more per robot published (e.g. its estimator and evaluator)",
+                         [](O& o) -> int& { return o.wait_readers_per_robot; }),
       P::real<O>("wait_readers_timeout_s", 0.0, 3600.0, "s", "... at most this long (then it starts anyway)",
                  [](O& o) -> double& { return o.wait_readers_timeout_s; }),
       P::integer<O, int>("flow_batch", 1, 100000, "", "rate 0: samples between waits for every reader's acknowledgement",
@@ -116,14 +119,14 @@ PublishCounters publish_recording(const DatasetBridgeOptions& options,
   dds::Participant participant(options.dds, "dataset_bridge");
   std::vector<std::unique_ptr<RobotWriters>> writers;
   for (const dataset_bridge::RobotStream& r : robots) writers.push_back(std::make_unique<RobotWriters>(participant, r.robot_id));
-  if (options.wait_readers > 0) {
+  const int readers = options.wait_readers + options.wait_readers_per_robot * static_cast<int>(robots.size());
+  if (readers > 0) {
     const auto timeout = std::chrono::milliseconds(static_cast<int>(options.wait_readers_timeout_s * 1000));
     for (auto& w : writers) {
-      if (!w->odometry.wait_for_readers(options.wait_readers, timeout) ||
-          !w->observation.wait_for_readers(options.wait_readers, timeout) ||
-          !w->truth.wait_for_readers(options.wait_readers, timeout)) {
+      if (!w->odometry.wait_for_readers(readers, timeout) || !w->observation.wait_for_readers(readers, timeout) ||
+          !w->truth.wait_for_readers(readers, timeout)) {
         std::fprintf(stderr, "dataset_bridge: fewer than %d readers matched after %.0f s; publishing anyway\n",
-                     options.wait_readers, options.wait_readers_timeout_s);
+                     readers, options.wait_readers_timeout_s);
         break;
       }
     }

@@ -19,6 +19,7 @@ struct DatasetBridgeOptions {
                                      // the readers acknowledge (reliable flow control)
   std::vector<int> robots = {1, 2, 3, 4, 5};  // `dataset_bridge.robots`
   int wait_readers = 0;              // `dataset_bridge.wait_readers`: matched readers per topic before the first sample
+  int wait_readers_per_robot = 0;    // ... plus this many per robot published (its estimator, its evaluator)
   double wait_readers_timeout_s = 10.0;
   int flow_batch = 200;              // rate 0: samples between waits for every reader's acknowledgement
   double ack_timeout_s = 10.0;       // rate 0: longest wait for acknowledgements (then counted, go on)
