@@ -22,6 +22,7 @@
 #   [RUNNER=podman] run_distributed_test.sh BIN_DIR CONFIG_DIR SCRIPTS_DIR PROFILE [MAX_ATE_M]
 set -euo pipefail
 bin=$1 config=$2 scripts=$3 profile=$4 max_ate=${5:-0.15}
+source "$(dirname "$0")/support/netns_lib.sh"
 runner=${RUNNER:-native}
 sim_s=30 cut_at_s=12 cut_s=5
 
@@ -63,8 +64,7 @@ cleanup() {
   if [[ $runner == podman ]]; then
     for h in "${hosts[@]}"; do podman rm -f "${tag}_$h" > /dev/null 2>&1 || true; done
   fi
-  for h in "${hosts[@]}" sw; do ip netns pids "${tag}_$h" 2>/dev/null | xargs -r kill -KILL 2>/dev/null || true; done
-  for h in "${hosts[@]}" sw; do ip netns del "${tag}_$h" 2>/dev/null || true; done
+  netns_remove "$tag" "${hosts[@]}"
   rm -rf "$work"
 }
 trap cleanup EXIT
@@ -72,28 +72,22 @@ trap 'exit 130' INT TERM  # a killed test still cleans up (the EXIT trap)
 
 # The network: one bridge, one veth per host (the robot's link emulated when asked).
 link_schedule=${LINK_SCHEDULE:-}
-ip netns add "${tag}_sw"
-ip -n "${tag}_sw" link add br0 type bridge mcast_snooping 0
-ip -n "${tag}_sw" link set br0 up
+netns_switch "$tag"
 i=0
 for h in "${hosts[@]}"; do
   i=$((i + 1))
-  ip netns add "${tag}_$h"
   if [[ -n $link_schedule && $h == robot ]]; then
+    ip netns add "${tag}_$h"
     "$LINK_EMULATOR" --a "${tag}_robot:eth0" --b "${tag}_sw:v_robot" --schedule "$link_schedule" \
       > "$work/link_emulator.log" 2>&1 &
     emulator=$!
     pids+=($emulator)
     for _ in $(seq 50); do grep -q ready "$work/link_emulator.log" && break; sleep 0.1; done
     grep -q ready "$work/link_emulator.log" || { cat "$work/link_emulator.log"; echo "FAIL: link_emulator"; exit 1; }
+    netns_attach "$tag" "$h" "10.200.$net.$i/24"
   else
-    ip link add "v_$h" netns "${tag}_sw" type veth peer name eth0 netns "${tag}_$h"
+    netns_host "$tag" "$h" "10.200.$net.$i/24"
   fi
-  ip -n "${tag}_sw" link set "v_$h" master br0 up
-  ip -n "${tag}_$h" link set lo up
-  ip -n "${tag}_$h" addr add "10.200.$net.$i/24" dev eth0
-  ip -n "${tag}_$h" link set eth0 up
-  ip -n "${tag}_$h" route add 224.0.0.0/4 dev eth0
 done
 echo "namespaces ${tag}_{${hosts[*]}, sw}, network 10.200.$net.0/24, profile $profile, runner $runner"
 
