@@ -7,7 +7,8 @@
 # exist (they retry), so what flows is discovery and the 1 Hz diagnostics.
 # With --sim, once every reader matched, a robot_sim per robot (world.seed =
 # the robot's number, ground truth on DDS: 4N participants) drives SETTLE_S
-# simulated seconds in real time: then the sensor data flows too, and each
+# simulated seconds in real time (measured from 10 s after they started):
+# then the sensor data flows too, and each
 # estimator's input counts (its own robot's samples, the others' it dropped)
 # are printed from its final line.
 # Prints: the time until every estimator's Odometry reader matched all N
@@ -15,10 +16,11 @@
 # per process kind over SETTLE_S seconds, and the bytes on the namespace's
 # loopback (start-up and steady state per second).
 #   scripts/fleet_scale.sh N multicast|server [SETTLE_S] [--sim]     (docs/deployment.md)
-# Exit status: 0 measured, 1 the readers did not all match within 120 s, 2 usage,
+# Exit status: 0 measured, 1 the readers did not all match within 120 s (or,
+# --sim, an estimator got none of its robot's samples or lost some), 2 usage,
 # 77 not root (skipped).
 set -euo pipefail
-usage() { sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; }
 case ${1:-} in -h | --help) usage; exit 0 ;; esac
 sim=0
 args=()
@@ -97,19 +99,23 @@ startup_bytes=$(($(rx_bytes) - start_bytes))
 declare -A cpu0
 ticks=$(getconf CLK_TCK)
 cpu_of() { awk '{print $14 + $15}' "/proc/$1/stat" 2>/dev/null || echo 0; }
-for pid in "${!kind_of[@]}"; do cpu0[$pid]=$(cpu_of "$pid"); done
-settle_bytes0=$(rx_bytes)
+warmup_s=0
 if ((sim)); then
   # Each robot drives (its bridges open the pseudo-terminals within reopen_period_s); measured
-  # over SETTLE_S s while all drive, then stopped.
+  # over SETTLE_S s while all drive, from WARMUP_S after they started (the sims' own
+  # participants discovered, the bridges' devices open), then stopped.
+  warmup_s=10
   sims=()
   for r in $(seq "$n"); do
-    ip netns exec "$ns" env "${env_common[@]}" "$bin/robot_sim" --config "$root/config/robot_sim.yaml" --duration $((settle + 60)) \
-      --arduino-link "$work/arduino$r" --pixy-link "$work/pixy$r" --set "world.seed=$r" --set "dds.robot_id=robot$r" \
-      > "$work/sim$r.log" 2>&1 &
-    pids+=($!); kind_of[$!]=robot_sim; cpu0[$!]=0; sims+=($!)
+    ip netns exec "$ns" env "${env_common[@]}" "$bin/robot_sim" --config "$root/config/robot_sim.yaml" \
+      --duration $((warmup_s + settle + 60)) --arduino-link "$work/arduino$r" --pixy-link "$work/pixy$r" \
+      --set "world.seed=$r" --set "dds.robot_id=robot$r" > "$work/sim$r.log" 2>&1 &
+    pids+=($!); kind_of[$!]=robot_sim; sims+=($!)
   done
+  sleep "$warmup_s"
 fi
+for pid in "${!kind_of[@]}"; do cpu0[$pid]=$(cpu_of "$pid"); done
+settle_bytes0=$(rx_bytes)
 sleep "$settle"
 settle_bytes=$(($(rx_bytes) - settle_bytes0))
 participants=$((3 * n))
@@ -117,7 +123,7 @@ traffic="discovery + 1 Hz diagnostics"
 if ((sim)); then participants=$((4 * n)) traffic="discovery, diagnostics and every robot's sensor data"; fi
 echo "fleet_scale: $n robots, $participants participants (+ the spy), $mode discovery, namespace loopback"
 echo "  every estimator's Odometry reader matched all $n writers after $matched_s s (spy polls of 1 s)"
-echo "  loopback traffic: $((startup_bytes / 1024)) KiB until then, $((settle_bytes / settle / 1024)) KiB/s over the next ${settle} s ($traffic)"
+echo "  loopback traffic: $((startup_bytes / 1024)) KiB until then, $((settle_bytes / settle / 1024)) KiB/s over ${settle} s from ${warmup_s} s later ($traffic)"
 for kind in encoder_bridge pixy_bridge slam_estimator robot_sim; do
   cpu=0 rss=0 count=0
   for pid in "${!kind_of[@]}"; do
@@ -145,5 +151,6 @@ if ((sim)); then
         if (NR != n) { printf "  estimators: %d of %d final lines\n", NR, n; exit 1 }
         printf "  each estimator took its own robot: odometry %d-%d, observations %d-%d (lost %d, late %d in all)\n", lo["odo"], hi["odo"], lo["obs"], hi["obs"], lost, late
         printf "  and dropped the other robots%s samples: %d-%d each (%.1f per own sample)\n", "\047", lo["other"], hi["other"], others / own
-      }' || { echo "fleet_scale: not every estimator reported its input"; exit 1; }
+        if (lo["odo"] == 0 || lo["obs"] == 0 || lost > 0) { print "  FAIL: an estimator got none of its robot%s samples, or lost some", "\047"; exit 1 }
+      }' || { echo "fleet_scale: the estimators' input (above) is incomplete"; exit 1; }
 fi
