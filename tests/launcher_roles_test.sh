@@ -2,7 +2,8 @@
 # ctest launcher_roles: an optional process that fails is reported and
 # restarted with back-off while the essential ones go on; an essential one that
 # fails stops the run; an optional one exiting 2 (configuration error) is not
-# restarted.
+# restarted; with several processes marked ends_run (a for_each over robots),
+# the run ends with the last of them.
 #   launcher_roles_test.sh LAUNCHER
 set -euo pipefail
 launcher=$1
@@ -53,4 +54,27 @@ elapsed=$(( $(date +%s) - start ))
 cat "$work/essential.log"
 grep -q "stopping after .* (a process failed)" "$work/essential.log" || fail "an essential failure did not stop the run"
 [[ $elapsed -lt 10 && $status -eq 1 ]] || fail "essential failure: exit $status after $elapsed s"
+
+cat > "$work/ends.yaml" <<'YAML'
+launch:
+  stop_timeout_s: 1
+  arguments:
+    robots: {default: '1,3', help: "robots"}
+  processes:
+    - name: robot${robot}
+      for_each: {robot: '${robots}'}
+      command: [/bin/sh, -c, "sleep ${robot}; echo robot ${robot} done"]
+      ends_run: true
+    - name: listener
+      command: [/bin/sleep, "30"]
+YAML
+start=$(date +%s)
+status=0
+"$launcher" "$work/ends.yaml" --run-dir "$work/run3" > "$work/ends.log" 2>&1 || status=$?
+elapsed=$(( $(date +%s) - start ))
+cat "$work/ends.log"
+grep -q "\[robot3\] robot 3 done" "$work/ends.log" || fail "the run ended before the last ends_run process"
+grep -qF "robot1 finished; the run goes on until 1 more process(es) marked ends_run finish" "$work/ends.log" ||
+  fail "the first ends_run process's end not reported"
+[[ $elapsed -ge 3 && $elapsed -lt 10 && $status -eq 0 ]] || fail "ends_run: exit $status after $elapsed s"
 echo PASS

@@ -1,6 +1,7 @@
 // pixyslam_launch: starts the processes of a launch file, forwards their output
-// with a prefix, stops them all on Ctrl-C, after duration_s or when a process
-// marked ends_run finishes, then runs the after_run commands (evaluation).
+// with a prefix, stops them all on Ctrl-C, after duration_s or when the
+// processes marked ends_run have finished, then runs the after_run commands
+// (evaluation).
 //   pixyslam_launch config/launch_sim.yaml [NAME:=VALUE ...] [--run-dir DIR] [--duration S] [--input FILE]
 //                   [--deployment DEPLOY.yaml --host NAME] [--show-args]
 // NAME:=VALUE: launch arguments (duration, and those the file declares).
@@ -64,14 +65,18 @@ Clock::duration seconds(double s) {
 
 // One run of a launch plan: starts its processes (each after its delay),
 // supervises them (an optional one that fails is restarted with back-off, an
-// essential one's failure stops the run, as does an ends_run process's exit,
+// essential one's failure stops the run, as does the exit of the last process
+// marked ends_run (with for_each, every robot's),
 // the duration or a signal), stops them all, runs the after-run steps and
 // prints the summary. Single-threaded; run() once.
 class LaunchSession {
  public:
   LaunchSession(launcher::LaunchPlan plan, const std::string& bin_dir,
                 std::unique_ptr<launcher::HealthMonitor> health)
-      : plan_(std::move(plan)), group_(bin_dir, stdout), health_(std::move(health)) {}
+      : plan_(std::move(plan)), group_(bin_dir, stdout), health_(std::move(health)) {
+    ends_run_left_ = std::count_if(plan_.processes.begin(), plan_.processes.end(),
+                                   [](const launcher::ProcessSpec& p) { return p.ends_run; });
+  }
 
   // The exit status: 0 only if every process ended cleanly.
   int run(const std::string& run_dir) {
@@ -126,7 +131,13 @@ class LaunchSession {
       failed_ = true;
       return false;
     }
-    return !spec.ends_run;
+    if (!spec.ends_run) return true;
+    if (--ends_run_left_ > 0) {
+      std::printf("[launch] %s finished; the run goes on until %ld more process(es) marked ends_run finish\n",
+                  spec.name.c_str(), ends_run_left_);
+      return true;
+    }
+    return false;
   }
 
   void start_due_restarts() {
@@ -199,6 +210,7 @@ class LaunchSession {
   std::vector<Restart> restarts_;
   std::map<std::string, int> failures_;  // per optional process name
   bool failed_ = false;
+  long ends_run_left_ = 0;  // processes marked ends_run that have not finished yet
 };
 
 struct LaunchCommandLine {
@@ -269,7 +281,7 @@ int main(int argc, char** argv) {
   signal(SIGPIPE, SIG_IGN);
   LaunchCommandLine args;
   app::Cli cli{"pixyslam_launch", "Starts the processes of a launch file, forwards their output with a prefix, stops them all on "
-               "Ctrl-C, after the duration or when a process marked ends_run finishes, then runs the after_run "
+               "Ctrl-C, after the duration or when the processes marked ends_run have finished, then runs the after_run "
                "steps. Exit code 0 only if every process ended cleanly."};
   cli.option("launch_file", args.launch_file, "e.g. config/launch_sim.yaml").required().existing_file()
       .type("LAUNCH.yaml");
