@@ -105,6 +105,27 @@ TEST(Visualiser, PathIsBoundedAndKeepsItsEnds) {
   EXPECT_EQ(path.poses()[0].position().x(), 0.045);
 }
 
+TEST(Visualiser, OnlyWantedChannelsAreBuiltAndThePathGrowsMeanwhile) {
+  Visualiser v;
+  const auto none = [](VisualChannel) { return false; };
+  for (int i = 0; i < 5; ++i) EXPECT_TRUE(v.on_map_state(state_with_landmarks(i + 1, 0.1 * i), none).empty());
+  const std::vector<VisualMessage> out =
+      v.on_map_state(state_with_landmarks(6, 0.5), [](VisualChannel c) { return c == VisualChannel::kPath; });
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].channel, VisualChannel::kPath);
+  ::foxglove::PosesInFramePubSubType type;
+  ::foxglove::PosesInFrame path;
+  std::string error;
+  ASSERT_TRUE(dds::deserialize_payload(type, out[0].cdr.data(), out[0].cdr.size(), &path, error)) << error;
+  EXPECT_EQ(path.poses().size(), 6u);  // the five unwanted states' poses too
+  msg::GroundTruth truth;
+  truth.landmarks().resize(3);
+  const std::vector<VisualMessage> true_out =
+      v.on_ground_truth(truth, [](VisualChannel c) { return c == VisualChannel::kTrueLandmarks; });
+  ASSERT_EQ(true_out.size(), 1u);
+  EXPECT_EQ(true_out[0].channel, VisualChannel::kTrueLandmarks);
+}
+
 TEST(Visualiser, MalformedPayloadIsRefusedOthersIgnored) {
   Visualiser v;
   std::vector<VisualMessage> out;

@@ -175,8 +175,7 @@ fg::SceneUpdate Visualiser::estimate_scene(const msg::MapState& state) const {
   return update;
 }
 
-fg::PosesInFrame Visualiser::extend_path(std::deque<msg::Pose2D>& path, const msg::Pose2D& pose,
-                                         std::uint64_t stamp_ns) const {
+void Visualiser::extend_path(std::deque<msg::Pose2D>& path, const msg::Pose2D& pose) const {
   if (path.empty() ||
       std::hypot(pose.x_m() - path.back().x_m(), pose.y_m() - path.back().y_m()) >= options_.path_min_step_m) {
     path.push_back(pose);
@@ -190,6 +189,9 @@ fg::PosesInFrame Visualiser::extend_path(std::deque<msg::Pose2D>& path, const ms
     kept.push_back(path.back());
     path.swap(kept);
   }
+}
+
+fg::PosesInFrame Visualiser::path_message(const std::deque<msg::Pose2D>& path, std::uint64_t stamp_ns) const {
   fg::PosesInFrame out;
   out.timestamp(to_time(stamp_ns));
   out.frame_id(options_.map_frame);
@@ -197,29 +199,42 @@ fg::PosesInFrame Visualiser::extend_path(std::deque<msg::Pose2D>& path, const ms
   return out;
 }
 
-std::vector<VisualMessage> Visualiser::on_map_state(const msg::MapState& state) {
+std::vector<VisualMessage> Visualiser::on_map_state(const msg::MapState& state, const ChannelFilter& wanted) {
   const std::uint64_t stamp = state.header().stamp_ns();
+  const auto want = [&](VisualChannel c) { return !wanted || wanted(c); };
+  extend_path(path_, state.mean_pose());
   std::vector<VisualMessage> out;
-  out.push_back(serialized(serializers_->scene, VisualChannel::kLandmarks, stamp, landmark_scene(state)));
-  out.push_back(serialized(serializers_->scene, VisualChannel::kEstimate, stamp, estimate_scene(state)));
-  out.push_back(serialized(serializers_->poses, VisualChannel::kPath, stamp,
-                                                        extend_path(path_, state.mean_pose(), stamp)));
-  fg::FrameTransform tf;
-  tf.timestamp(to_time(stamp));
-  tf.parent_frame_id(options_.map_frame);
-  tf.child_frame_id(options_.robot_frame);
-  tf.translation().x(state.mean_pose().x_m());
-  tf.translation().y(state.mean_pose().y_m());
-  tf.rotation(yaw_quaternion(state.mean_pose().theta_rad()));
-  out.push_back(serialized(serializers_->transform, VisualChannel::kTransform, stamp, tf));
+  if (want(VisualChannel::kLandmarks)) {
+    out.push_back(serialized(serializers_->scene, VisualChannel::kLandmarks, stamp, landmark_scene(state)));
+  }
+  if (want(VisualChannel::kEstimate)) {
+    out.push_back(serialized(serializers_->scene, VisualChannel::kEstimate, stamp, estimate_scene(state)));
+  }
+  if (want(VisualChannel::kPath)) {
+    out.push_back(serialized(serializers_->poses, VisualChannel::kPath, stamp, path_message(path_, stamp)));
+  }
+  if (want(VisualChannel::kTransform)) {
+    fg::FrameTransform tf;
+    tf.timestamp(to_time(stamp));
+    tf.parent_frame_id(options_.map_frame);
+    tf.child_frame_id(options_.robot_frame);
+    tf.translation().x(state.mean_pose().x_m());
+    tf.translation().y(state.mean_pose().y_m());
+    tf.rotation(yaw_quaternion(state.mean_pose().theta_rad()));
+    out.push_back(serialized(serializers_->transform, VisualChannel::kTransform, stamp, tf));
+  }
   return out;
 }
 
-std::vector<VisualMessage> Visualiser::on_ground_truth(const msg::GroundTruth& truth) {
+std::vector<VisualMessage> Visualiser::on_ground_truth(const msg::GroundTruth& truth, const ChannelFilter& wanted) {
   const std::uint64_t stamp = truth.header().stamp_ns();
+  const auto want = [&](VisualChannel c) { return !wanted || wanted(c); };
+  extend_path(true_path_, truth.pose());
   std::vector<VisualMessage> out;
-  out.push_back(serialized(serializers_->poses, VisualChannel::kTruePath, stamp,
-                                                        extend_path(true_path_, truth.pose(), stamp)));
+  if (want(VisualChannel::kTruePath)) {
+    out.push_back(serialized(serializers_->poses, VisualChannel::kTruePath, stamp, path_message(true_path_, stamp)));
+  }
+  if (!want(VisualChannel::kTrueLandmarks)) return out;
   fg::SceneUpdate update = replacing_all(stamp);
   for (const msg::TrueLandmark& l : truth.landmarks()) {
     fg::SceneEntity e = entity(options_.map_frame, "true_landmark_" + std::to_string(l.landmark_id()), stamp,

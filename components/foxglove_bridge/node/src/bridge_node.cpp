@@ -99,12 +99,14 @@ template <class Message>
 void BridgeNode::on_sample(std::uint32_t channel_id, const Message& message) {
   if (server_->has_subscribers(channel_id)) forward(channel_id, dds::to_cdr(message));
   if (!options_.visuals) return;
+  // Only the scene messages a client subscribed to are built (the paths grow regardless).
+  const auto subscribed = [this](foxglove::VisualChannel c) { return server_->has_subscribers(visual_channel_id(c)); };
   if constexpr (std::is_same_v<Message, msg::MapState>) {
     std::lock_guard<std::mutex> lock(visual_mutex_);
-    visualise(visualiser_.on_map_state(message));
+    visualise(visualiser_.on_map_state(message, subscribed));
   } else if constexpr (std::is_same_v<Message, msg::GroundTruth>) {
     std::lock_guard<std::mutex> lock(visual_mutex_);
-    visualise(visualiser_.on_ground_truth(message));
+    visualise(visualiser_.on_ground_truth(message, subscribed));
   }
 }
 

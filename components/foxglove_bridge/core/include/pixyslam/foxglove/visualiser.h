@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -71,10 +72,14 @@ class Visualiser {
   Visualiser(const Visualiser&) = delete;
   Visualiser& operator=(const Visualiser&) = delete;
 
+  // Which channels to build and serialize (empty: all). The paths grow either
+  // way, so a channel wanted later starts with the whole path.
+  using ChannelFilter = std::function<bool(VisualChannel)>;
+
   // Landmarks, particles and pose ellipse, path, transform.
-  std::vector<VisualMessage> on_map_state(const msg::MapState& state);
+  std::vector<VisualMessage> on_map_state(const msg::MapState& state, const ChannelFilter& wanted = {});
   // True path and true landmarks.
-  std::vector<VisualMessage> on_ground_truth(const msg::GroundTruth& truth);
+  std::vector<VisualMessage> on_ground_truth(const msg::GroundTruth& truth, const ChannelFilter& wanted = {});
   // Decodes a CDR payload of `type_name` and calls the above; other types give
   // nothing. Returns false with `error` set when the payload does not decode.
   bool on_payload(std::string_view type_name, const std::vector<std::uint8_t>& payload,
@@ -85,9 +90,9 @@ class Visualiser {
   ::foxglove::SceneUpdate estimate_scene(const msg::MapState& state) const;
 
  private:
-  // Adds `pose` to `path` (decimating) and returns the PosesInFrame.
-  ::foxglove::PosesInFrame extend_path(std::deque<msg::Pose2D>& path, const msg::Pose2D& pose,
-                                       std::uint64_t stamp_ns) const;
+  // Adds `pose` to `path` (decimating).
+  void extend_path(std::deque<msg::Pose2D>& path, const msg::Pose2D& pose) const;
+  ::foxglove::PosesInFrame path_message(const std::deque<msg::Pose2D>& path, std::uint64_t stamp_ns) const;
 
   // The generated serializers, made once: their constructors walk the nested
   // unbounded sequences (fastddsgen's maximum size), far too slow per message.

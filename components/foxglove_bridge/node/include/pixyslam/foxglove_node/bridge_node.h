@@ -26,7 +26,7 @@ struct BridgeCounters {
   std::uint64_t samples_received = 0;   // DDS samples of every bridged topic
   std::uint64_t samples_malformed = 0;  // did not decode (dropped by the readers)
   std::uint64_t seq_gaps = 0;           // header seq numbers skipped, per writer
-  std::uint64_t visual_messages = 0;    // pixyslam/viz/* messages made
+  std::uint64_t visual_messages = 0;    // pixyslam/viz/* messages made (for subscribed channels only)
 };
 
 // The foxglove_bridge process: every selected DDS topic as a Foxglove channel
