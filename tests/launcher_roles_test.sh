@@ -24,10 +24,17 @@ launch:
       command: [/bin/sh, -c, "sleep 4; echo essential done"]
       ends_run: true
 YAML
-status=0
-"$launcher" "$work/optional.yaml" --run-dir "$work/run1" > "$work/optional.log" 2>&1 || status=$?
-cat "$work/optional.log"
 fail() { echo "FAIL: $*"; exit 1; }
+# run_launch NAME: runs $work/NAME.yaml into $work/NAME.log (printed); sets status and elapsed (s).
+run_launch() {
+  local start
+  start=$(date +%s)
+  status=0
+  "$launcher" "$work/$1.yaml" --run-dir "$work/run_$1" > "$work/$1.log" 2>&1 || status=$?
+  elapsed=$(( $(date +%s) - start ))
+  cat "$work/$1.log"
+}
+run_launch optional
 grep -q "\[essential\] essential done" "$work/optional.log" || fail "the essential process did not run to its end"
 restarts=$(grep -c "restarting flaky" "$work/optional.log" || true)
 # Back-off 1 + 2 s within the 4 s run: two restarts (a third would come at 7 s).
@@ -47,11 +54,7 @@ launch:
     - name: broken
       command: [/bin/sh, -c, "sleep 0.5; exit 3"]
 YAML
-start=$(date +%s)
-status=0
-"$launcher" "$work/essential.yaml" --run-dir "$work/run2" > "$work/essential.log" 2>&1 || status=$?
-elapsed=$(( $(date +%s) - start ))
-cat "$work/essential.log"
+run_launch essential
 grep -q "stopping after .* (a process failed)" "$work/essential.log" || fail "an essential failure did not stop the run"
 [[ $elapsed -lt 10 && $status -eq 1 ]] || fail "essential failure: exit $status after $elapsed s"
 
@@ -68,11 +71,7 @@ launch:
     - name: listener
       command: [/bin/sleep, "30"]
 YAML
-start=$(date +%s)
-status=0
-"$launcher" "$work/ends.yaml" --run-dir "$work/run3" > "$work/ends.log" 2>&1 || status=$?
-elapsed=$(( $(date +%s) - start ))
-cat "$work/ends.log"
+run_launch ends
 grep -q "\[robot3\] robot 3 done" "$work/ends.log" || fail "the run ended before the last ends_run process"
 grep -qF "robot1 finished; the run goes on until 1 more process(es) marked ends_run finish" "$work/ends.log" ||
   fail "the first ends_run process's end not reported"
