@@ -43,5 +43,7 @@ for role in robot estimator logger viewer; do
     --build-arg PACKAGES_ID="$packages_id" \
     -t "localhost/pixyslam-$role:latest" "$root" > /dev/null
 done
+# The previous builds' images, untagged now: only ours (the Dockerfile's label), nobody else's.
+"$engine" image prune -f --filter label=org.pixyslam.image > /dev/null || true
 echo "build_images: packages from $packages ($packages_id), $(($(date +%s) - start)) s"
 "$engine" images --format '{{.Repository}}:{{.Tag}} {{.Size}}' | grep "pixyslam-" | sort
