@@ -17,10 +17,7 @@ RobotStream make_robot_stream(const mrclam::RobotData& data, const offline::Mrcl
 void keep_first_seconds(RobotStream& stream, double duration_s) {
   if (duration_s <= 0.0) return;
   offline::keep_first_seconds(stream.input, duration_s);
-  const double end_s = stream.input.start_time_s + duration_s;
-  stream.sightings.erase(std::remove_if(stream.sightings.begin(), stream.sightings.end(),
-                                        [end_s](const slam::ObservationFrame& f) { return f.t_s > end_s; }),
-                         stream.sightings.end());
+  offline::erase_after(stream.sightings, stream.input.start_time_s + duration_s);
 }
 
 std::vector<Event> merge_timeline(const std::vector<RobotStream>& robots) {

@@ -285,16 +285,9 @@ RunInput mrclam_input(const mrclam::RobotData& d, const MrclamSensorModel& model
 void keep_first_seconds(RunInput& input, double duration_s) {
   if (duration_s <= 0.0) return;
   const double end_s = input.start_time_s + duration_s;
-  const auto after = [end_s](double t_s) { return t_s > end_s; };
-  input.truth.erase(std::remove_if(input.truth.begin(), input.truth.end(),
-                                   [&](const eval::TimedPose& p) { return after(p.t_s); }),
-                    input.truth.end());
-  input.odometry.erase(std::remove_if(input.odometry.begin(), input.odometry.end(),
-                                      [&](const slam::OdometrySample& o) { return after(o.t_s); }),
-                       input.odometry.end());
-  input.frames.erase(std::remove_if(input.frames.begin(), input.frames.end(),
-                                    [&](const slam::ObservationFrame& f) { return after(f.t_s); }),
-                     input.frames.end());
+  erase_after(input.truth, end_s);
+  erase_after(input.odometry, end_s);
+  erase_after(input.frames, end_s);
 }
 
 slam::ObservationFrame mrclam_frame(const mrclam::MeasurementFrame& f, const MrclamSensorModel& model) {

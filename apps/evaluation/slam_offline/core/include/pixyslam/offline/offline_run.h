@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <functional>
 #include <string>
 #include <vector>
@@ -120,6 +121,12 @@ RunInput mrclam_input(const mrclam::RobotData& data, const MrclamSensorModel& mo
 // Keeps the first `duration_s` seconds of `input` from its start_time_s (the
 // truth, odometry and frames stamped after that go); <= 0 keeps everything.
 void keep_first_seconds(RunInput& input, double duration_s);
+// Erases the items stamped (`t_s`) after `end_s`.
+template <class Stamped>
+void erase_after(std::vector<Stamped>& items, double end_s) {
+  items.erase(std::remove_if(items.begin(), items.end(), [end_s](const Stamped& s) { return s.t_s > end_s; }),
+              items.end());
+}
 // One camera image's detections with the model's range correction (subject as landmark_id).
 slam::ObservationFrame mrclam_frame(const mrclam::MeasurementFrame& frame, const MrclamSensorModel& model);
 }  // namespace pixyslam::offline
