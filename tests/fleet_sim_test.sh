@@ -22,7 +22,7 @@ status=0
 PIXYSLAM_DDS_DOMAIN=$((60 + $$ % 40)) "$bin/pixyslam_launch" "$work/config/launch_fleet_sim.yaml" \
   --run-dir "$work/run" > "$work/launch.log" 2>&1 || status=$?
 log=$work/launch.log
-grep -E "odometry published|observations published|slam_estimator: odometry|pose ATE RMSE|robots robot|check passed|exit code" "$log"
+grep -E "odometry published|observations published|slam_estimator: odometry|pose ATE RMSE|robots robot|\[log_check\]|exit code" "$log"
 [[ $status -eq 0 ]] || fail "pixyslam_launch exited with $status"
 if grep -q "<- FAILED" "$log"; then fail "a process failed"; fi
 grep -q "check passed" "$log" || fail "the log check"
