@@ -527,6 +527,7 @@ void print_fleet(const std::map<int, FleetRuns>& fleet) {
 struct EvalArguments {
   std::string dataset, config_path, association = "known_id", out_dir;
   std::vector<int> robots{1, 2, 3, 4, 5}, seeds{1, 2, 3};
+  std::vector<std::string> sets;  // --set: filter.KEY=V or mrclam.KEY=V
   double segment_every_s = 0.0;  // 0: no segments
   bool loro = false, blind_return = false, optimise = false;
 };
@@ -546,8 +547,18 @@ int run(const EvalArguments& args) {
   config::YamlReader root = config::YamlReader::from_file(config_path);
   config::YamlReader filter_yaml = root.child("filter");
   slam::FilterOptions options = slam::read_filter_options(filter_yaml);
-  const offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
+  offline::MrclamSensorModel model = offline::read_mrclam_sensor_model(root);
   root.finish();
+  std::vector<std::string> filter_sets = args.sets;
+  const std::vector<std::string> mrclam_sets = parameters::take_section(filter_sets, "mrclam");
+  try {
+    slam::apply_overrides(options, filter_sets);
+    for (const std::string& a : mrclam_sets) {
+      parameters::apply_override(model, offline::mrclam_sensor_parameters(), "mrclam", a);
+    }
+  } catch (const std::invalid_argument& e) {
+    throw app::UsageError(std::string("--set: ") + e.what());
+  }
   if (association == "maximum_likelihood") options.association = slam::Association::kMaximumLikelihood;
   CsvOutput csv(args.out_dir);
 
@@ -700,6 +711,7 @@ int main(int argc, char** argv) {
                "several seeds per robot; segment starts, leave-one-robot-out and blind-return evaluations."};
   cli.option("--dataset", a.dataset, "the MRCLAM data set folder (exit 77 when absent: a skip)").required().type("DIR");
   app::add_config(cli, a.config_path, "filter options (filter:) and corrections (mrclam:)");
+  app::add_set(cli, a.sets, "filter.delayed_sampling.split_heading=true or mrclam.odometry_delay_s=0");
   cli.option("--robots", robots, "robots to run (default 1,2,3,4,5)").type("LIST");
   cli.option("--seeds", seeds, "filter seeds per robot (default 1,2,3)").type("LIST");
   cli.option("--association", a.association, "known_id (default) or maximum_likelihood (ids withheld)")

@@ -261,5 +261,49 @@ TEST(JointGaussian, IteratedFitReachesTheMapOfALargeCorrection) {
   EXPECT_TRUE(again.innovation.isApprox(once.innovation, 1e-9) || again.innovation.norm() < 1e-12);
 }
 
+// A heading 0.3 rad uncertain, a landmark first seen 7 m ahead from that pose
+// (relative) and one mapped before (known). Split 0.15 rad apart: the
+// components are symmetric, their weights and moments make up the heading's
+// Gaussian, each component's heading sd is half the spacing, the relative
+// landmark stays 7 m ahead of each component's pose (on its arc; the tangent
+// of a linear update would put it sqrt(49 + (7 delta)^2) m away), the known
+// one stays where it was, and the first estimate turns with the pose.
+TEST(JointGaussian, HeadingSplitTurnsRelativeLandmarksOnTheirArcs) {
+  const double sigma = 0.3;
+  const double spacing = 0.15;
+  JointGaussian g;
+  g.begin(pose_gaussian(Pose2(1.0, 2.0, 0.5), Eigen::Vector3d(0.04, 0.04, sigma * sigma)));
+  const int ahead = g.add_new(3, Eigen::Vector2d(7.0, 0.0), noise(0.05, 0.01));
+  const Eigen::Vector2d known_position(-2.0, 4.0);
+  const int known = g.add_known(9, known_position, 1e-4 * Eigen::Matrix2d::Identity());
+  const std::vector<HeadingComponent> parts = split_heading(g, spacing);
+  ASSERT_GE(parts.size(), 11u);
+  ASSERT_EQ(parts.size() % 2, 1u);
+  double weight = 0.0, mean = 0.0, second = 0.0, largest = 0.0;
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const JointGaussian& c = parts[k].state;
+    const double delta = wrap_angle(c.mean(2) - g.mean(2));
+    EXPECT_NEAR(parts[k].weight, parts[parts.size() - 1 - k].weight, 1e-12);
+    EXPECT_NEAR(std::sqrt(c.cov(2, 2)), 0.5 * spacing, 1e-9);
+    EXPECT_NEAR((c.landmark_mean(ahead) - c.mean.head<2>()).norm(), 7.0, 1e-9) << delta;
+    EXPECT_TRUE(c.landmark_mean(known).isApprox(known_position, 1e-12));
+    const Eigen::Vector2d first_ahead = c.first[static_cast<std::size_t>(ahead)] - c.frame_pose.head<2>();
+    EXPECT_NEAR(std::atan2(first_ahead.y(), first_ahead.x()), c.frame_pose(2), 1e-9);
+    EXPECT_TRUE(c.healthy());
+    weight += parts[k].weight;
+    mean += parts[k].weight * delta;
+    second += parts[k].weight * (delta * delta + c.cov(2, 2));
+    largest = std::max(largest, std::abs(delta));
+  }
+  EXPECT_NEAR(weight, 1.0, 1e-12);
+  EXPECT_NEAR(mean, 0.0, 1e-12);
+  EXPECT_NEAR(second, sigma * sigma, 0.02 * sigma * sigma);
+  EXPECT_GE(largest, 2.5 * sigma);
+  // Nothing to split when the heading is already as narrow as a component.
+  JointGaussian narrow;
+  narrow.begin(pose_gaussian(Pose2(0.0, 0.0, 0.0), Eigen::Vector3d(0.04, 0.04, 0.05 * 0.05)));
+  EXPECT_TRUE(split_heading(narrow, spacing).empty());
+}
+
 }  // namespace
 }  // namespace pixyslam::slam

@@ -510,6 +510,7 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
     if (decision_[k] == Decision::kNewDone) log_w += new_log_likelihood_[k];
   }
   bool end_joint = false;
+  if (options_.delayed_sampling.split_heading) log_w += draw_heading_at_return(p);
   for (std::size_t k = 0; k < n; ++k) {
     if (decision_[k] == Decision::kNewDone) continue;
     int i = g.find(slots_[k]);
@@ -606,6 +607,65 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
     lm.mean = g.landmark_mean(i);
     lm.cov = g.landmark_cov(i);
   }
+}
+
+double FastSlam2::draw_heading_at_return(Particle& p) {
+  // Split only a heading too uncertain to sample from (the joint state's own
+  // threshold), into components that narrow.
+  JointGaussian& g = p.joint;
+  const double spacing = options_.delayed_sampling.enter_heading_sigma_rad;
+  if (!(std::sqrt(g.cov(2, 2)) > spacing)) return 0.0;
+  // The frame's detections of landmarks mapped outside this state (absolute
+  // references); the relative ones turn with the pose and cannot tell.
+  known_.clear();
+  for (std::size_t k = 0; k < decision_.size(); ++k) {
+    if (decision_[k] == Decision::kNewDone) continue;
+    int i = g.find(slots_[k]);
+    if (i < 0) {
+      const Landmark* lm = p.map.find(slots_[k]);
+      i = g.add_known(slots_[k], lm->mean, lm->cov);
+    }
+    if (g.relative[static_cast<std::size_t>(i)] == 0) known_.push_back(k);
+  }
+  if (known_.empty()) return 0.0;
+  std::vector<HeadingComponent> components = split_heading(g, spacing);
+  if (components.size() < 2) return 0.0;
+  std::vector<double> log_likelihood(components.size(), 0.0);
+  std::vector<double> log_posterior(components.size(), 0.0);
+  double best = -std::numeric_limits<double>::infinity();
+  for (std::size_t c = 0; c < components.size(); ++c) {
+    JointGaussian s = components[c].state;
+    s.begin_frame();
+    double ll = 0.0;
+    for (const std::size_t k : known_) {
+      const int i = s.find(slots_[k]);
+      if ((s.landmark_mean(i) - s.mean.head<2>()).squaredNorm() < kMinLandmarkDistanceSq) continue;
+      const JointFit fit = fit_observation(s, i, z_[k], r_[k]);
+      if (!std::isfinite(fit.mahalanobis2) || !std::isfinite(fit.log_likelihood)) continue;
+      if (options_.gate_enabled && fit.mahalanobis2 > gate_d2_) {
+        ll += fit.log_likelihood + 0.5 * (fit.mahalanobis2 - gate_d2_);
+        continue;
+      }
+      ll += fit.log_likelihood;
+      if (!apply_observation(s, fit)) break;
+    }
+    log_likelihood[c] = ll;
+    log_posterior[c] = std::log(components[c].weight) + ll;
+    best = std::max(best, log_posterior[c]);
+  }
+  double total = 0.0;
+  for (double& l : log_posterior) total += std::exp(l - best);
+  std::uniform_real_distribution<double> uniform(0.0, total);
+  double u = uniform(rng_);
+  std::size_t chosen = 0;
+  for (; chosen + 1 < components.size(); ++chosen) {
+    u -= std::exp(log_posterior[chosen] - best);
+    if (u <= 0.0) break;
+  }
+  ++counters_.joint_heading_splits;
+  g = std::move(components[chosen].state);
+  g.begin_frame();
+  return best + std::log(total) - log_likelihood[chosen];
 }
 
 void FastSlam2::finish_joint(Particle& p) {

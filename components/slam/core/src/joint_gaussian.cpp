@@ -29,6 +29,7 @@ int append_block(JointGaussian& g, std::uint32_t slot) {
   g.cov.rightCols<2>().setZero();
   g.slots.push_back(slot);
   g.first.emplace_back(Eigen::Vector2d::Zero());
+  g.relative.push_back(0);
   return g.landmark_count() - 1;
 }
 
@@ -64,6 +65,7 @@ void JointGaussian::begin(const PoseGaussian& pose) {
   cov = pose.cov;
   slots.clear();
   first.clear();
+  relative.clear();
   frame_pose = pose.mean;
 }
 
@@ -72,6 +74,7 @@ void JointGaussian::clear() {
   cov.resize(0, 0);
   slots.clear();
   first.clear();
+  relative.clear();
 }
 
 void JointGaussian::end_frame() {
@@ -138,6 +141,7 @@ int JointGaussian::add_new(std::uint32_t slot, const Eigen::Vector2d& z, const E
   const Eigen::Index n = cross.cols();
   mean.tail<2>() = landmark;
   first.back() = landmark;
+  relative.back() = 1;
   cov.bottomLeftCorner(2, n) = cross;
   cov.topRightCorner(n, 2) = cross.transpose();
   cov.bottomRightCorner<2, 2>() =
@@ -236,6 +240,117 @@ bool apply_observation(JointGaussian& g, const JointFit& fit) {
   g.mean(2) = wrap_angle(g.mean(2));
   for (Eigen::Index c = 0; c < n; ++c) g.cov.col(c) -= a.col(0) * a(c, 0) + a.col(1) * a(c, 1);
   return true;
+}
+
+namespace {
+
+Eigen::Matrix2d rotation(double theta) {
+  const double c = std::cos(theta);
+  const double s = std::sin(theta);
+  Eigen::Matrix2d r;
+  r << c, -s, s, c;
+  return r;
+}
+
+// d rotation(theta) / d theta.
+Eigen::Matrix2d rotation_derivative(double theta) {
+  const double c = std::cos(theta);
+  const double s = std::sin(theta);
+  Eigen::Matrix2d r;
+  r << -s, -c, c, -s;
+  return r;
+}
+
+}  // namespace
+
+namespace {
+
+// The relative landmarks in robot-centred coordinates, m_R = R(theta)^T (m - p),
+// and the Jacobian of that change of coordinates at the state's mean.
+void to_robocentric(const JointGaussian& g, Eigen::VectorXd& mean, Eigen::MatrixXd& cov) {
+  const Eigen::Index n = g.mean.size();
+  const Eigen::Vector3d pose = g.mean.head<3>();
+  const Eigen::Matrix2d rt = rotation(pose(2)).transpose();
+  const Eigen::Matrix2d drt = rotation_derivative(pose(2)).transpose();
+  Eigen::MatrixXd j = Eigen::MatrixXd::Identity(n, n);
+  mean = g.mean;
+  for (int i = 0; i < g.landmark_count(); ++i) {
+    if (g.relative[static_cast<std::size_t>(i)] == 0) continue;
+    const Eigen::Index b = 3 + 2 * i;
+    const Eigen::Vector2d d = g.mean.segment<2>(b) - pose.head<2>();
+    mean.segment<2>(b) = rt * d;
+    j.block<2, 2>(b, 0) = -rt;
+    j.block<2, 1>(b, 2) = drt * d;
+    j.block<2, 2>(b, b) = rt;
+  }
+  cov = j * g.cov * j.transpose();
+}
+
+// Back to world coordinates, m = p + R(theta) m_R, into `out` (a copy of the
+// state the coordinates came from). The linearisation points (first estimates of
+// the relative landmarks, frame pose) move by the same rigid motion as the pose.
+void from_robocentric(const JointGaussian& from, const Eigen::VectorXd& mean, const Eigen::MatrixXd& cov,
+                      JointGaussian& out) {
+  const Eigen::Index n = mean.size();
+  const Eigen::Vector3d before = from.mean.head<3>();
+  const Eigen::Vector3d after = mean.head<3>();
+  const Eigen::Matrix2d r = rotation(after(2));
+  const Eigen::Matrix2d dr = rotation_derivative(after(2));
+  Eigen::MatrixXd j = Eigen::MatrixXd::Identity(n, n);
+  out.mean = mean;
+  for (int i = 0; i < from.landmark_count(); ++i) {
+    if (from.relative[static_cast<std::size_t>(i)] == 0) continue;
+    const Eigen::Index b = 3 + 2 * i;
+    const Eigen::Vector2d m_r = mean.segment<2>(b);
+    out.mean.segment<2>(b) = after.head<2>() + r * m_r;
+    j.block<2, 2>(b, 0) = Eigen::Matrix2d::Identity();
+    j.block<2, 1>(b, 2) = dr * m_r;
+    j.block<2, 2>(b, b) = r;
+  }
+  out.cov = j * cov * j.transpose();
+  out.cov = (0.5 * (out.cov + out.cov.transpose())).eval();
+  const Eigen::Matrix2d turn = r * rotation(before(2)).transpose();
+  const auto move = [&](const Eigen::Vector2d& q) -> Eigen::Vector2d {
+    return after.head<2>() + turn * (q - before.head<2>());
+  };
+  for (int i = 0; i < from.landmark_count(); ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (from.relative[k] != 0) out.first[k] = move(from.first[k]);
+  }
+  out.frame_pose.head<2>() = move(from.frame_pose.head<2>());
+  out.frame_pose(2) = wrap_angle(from.frame_pose(2) + wrap_angle(after(2) - before(2)));
+}
+
+}  // namespace
+
+std::vector<HeadingComponent> split_heading(const JointGaussian& g, double spacing_rad) {
+  std::vector<HeadingComponent> out;
+  const double variance = g.cov(2, 2);
+  const double component_variance = 0.25 * spacing_rad * spacing_rad;
+  if (!(spacing_rad > 0.0) || !(variance > component_variance)) return out;
+  Eigen::VectorXd y;
+  Eigen::MatrixXd p;
+  to_robocentric(g, y, p);
+  // Regression of the state on the heading; the heading's own coordinate is 1.
+  const Eigen::VectorXd b = p.col(2) / p(2, 2);
+  const double spread = variance - component_variance;  // of the component means
+  const Eigen::MatrixXd cov = p - spread * b * b.transpose();
+  const int half = static_cast<int>(std::ceil(3.0 * std::sqrt(spread) / spacing_rad));
+  double total = 0.0;
+  for (int k = -half; k <= half; ++k) {
+    const double delta = k * spacing_rad;
+    HeadingComponent c;
+    c.weight = std::exp(-0.5 * delta * delta / spread);
+    Eigen::VectorXd mean = y + delta * b;
+    mean(2) = wrap_angle(mean(2));
+    c.state = g;
+    from_robocentric(g, mean, cov, c.state);
+    if (!c.state.healthy()) continue;
+    total += c.weight;
+    out.push_back(std::move(c));
+  }
+  for (HeadingComponent& c : out) c.weight /= total;
+  return out;
 }
 
 std::vector<ConditionedLandmark> condition_on_pose(const JointGaussian& g, const Pose2& pose) {

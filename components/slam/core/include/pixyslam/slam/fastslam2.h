@@ -62,6 +62,7 @@ struct FilterCounters {
   std::uint64_t delayed_sampling_starts = 0;  // particle-frames that began a joint state
   std::uint64_t joint_breakdowns = 0;  // joint-state updates refused as numerically broken
   std::uint64_t joint_iterated_updates = 0;  // outside the gate linearised once, inside re-linearised
+  std::uint64_t joint_heading_splits = 0;  // joint states re-drawn along their heading at a return
 };
 
 // FastSLAM 2.0 (Montemerlo, Thrun, Koller, Wegbreit 2003) with known data
@@ -146,6 +147,13 @@ class FastSlam2 {
   void update_particle(Particle& p, const std::vector<RangeBearing>& detections);
   void update_particle_joint(Particle& p, const std::vector<RangeBearing>& detections);
   void finish_joint(Particle& p);
+  // DelayedSamplingOptions::split_heading: at a frame that sees landmarks mapped
+  // outside the joint state, the state is split along its heading
+  // (split_heading()) and one component drawn by prior weight times the
+  // likelihood of those detections. Returns the log weight to add beyond what
+  // the frame's updates of the drawn component add (log of the mixture's
+  // likelihood minus the component's).
+  double draw_heading_at_return(Particle& p);
   // The particles' weights normalised (from their log weights).
   std::vector<double> normalised_particle_weights() const;
   void resample_if_needed(const std::vector<double>& weights);
@@ -232,6 +240,7 @@ class FastSlam2 {
   std::vector<std::uint32_t> slots_;
   std::vector<double> new_log_likelihood_;  // per detection: log weight if it starts a landmark
   std::vector<Decision> decision_;
+  std::vector<std::size_t> known_;  // detections of landmarks mapped outside the joint state
   std::vector<Landmark*> landmarks_;
   std::vector<int> gated_votes_;
   FilterCounters counters_;

@@ -31,6 +31,9 @@ struct JointGaussian {
   Eigen::MatrixXd cov;
   std::vector<std::uint32_t> slots;       // landmark slot of state block i (at 3 + 2i)
   std::vector<Eigen::Vector2d> first;     // first estimate of landmark i
+  // Landmark i was first seen in this state (add_new): placed relative to the
+  // pose, it turns with it when a mapped landmark corrects the heading.
+  std::vector<std::uint8_t> relative;
   Eigen::Vector3d frame_pose = Eigen::Vector3d::Zero();  // pose predicted for the frame
 
   bool active() const { return mean.size() != 0; }
@@ -90,6 +93,23 @@ JointFit fit_observation_iterated(const JointGaussian& g, int index, const Eigen
 // EKF update with a fit: K = P H^T S^-1, mean += K nu, P -= K S K^T. Returns
 // false and leaves g unchanged when the result would not be healthy().
 [[nodiscard]] bool apply_observation(JointGaussian& g, const JointFit& fit);
+// The state as a Gaussian mixture along its heading, for an observation too
+// nonlinear for one linearisation (a mapped landmark seen again after the
+// heading drifted by tens of degrees while blind). In robot-centred coordinates
+// for the relative landmarks, m_R = R(theta)^T (m - p) (Castellanos et al.
+// 2007, robocentric EKF-SLAM), so each component turns them about the pose on
+// their arcs rather than along the tangent: component k has its heading moved
+// by delta_k = k spacing (|delta| up to 3 sd), the rest of the state by its
+// regression on the heading, covariance P - (s^2 - c^2) b b^T with heading
+// variance c^2 = (spacing / 2)^2, and prior weight N(delta_k; 0, s^2 - c^2)
+// (normalised); back in world coordinates with its linearisation points (first
+// estimates, frame pose) moved rigidly with the pose. Empty when the heading sd
+// is not above spacing / 2.
+struct HeadingComponent {
+  double weight = 0.0;
+  JointGaussian state;
+};
+std::vector<HeadingComponent> split_heading(const JointGaussian& g, double spacing_rad);
 
 // The landmarks given a pose drawn from the state's pose marginal: mean_i +
 // P_ix Pxx^-1 (x - mean_x), covariance P_ii - P_ix Pxx^-1 P_xi. The landmarks'

@@ -37,6 +37,14 @@ struct DelayedSamplingOptions {
   double exit_heading_sigma_rad = 0.08;
   double exit_position_sigma_m = 0.2;
   int max_landmarks = 16;
+  // Mapped landmarks seen again while the joint state's heading sd exceeds
+  // enter_heading_sigma_rad: each particle's state is split along its heading
+  // (robot-centred, components enter_heading_sigma_rad apart) and one component
+  // drawn by how well it explains them, instead of one linearised update at a
+  // heading that may be tens of degrees off. The particles then hold different
+  // headings, which decides associations when the ids are withheld
+  // (docs/mrclam.md, "Heading split at a return").
+  bool split_heading = false;
 };
 
 // Output frame anchoring. The map's frame is tied to the world only by the start
