@@ -711,7 +711,7 @@ int main(int argc, char** argv) {
                "several seeds per robot; segment starts, leave-one-robot-out and blind-return evaluations."};
   cli.option("--dataset", a.dataset, "the MRCLAM data set folder (exit 77 when absent: a skip)").required().type("DIR");
   app::add_config(cli, a.config_path, "filter options (filter:) and corrections (mrclam:)");
-  app::add_set(cli, a.sets, "filter.delayed_sampling.split_heading=true or mrclam.odometry_delay_s=0");
+  app::add_set(cli, a.sets, "filter.delayed_sampling.split_heading=true or mrclam.odometry_delay_s=0, both listed below");
   cli.option("--robots", robots, "robots to run (default 1,2,3,4,5)").type("LIST");
   cli.option("--seeds", seeds, "filter seeds per robot (default 1,2,3)").type("LIST");
   cli.option("--association", a.association, "known_id (default) or maximum_likelihood (ids withheld)")
@@ -731,7 +731,10 @@ int main(int argc, char** argv) {
              "write runs.csv, segments.csv and errors_robotR_seedS.csv (error over time) there, for "
              "scripts/plot_results.py")
       .type("DIR");
-  cli.footer("Exit status: 0 done, 1 an error or a robot's mean ATE not better than dead reckoning, 2 a bad "
+  cli.footer("filter parameters (filter:):\n" + parameters::help_text(slam::filter_parameters(), "filter") +
+             "MRCLAM sensor model (mrclam:):\n" +
+             parameters::help_text(offline::mrclam_sensor_parameters(), "mrclam") +
+             "Exit status: 0 done, 1 an error or a robot's mean ATE not better than dead reckoning, 2 a bad "
              "command line or config, 77 the data set folder is absent (skip).");
   if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("mrclam_eval", [&] {
