@@ -60,6 +60,9 @@ int run(int argc, char** argv) {
       .type("K");
   cli.option("--whole-period", schedule.whole_period_s, "data time between whole-problem solves, default 10")
       .positive().type("S");
+  cli.option("--whole-max-duty", schedule.whole_max_duty,
+             "whole solves take at most this fraction of data time, default 0.1 (0: no bound)")
+      .range(0.0, 1.0).type("F");
   if (const auto done = cli.parse(argc, argv)) return *done;
   if (cli.given("--window-keyframes")) schedule.window_keyframes = static_cast<std::size_t>(window_keyframes);
 
@@ -90,9 +93,9 @@ int run(int argc, char** argv) {
   const offline::OptimisedRun opt = offline::optimise_run(options, input, filter, schedule);
   const double data_s = filter.trajectory.empty() ? 0.0 : filter.trajectory.back().t_s - input.start_time_s;
   std::printf("data %.1f s, %zu keyframes, %zu observation factors; schedule: window of %zu keyframes every %.1f s, "
-              "whole problem every %.1f s\n",
+              "whole problem every %.1f s (at most %.0f %% of data time)\n",
               data_s, opt.counters.keyframes, opt.counters.observations, schedule.window_keyframes,
-              schedule.window_period_s, schedule.whole_period_s);
+              schedule.window_period_s, schedule.whole_period_s, 100.0 * schedule.whole_max_duty);
   std::printf("optimiser CPU %.3f s in all, %.3f s per minute of data (%.2f %% of one core); filter CPU %.3f s\n",
               opt.result.cpu_time_s, data_s > 0.0 ? 60.0 * opt.result.cpu_time_s / data_s : 0.0,
               data_s > 0.0 ? 100.0 * opt.result.cpu_time_s / data_s : 0.0, filter.cpu_time_s);

@@ -228,6 +228,34 @@ TEST(SolveSchedule, WholeEveryPeriodElseWindowAndZeroTurnsASolveOff) {
   EXPECT_EQ(windows_only.due(1001.0), SolveKind::kNone);
 }
 
+// A whole solve that took 3 s with whole_max_duty 0.1 puts the next one 30 s
+// later, not 10; window solves go on meanwhile; a quick whole solve, or a
+// window solve however slow, changes nothing; without a bound, none does.
+TEST(SolveSchedule, WholeSolvesTakeAtMostTheirDutyOfDataTime) {
+  SolveSchedule s({100, 1.0, 10.0, 0.1}, 0.0);
+  ASSERT_EQ(s.due(10.0), SolveKind::kWhole);
+  s.solved(SolveKind::kWhole, 10.0, 3.0);
+  int windows = 0;
+  for (double t = 10.5; t < 40.0; t += 0.5) {
+    const SolveKind k = s.due(t);
+    ASSERT_NE(k, SolveKind::kWhole) << t;
+    if (k == SolveKind::kWindow) {
+      s.solved(k, t, 5.0);
+      ++windows;
+    }
+  }
+  EXPECT_EQ(windows, 29);
+  EXPECT_EQ(s.due(40.0), SolveKind::kWhole);
+  s.solved(SolveKind::kWhole, 40.0, 0.2);  // 2 s of duty: the period (10 s) rules
+  EXPECT_NE(s.due(49.5), SolveKind::kWhole);
+  EXPECT_EQ(s.due(50.0), SolveKind::kWhole);
+
+  SolveSchedule unbounded({100, 1.0, 10.0, 0.0}, 0.0);
+  ASSERT_EQ(unbounded.due(10.0), SolveKind::kWhole);
+  unbounded.solved(SolveKind::kWhole, 10.0, 3.0);
+  EXPECT_EQ(unbounded.due(20.0), SolveKind::kWhole);
+}
+
 TEST(MapOptimizer, LandmarkCovariancesShrinkWithMoreObservations) {
   MapOptimizerOptions o;  // the default noise
   auto covariance_trace = [&](int samples) {

@@ -370,4 +370,9 @@ SolveKind SolveSchedule::due(double t_s) {
   return SolveKind::kNone;
 }
 
+void SolveSchedule::solved(SolveKind kind, double t_s, double seconds) {
+  if (kind != SolveKind::kWhole || !(options_.whole_max_duty > 0.0) || !(seconds > 0.0)) return;
+  next_whole_s_ = std::max(next_whole_s_, t_s + seconds / options_.whole_max_duty);
+}
+
 }  // namespace pixyslam::map_optimizer

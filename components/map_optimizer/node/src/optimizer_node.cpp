@@ -175,7 +175,10 @@ void OptimizerNode::step(const slam::SensorInput& input) {
   last_t_s_ = std::max(last_t_s_, t);
   dirty_ = true;
   const map_optimizer::SolveKind due = schedule_->due(t);
-  if (due != map_optimizer::SolveKind::kNone) solve(due == map_optimizer::SolveKind::kWhole);
+  if (due == map_optimizer::SolveKind::kNone) return;
+  const double cpu_before = thread_cpu_seconds();
+  solve(due == map_optimizer::SolveKind::kWhole);
+  schedule_->solved(due, t, thread_cpu_seconds() - cpu_before);
 }
 
 void OptimizerNode::solve(bool whole) {

@@ -22,13 +22,17 @@ OptimisedRun optimise_run(const slam::FilterOptions& options, const RunInput& in
   auto record = [&](double t) {
     anchors.push_back(optimizer.anchor_now());
     times.push_back(t);
-    switch (due.due(t)) {
+    const map_optimizer::SolveKind kind = due.due(t);
+    switch (kind) {
       case map_optimizer::SolveKind::kWhole: out.whole_solves.push_back(optimizer.solve()); break;
       case map_optimizer::SolveKind::kWindow:
         out.window_solves.push_back(optimizer.solve(schedule.window_keyframes));
         break;
-      case map_optimizer::SolveKind::kNone: break;
+      case map_optimizer::SolveKind::kNone: return;
     }
+    const std::vector<map_optimizer::SolveSummary>& done =
+        kind == map_optimizer::SolveKind::kWhole ? out.whole_solves : out.window_solves;
+    due.solved(kind, t, done.back().solve_time_s);
   };
   for_each_step(
       input,

@@ -182,13 +182,19 @@ class MapOptimizer {
 // When to solve while the data come (the map_optimizer process and
 // bench_map_optimizer share it): the whole problem every whole_period_s of data
 // time, else the newest window_keyframes every window_period_s. A period of 0
-// turns that solve off; the caller solves the whole problem at the end.
+// turns that solve off; the caller solves the whole problem at the end. The
+// whole problem grows with the run (0.25 s at 15 minutes here, ten times that
+// on a Pi-class core): with whole_max_duty, after a whole solve that took T s
+// the next waits at least T / whole_max_duty of data time, so whole solves take
+// at most that fraction of the run however long it gets (window solves have a
+// fixed size).
 struct SolveScheduleOptions {
   std::size_t window_keyframes = 100;  // the newest keyframes a window solve frees
   double window_period_s = 1.0;        // data time between window solves
   double whole_period_s = 10.0;        // data time between whole-problem solves
+  double whole_max_duty = 0.1;         // 0: no bound
   // No solve on the way: only the caller's solve at the end.
-  static SolveScheduleOptions at_end_only() { return {100, 0.0, 0.0}; }
+  static SolveScheduleOptions at_end_only() { return {100, 0.0, 0.0, 0.0}; }
 };
 
 enum class SolveKind { kNone, kWindow, kWhole };
@@ -199,6 +205,9 @@ class SolveSchedule {
   // The solve due once the data reach t_s; a whole solve also restarts the
   // window period (it solved the window too).
   SolveKind due(double t_s);
+  // A solve due at t_s took `seconds` (CPU): whole_max_duty spaces the next
+  // whole solve by it.
+  void solved(SolveKind kind, double t_s, double seconds);
   const SolveScheduleOptions& options() const { return options_; }
 
  private:
