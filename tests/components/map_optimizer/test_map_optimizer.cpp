@@ -256,6 +256,57 @@ TEST(SolveSchedule, WholeSolvesTakeAtMostTheirDutyOfDataTime) {
   EXPECT_EQ(unbounded.due(20.0), SolveKind::kWhole);
 }
 
+// The whole problem copied out and solved elsewhere (the live process's
+// background solve) ends where solve() does, with the same covariances; data
+// added after the copy ride along rigidly with its newest keyframe.
+TEST(MapOptimizer, SnapshotSolvedElsewhereMatchesASolveAndCarriesNewerData) {
+  const ExactRun run = exact_circle(200);
+  const auto feed = [&](MapOptimizer& opt, std::size_t from, std::size_t to) {
+    for (std::size_t i = from; i < to; ++i) {
+      opt.add_odometry(run.odometry[i]);
+      opt.add_frame(run.frames[i], run.truth[i] + slam::Pose2(0.2, -0.2, 0.1));
+    }
+  };
+  MapOptimizerOptions o;  // the default noise and Huber loss
+  MapOptimizer here(o, run.truth.front(), 50.0);
+  MapOptimizer there(o, run.truth.front(), 50.0);
+  feed(here, 0, 120);
+  feed(there, 0, 120);
+  const SolveSummary direct = here.solve();
+  ASSERT_TRUE(here.compute_landmark_covariances());
+  const WholeProblem copy = there.snapshot();
+  EXPECT_EQ(copy.poses.size(), there.keyframes().size());
+  EXPECT_EQ(copy.landmark_ids.size(), 4u);
+  const WholeSolution solved = solve_whole_problem(copy, true);
+  EXPECT_NEAR(solved.summary.final_cost, direct.final_cost, 1e-9 * (1.0 + direct.final_cost));
+  EXPECT_EQ(solved.summary.residuals, direct.residuals);
+
+  // Newer data arrive while the copy is being solved.
+  feed(there, 120, 200);
+  const std::size_t n0 = copy.poses.size();
+  const slam::Pose2 last_before = there.keyframes()[n0 - 1].pose;
+  const slam::Pose2 newest_before = there.keyframes().back().pose;
+  there.adopt(solved);
+  for (std::size_t i = 0; i < n0; ++i) {
+    EXPECT_LT((there.keyframes()[i].pose - here.keyframes()[i].pose).norm(), 1e-7) << i;
+  }
+  const std::vector<LandmarkSolution> a = here.landmarks(), b = there.landmarks();
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t j = 0; j < a.size(); ++j) {
+    EXPECT_LT((a[j].mean - b[j].mean).norm(), 1e-7);
+    EXPECT_LT((a[j].cov - b[j].cov).norm(), 1e-9 + 1e-6 * a[j].cov.norm());
+  }
+  // The newest keyframe keeps its pose relative to the copy's newest.
+  const auto relative = [](const slam::Pose2& from, const slam::Pose2& to) {
+    const double c = std::cos(from.z()), s = std::sin(from.z());
+    const Eigen::Vector2d d = to.head<2>() - from.head<2>();
+    return slam::Pose2(c * d.x() + s * d.y(), -s * d.x() + c * d.y(), slam::wrap_angle(to.z() - from.z()));
+  };
+  const slam::Pose2 kept = relative(there.keyframes()[n0 - 1].pose, there.keyframes().back().pose);
+  EXPECT_LT((kept - relative(last_before, newest_before)).norm(), 1e-9);
+  EXPECT_GT((there.keyframes()[n0 - 1].pose - last_before).norm(), 1e-3);  // the solve did move it
+}
+
 TEST(MapOptimizer, LandmarkCovariancesShrinkWithMoreObservations) {
   MapOptimizerOptions o;  // the default noise
   auto covariance_trace = [&](int samples) {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
 #include <stdexcept>
 #include <utility>
 
@@ -66,6 +68,68 @@ struct RangeBearingResidual {
 };
 
 bool finite(const slam::Pose2& p) { return p.allFinite(); }
+
+ceres::CostFunction* odometry_cost(const OdometryFactor& f) {
+  return new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(new OdometryResidual{f.delta, f.sqrt_information});
+}
+
+ceres::CostFunction* observation_cost(const ObservationFactor& f) {
+  return new ceres::AutoDiffCostFunction<RangeBearingResidual, 2, 3, 2>(
+      new RangeBearingResidual{f.range_m, f.bearing_rad, f.range_sigma_m, f.bearing_sigma_rad});
+}
+
+ceres::Solver::Options solver_options(const MapOptimizerOptions& o) {
+  ceres::Solver::Options solver;
+  solver.max_num_iterations = o.max_iterations;
+  solver.function_tolerance = o.function_tolerance;
+  solver.num_threads = 1;
+  solver.logging_type = ceres::SILENT;
+  solver.linear_solver_type = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ||
+                                      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE)
+                                  ? ceres::SPARSE_NORMAL_CHOLESKY
+                                  : ceres::DENSE_QR;
+  return solver;
+}
+
+void fill_summary(const ceres::Solver::Summary& summary, SolveSummary& out) {
+  out.converged = summary.termination_type == ceres::CONVERGENCE;
+  out.iterations = static_cast<int>(summary.iterations.size());
+  out.initial_cost = summary.initial_cost;
+  out.final_cost = summary.final_cost;
+  out.solve_time_s = summary.total_time_in_seconds;
+  out.message = summary.message;
+}
+
+// Landmark covariances of a solved problem into `covs` (NaN where not computed).
+bool landmark_covariances(ceres::Problem& problem, const std::vector<const double*>& landmarks,
+                          std::vector<Eigen::Matrix2d>& covs) {
+  covs.assign(landmarks.size(), Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  if (landmarks.empty()) return true;
+  ceres::Covariance::Options options;
+  options.num_threads = 1;
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (const double* l : landmarks) blocks.emplace_back(l, l);
+  if (!covariance.Compute(blocks, &problem)) return false;
+  for (std::size_t i = 0; i < landmarks.size(); ++i) {
+    Eigen::Matrix<double, 2, 2, Eigen::RowMajor> c;
+    if (covariance.GetCovarianceBlock(landmarks[i], landmarks[i], c.data())) covs[i] = c;
+  }
+  return true;
+}
+
+// a o b for planar poses (x, y, theta).
+std::array<double, 3> compose(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  const double c = std::cos(a[2]);
+  const double s = std::sin(a[2]);
+  return {a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], slam::wrap_angle(a[2] + b[2])};
+}
+
+std::array<double, 3> inverse(const std::array<double, 3>& a) {
+  const double c = std::cos(a[2]);
+  const double s = std::sin(a[2]);
+  return {-c * a[0] - s * a[1], s * a[0] - c * a[1], slam::wrap_angle(-a[2])};
+}
 
 }  // namespace
 
@@ -173,13 +237,17 @@ void MapOptimizer::close_keyframe(double t_s, const std::optional<slam::Pose2>& 
   const Eigen::Matrix3d cov =
       open_motion_.noise(1.0, 0.0) + kOdometryCovarianceFloor * Eigen::Matrix3d::Identity();
   const Eigen::Matrix3d lower = cov.llt().matrixL();
-  OdometryResidual residual{delta, lower.triangularView<Eigen::Lower>().solve(Eigen::Matrix3d::Identity())};
+  OdometryFactor factor;
+  factor.from = pose_blocks_.size() - 1;
+  factor.to = pose_blocks_.size();
+  factor.delta = delta;
+  factor.sqrt_information = lower.triangularView<Eigen::Lower>().solve(Eigen::Matrix3d::Identity());
 
   pose_blocks_.push_back({initial.x(), initial.y(), initial.z()});
   double* const before = previous.data();
   double* const after = pose_blocks_.back().data();
-  problem_->AddResidualBlock(new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(new OdometryResidual(residual)),
-                             nullptr, before, after);
+  problem_->AddResidualBlock(odometry_cost(factor), nullptr, before, after);
+  odometry_factors_.push_back(factor);
   keyframes_.push_back({t_s, initial});
   keyframe_due_s_ = t_s + options_.keyframe_interval_s;
   open_motion_.clear();
@@ -243,9 +311,14 @@ void MapOptimizer::add_frame(const slam::ObservationFrame& frame, const std::opt
                                    ? d->range_sigma_m
                                    : options_.range_sigma_m + options_.range_sigma_per_m * d->range_m;
     const double bearing_sigma = d->bearing_sigma_rad > 0.0 ? d->bearing_sigma_rad : options_.bearing_sigma_rad;
-    problem_->AddResidualBlock(new ceres::AutoDiffCostFunction<RangeBearingResidual, 2, 3, 2>(
-                                   new RangeBearingResidual{d->range_m, d->bearing_rad, range_sigma, bearing_sigma}),
-                               loss_.get(), pose, lm.xy.data());
+    ObservationFactor factor;
+    factor.keyframe = k;
+    factor.range_m = d->range_m;
+    factor.bearing_rad = d->bearing_rad;
+    factor.range_sigma_m = range_sigma;
+    factor.bearing_sigma_rad = bearing_sigma;
+    problem_->AddResidualBlock(observation_cost(factor), loss_.get(), pose, lm.xy.data());
+    observation_records_.push_back({k, d->landmark_id, factor});
     ++lm.observations;
     lm.last_keyframe = k;
     ++counters_.observations;
@@ -272,29 +345,96 @@ SolveSummary MapOptimizer::solve(std::optional<std::size_t> window_keyframes) {
   out.keyframes_free = n - first_free;
   out.residuals = static_cast<std::size_t>(problem_->NumResidualBlocks());
 
-  ceres::Solver::Options solver;
-  solver.max_num_iterations = options_.max_iterations;
-  solver.function_tolerance = options_.function_tolerance;
-  solver.num_threads = 1;
-  solver.logging_type = ceres::SILENT;
-  solver.linear_solver_type = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ||
-                                      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE)
-                                  ? ceres::SPARSE_NORMAL_CHOLESKY
-                                  : ceres::DENSE_QR;
   ceres::Solver::Summary summary;
-  if (out.keyframes_free > 0 || out.landmarks_free > 0) ceres::Solve(solver, problem_.get(), &summary);
+  if (out.keyframes_free > 0 || out.landmarks_free > 0) ceres::Solve(solver_options(options_), problem_.get(), &summary);
 
   for (std::size_t i = 1; i < first_free; ++i) problem_->SetParameterBlockVariable(pose_blocks_[i].data());
   for (auto& [id, lm] : landmarks_) problem_->SetParameterBlockVariable(lm.xy.data());
   sync_keyframes();
   ++counters_.solves;
-  out.converged = summary.termination_type == ceres::CONVERGENCE;
-  out.iterations = static_cast<int>(summary.iterations.size());
-  out.initial_cost = summary.initial_cost;
-  out.final_cost = summary.final_cost;
-  out.solve_time_s = summary.total_time_in_seconds;
-  out.message = summary.message;
+  fill_summary(summary, out);
   return out;
+}
+
+WholeProblem MapOptimizer::snapshot() const {
+  WholeProblem p;
+  p.options = options_;
+  p.poses.assign(pose_blocks_.begin(), pose_blocks_.end());
+  std::map<int, std::size_t> index;
+  for (const auto& [id, lm] : landmarks_) {
+    index[id] = p.landmark_ids.size();
+    p.landmark_ids.push_back(id);
+    p.landmarks.push_back(lm.xy);
+  }
+  p.odometry = odometry_factors_;
+  p.observations.reserve(observation_records_.size());
+  for (const ObservationRecord& r : observation_records_) {
+    ObservationFactor f = r.factor;
+    f.landmark = index.at(r.landmark_id);
+    p.observations.push_back(f);
+  }
+  return p;
+}
+
+WholeSolution solve_whole_problem(const WholeProblem& problem, bool covariances) {
+  WholeSolution out;
+  out.poses = problem.poses;
+  out.landmark_ids = problem.landmark_ids;
+  out.landmarks = problem.landmarks;
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem p(problem_options);
+  ceres::HuberLoss loss(problem.options.huber_threshold);
+  for (std::array<double, 3>& pose : out.poses) p.AddParameterBlock(pose.data(), 3);
+  if (!out.poses.empty()) p.SetParameterBlockConstant(out.poses.front().data());
+  for (std::array<double, 2>& l : out.landmarks) p.AddParameterBlock(l.data(), 2);
+  for (const OdometryFactor& f : problem.odometry) {
+    p.AddResidualBlock(odometry_cost(f), nullptr, out.poses.at(f.from).data(), out.poses.at(f.to).data());
+  }
+  for (const ObservationFactor& f : problem.observations) {
+    p.AddResidualBlock(observation_cost(f), &loss, out.poses.at(f.keyframe).data(), out.landmarks.at(f.landmark).data());
+  }
+  out.summary.keyframes_free = out.poses.empty() ? 0 : out.poses.size() - 1;
+  out.summary.landmarks_free = out.landmarks.size();
+  out.summary.residuals = static_cast<std::size_t>(p.NumResidualBlocks());
+  ceres::Solver::Summary summary;
+  if (out.summary.keyframes_free > 0 || out.summary.landmarks_free > 0) {
+    ceres::Solve(solver_options(problem.options), &p, &summary);
+  }
+  fill_summary(summary, out.summary);
+  for (std::array<double, 3>& pose : out.poses) pose[2] = slam::wrap_angle(pose[2]);
+  std::vector<const double*> blocks;
+  for (const std::array<double, 2>& l : out.landmarks) blocks.push_back(l.data());
+  if (covariances) {
+    landmark_covariances(p, blocks, out.landmark_covs);
+  } else {
+    out.landmark_covs.assign(out.landmarks.size(), Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  }
+  return out;
+}
+
+void MapOptimizer::adopt(const WholeSolution& solution) {
+  const std::size_t n = std::min(solution.poses.size(), pose_blocks_.size());
+  if (n == 0) return;
+  // The rigid correction of the snapshot's newest keyframe: solved o current^-1.
+  const std::array<double, 3> correction = compose(solution.poses[n - 1], inverse(pose_blocks_[n - 1]));
+  for (std::size_t i = 0; i < n; ++i) pose_blocks_[i] = solution.poses[i];
+  for (std::size_t i = n; i < pose_blocks_.size(); ++i) pose_blocks_[i] = compose(correction, pose_blocks_[i]);
+  std::map<int, std::size_t> solved;
+  for (std::size_t i = 0; i < solution.landmark_ids.size(); ++i) solved[solution.landmark_ids[i]] = i;
+  for (auto& [id, lm] : landmarks_) {
+    const auto it = solved.find(id);
+    if (it != solved.end()) {
+      lm.xy = solution.landmarks[it->second];
+      lm.cov = solution.landmark_covs.at(it->second);
+    } else {
+      const std::array<double, 3> moved = compose(correction, {lm.xy[0], lm.xy[1], 0.0});
+      lm.xy = {moved[0], moved[1]};
+      lm.cov.setConstant(std::numeric_limits<double>::quiet_NaN());
+    }
+  }
+  sync_keyframes();
+  ++counters_.solves;
 }
 
 void MapOptimizer::sync_keyframes() {
@@ -306,19 +446,13 @@ void MapOptimizer::sync_keyframes() {
 }
 
 bool MapOptimizer::compute_landmark_covariances() {
-  for (auto& [id, lm] : landmarks_) lm.cov.setConstant(std::numeric_limits<double>::quiet_NaN());
-  if (landmarks_.empty()) return true;
-  ceres::Covariance::Options options;
-  options.num_threads = 1;
-  ceres::Covariance covariance(options);
-  std::vector<std::pair<const double*, const double*>> blocks;
-  for (const auto& [id, lm] : landmarks_) blocks.emplace_back(lm.xy.data(), lm.xy.data());
-  if (!covariance.Compute(blocks, problem_.get())) return false;
-  for (auto& [id, lm] : landmarks_) {
-    Eigen::Matrix<double, 2, 2, Eigen::RowMajor> c;
-    if (covariance.GetCovarianceBlock(lm.xy.data(), lm.xy.data(), c.data())) lm.cov = c;
-  }
-  return true;
+  std::vector<const double*> blocks;
+  for (const auto& [id, lm] : landmarks_) blocks.push_back(lm.xy.data());
+  std::vector<Eigen::Matrix2d> covs;
+  const bool ok = landmark_covariances(*problem_, blocks, covs);
+  std::size_t i = 0;
+  for (auto& [id, lm] : landmarks_) lm.cov = covs[i++];
+  return ok;
 }
 
 std::vector<LandmarkSolution> MapOptimizer::landmarks() const {

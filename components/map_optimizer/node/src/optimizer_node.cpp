@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <future>
 
 #include "pixyslam/slam_node/map_state_conversions.h"
 
@@ -128,7 +129,8 @@ void OptimizerNode::loop() {
     for (const slam::SensorInput& input : ready.inputs) step(input);
     if (stopping) {
       std::lock_guard<std::mutex> state_lock(state_mutex_);
-      if (optimizer_ && dirty_) solve(true);
+      collect_whole(true);
+      if (optimizer_ && (dirty_ || whole_dirty_)) solve(true);
     }
     if (options_.status_period_s > 0.0 && Clock::now() >= next_status) {
       log_status();
@@ -174,11 +176,40 @@ void OptimizerNode::step(const slam::SensorInput& input) {
   }
   last_t_s_ = std::max(last_t_s_, t);
   dirty_ = true;
-  const map_optimizer::SolveKind due = schedule_->due(t);
+  whole_dirty_ = true;
+  collect_whole(false);
+  map_optimizer::SolveKind due = schedule_->due(t);
+  if (due == map_optimizer::SolveKind::kWhole) {
+    if (!whole_job_.valid()) {
+      // In the background on a copy: the windows go on meanwhile.
+      whole_dirty_ = false;
+      whole_job_ = std::async(std::launch::async, [problem = optimizer_->snapshot(), t] {
+        const double cpu_before = thread_cpu_seconds();
+        BackgroundWhole job;
+        job.solution = map_optimizer::solve_whole_problem(problem, true);
+        job.cpu_s = thread_cpu_seconds() - cpu_before;
+        job.due_t_s = t;
+        return job;
+      });
+      return;
+    }
+    due = map_optimizer::SolveKind::kWindow;  // the last one is still running
+  }
   if (due == map_optimizer::SolveKind::kNone) return;
-  const double cpu_before = thread_cpu_seconds();
-  solve(due == map_optimizer::SolveKind::kWhole);
-  schedule_->solved(due, t, thread_cpu_seconds() - cpu_before);
+  solve(false);
+}
+
+void OptimizerNode::collect_whole(bool wait) {
+  if (!whole_job_.valid()) return;
+  if (!wait && whole_job_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+  const BackgroundWhole job = whole_job_.get();
+  optimizer_->adopt(job.solution);
+  schedule_->solved(map_optimizer::SolveKind::kWhole, job.due_t_s, job.cpu_s);
+  background_cpu_s_ += job.cpu_s;
+  ++counters_.whole_solves;
+  counters_.solve_time_s += job.solution.summary.solve_time_s;
+  counters_.cpu_time_s = thread_cpu_seconds() - cpu_start_s_ + background_cpu_s_;
+  publish(job.solution.summary, true);
 }
 
 void OptimizerNode::solve(bool whole) {
@@ -187,11 +218,12 @@ void OptimizerNode::solve(bool whole) {
   if (whole) {
     optimizer_->compute_landmark_covariances();
     ++counters_.whole_solves;
+    whole_dirty_ = false;
   } else {
     ++counters_.window_solves;
   }
   counters_.solve_time_s += s.solve_time_s;
-  counters_.cpu_time_s = thread_cpu_seconds() - cpu_start_s_;
+  counters_.cpu_time_s = thread_cpu_seconds() - cpu_start_s_ + background_cpu_s_;
   dirty_ = false;
   publish(s, whole);
 }

@@ -112,6 +112,42 @@ struct OptimizerCounters {
   std::size_t solves = 0;
 };
 
+// The whole problem copied out of a MapOptimizer (MapOptimizer::snapshot()):
+// solvable on another thread while the optimiser goes on taking data and
+// solving windows; its solution goes back with MapOptimizer::adopt().
+struct OdometryFactor {
+  std::size_t from = 0;  // keyframe indices
+  std::size_t to = 0;
+  Eigen::Vector3d delta = Eigen::Vector3d::Zero();  // odometry composed between them, in from's frame
+  Eigen::Matrix3d sqrt_information = Eigen::Matrix3d::Identity();
+};
+struct ObservationFactor {
+  std::size_t keyframe = 0;
+  std::size_t landmark = 0;  // index into WholeProblem::landmark_ids
+  double range_m = 0.0;
+  double bearing_rad = 0.0;
+  double range_sigma_m = 1.0;
+  double bearing_sigma_rad = 1.0;
+};
+struct WholeProblem {
+  MapOptimizerOptions options;
+  std::vector<std::array<double, 3>> poses;  // keyframes; the first held fixed
+  std::vector<int> landmark_ids;
+  std::vector<std::array<double, 2>> landmarks;
+  std::vector<OdometryFactor> odometry;
+  std::vector<ObservationFactor> observations;
+};
+struct WholeSolution {
+  std::vector<std::array<double, 3>> poses;
+  std::vector<int> landmark_ids;
+  std::vector<std::array<double, 2>> landmarks;
+  std::vector<Eigen::Matrix2d> landmark_covs;  // NaN when not computed or rank deficient
+  SolveSummary summary;
+};
+// Pure: its own Ceres problem, nothing shared. With `covariances`, the
+// landmarks' marginal covariances too.
+WholeSolution solve_whole_problem(const WholeProblem& problem, bool covariances);
+
 class MapOptimizer {
  public:
   MapOptimizer(const MapOptimizerOptions& options, const slam::Pose2& start_pose, double start_time_s);
@@ -137,6 +173,13 @@ class MapOptimizer {
   // Landmark marginal covariances of the current solution (one Ceres covariance
   // computation; false and NaN covariances when the problem is rank deficient).
   bool compute_landmark_covariances();
+  // The whole problem as it stands, for solve_whole_problem() elsewhere.
+  WholeProblem snapshot() const;
+  // Takes a solution of an earlier snapshot: its keyframes and landmarks get
+  // the solved values; keyframes and landmarks added since move with the
+  // rigid correction of the snapshot's newest keyframe (their odometry and
+  // observations are relative to it), until the next solve refines them.
+  void adopt(const WholeSolution& solution);
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   std::vector<LandmarkSolution> landmarks() const;
@@ -169,6 +212,14 @@ class MapOptimizer {
   std::deque<std::array<double, 3>> pose_blocks_;  // stable addresses for Ceres
   std::vector<Keyframe> keyframes_;                // pose_blocks_ as poses
   std::map<int, LandmarkBlock> landmarks_;
+  // The factors as added (snapshot()), landmarks by id.
+  std::vector<OdometryFactor> odometry_factors_;
+  struct ObservationRecord {
+    std::size_t keyframe;
+    int landmark_id;
+    ObservationFactor factor;
+  };
+  std::vector<ObservationRecord> observation_records_;
   std::map<int, Eigen::Vector2d> landmark_guesses_;
   slam::ComposedMotion open_motion_;  // odometry since the newest keyframe
   double last_time_s_ = 0.0;

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -66,9 +67,11 @@ struct OptimizerNodeCounters {
 
 // The map optimiser process: Odometry, LandmarkObservation and the estimator's
 // MapState in; OptimisedMap out. One thread feeds the core in stamp order
-// (SensorQueue, as the estimator) and solves: the newest window every
-// window_period_s of data, the whole problem every whole_period_s and at the
-// end (with the landmarks' marginal covariances), publishing after each.
+// (SensorQueue, as the estimator) and solves the newest window every
+// window_period_s of data; every whole_period_s a copy of the whole problem
+// (MapOptimizer::snapshot) is solved in the background, with the landmarks'
+// marginal covariances, while the windows go on, and adopted when done; at the
+// end the whole problem once more. It publishes after each solve.
 // MapStates give the keyframes' starting poses (the filter's pose at a frame's
 // stamp, when it has arrived) and new landmarks' starting positions.
 class OptimizerNode {
@@ -90,6 +93,9 @@ class OptimizerNode {
   void loop();
   void step(const slam::SensorInput& input);
   void solve(bool whole);
+  // The background whole solve, if one is running: adopted and published when
+  // done (or, with `wait`, once done).
+  void collect_whole(bool wait);
   void publish(const map_optimizer::SolveSummary& s, bool whole);
   void log_status() const;
   diagnostics::Snapshot diagnostics_snapshot() const;
@@ -119,6 +125,14 @@ class OptimizerNode {
   double last_t_s_ = 0.0;
   std::optional<map_optimizer::SolveSchedule> schedule_;  // from the first input's time
   bool dirty_ = false;  // input since the last solve
+  bool whole_dirty_ = false;  // input since the last whole solve began
+  struct BackgroundWhole {
+    map_optimizer::WholeSolution solution;
+    double cpu_s = 0.0;
+    double due_t_s = 0.0;
+  };
+  std::future<BackgroundWhole> whole_job_;
+  double background_cpu_s_ = 0.0;  // the background solves' CPU time
   std::uint64_t last_odometry_seq_ = 0;
   std::uint64_t last_observation_seq_ = 0;
   double cpu_start_s_ = 0.0;
