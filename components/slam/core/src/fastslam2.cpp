@@ -654,7 +654,7 @@ double FastSlam2::draw_heading_at_return(Particle& p) {
     best = std::max(best, log_posterior[c]);
   }
   double total = 0.0;
-  for (double& l : log_posterior) total += std::exp(l - best);
+  for (const double l : log_posterior) total += std::exp(l - best);
   std::uniform_real_distribution<double> uniform(0.0, total);
   double u = uniform(rng_);
   std::size_t chosen = 0;
