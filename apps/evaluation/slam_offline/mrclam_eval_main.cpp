@@ -568,6 +568,8 @@ int run(const EvalArguments& args) {
   constexpr double kDeg = 180.0 / M_PI;
   bool all_better = true;
   double sum_ate = 0, sum_ate_aligned = 0, sum_head = 0, sum_lm = 0, sum_lma = 0, sum_wall = 0;
+  double worst_ate = 0.0;  // the full run with the largest ATE
+  int worst_robot = 0, worst_seed = 0;
   int runs = 0;
   offline::NeesStats nees_all;
   // --optimise: the same sums for the map optimiser's solutions.
@@ -618,6 +620,11 @@ int run(const EvalArguments& args) {
       robot_ate += rep.filter.ate_rmse_m;
       robot_dr += rep.dead_reckoning.ate_rmse_m;
       sum_ate += rep.filter.ate_rmse_m;
+      if (rep.filter.ate_rmse_m > worst_ate) {
+        worst_ate = rep.filter.ate_rmse_m;
+        worst_robot = robot;
+        worst_seed = seed;
+      }
       sum_ate_aligned += rep.filter.ate_rmse_aligned_m;
       sum_head += rep.filter.heading_rmse_rad * kDeg;
       sum_lm += rep.landmarks.rmse_m;
@@ -639,6 +646,9 @@ int run(const EvalArguments& args) {
   std::printf("MEAN over %d runs: ATE %.3f m (%.3f m after SE(2) alignment), heading %.2f deg, landmarks %.3f m raw / "
               "%.3f m aligned, %.2f s per run\n",
               runs, sum_ate / runs, sum_ate_aligned / runs, sum_head / runs, sum_lm / runs, sum_lma / runs, sum_wall / runs);
+  if (worst_ate > 0.0) {
+    std::printf("WORST run: ATE %.3f m (robot %d, seed %d)\n", worst_ate, worst_robot, worst_seed);
+  }
   if (nees_all.steps + nees_all.singular > 0) print_nees("POOLED over the full runs: pose", nees_all);
   print_fleet(fleet);
   if (opt_sum.runs > 0) {
