@@ -318,7 +318,7 @@ void MapOptimizer::add_frame(const slam::ObservationFrame& frame, const std::opt
     factor.range_sigma_m = range_sigma;
     factor.bearing_sigma_rad = bearing_sigma;
     problem_->AddResidualBlock(observation_cost(factor), loss_.get(), pose, lm.xy.data());
-    observation_records_.push_back({k, d->landmark_id, factor});
+    observation_records_.push_back({d->landmark_id, factor});
     ++lm.observations;
     lm.last_keyframe = k;
     ++counters_.observations;
@@ -478,12 +478,9 @@ MapOptimizer::PoseAnchor MapOptimizer::anchor_now() const {
 }
 
 slam::Pose2 MapOptimizer::pose_of(const PoseAnchor& anchor) const {
-  const std::array<double, 3>& b = pose_blocks_.at(anchor.keyframe);
-  const double c = std::cos(b[2]);
-  const double s = std::sin(b[2]);
-  return slam::Pose2(b[0] + c * anchor.relative.x() - s * anchor.relative.y(),
-                     b[1] + s * anchor.relative.x() + c * anchor.relative.y(),
-                     slam::wrap_angle(b[2] + anchor.relative.z()));
+  const std::array<double, 3> p =
+      compose(pose_blocks_.at(anchor.keyframe), {anchor.relative.x(), anchor.relative.y(), anchor.relative.z()});
+  return slam::Pose2(p[0], p[1], p[2]);
 }
 
 SolveSchedule::SolveSchedule(const SolveScheduleOptions& options, double start_s)

@@ -130,7 +130,7 @@ void OptimizerNode::loop() {
     if (stopping) {
       std::lock_guard<std::mutex> state_lock(state_mutex_);
       collect_whole(true);
-      if (optimizer_ && (dirty_ || whole_dirty_)) solve(true);
+      if (optimizer_ && dirty_) solve(true);
     }
     if (options_.status_period_s > 0.0 && Clock::now() >= next_status) {
       log_status();
@@ -176,13 +176,12 @@ void OptimizerNode::step(const slam::SensorInput& input) {
   }
   last_t_s_ = std::max(last_t_s_, t);
   dirty_ = true;
-  whole_dirty_ = true;
   collect_whole(false);
   map_optimizer::SolveKind due = schedule_->due(t);
   if (due == map_optimizer::SolveKind::kWhole) {
     if (!whole_job_.valid()) {
       // In the background on a copy: the windows go on meanwhile.
-      whole_dirty_ = false;
+      dirty_ = false;
       whole_job_ = std::async(std::launch::async, [problem = optimizer_->snapshot(), t] {
         const double cpu_before = thread_cpu_seconds();
         BackgroundWhole job;
@@ -218,13 +217,12 @@ void OptimizerNode::solve(bool whole) {
   if (whole) {
     optimizer_->compute_landmark_covariances();
     ++counters_.whole_solves;
-    whole_dirty_ = false;
+    dirty_ = false;
   } else {
     ++counters_.window_solves;
   }
   counters_.solve_time_s += s.solve_time_s;
   counters_.cpu_time_s = thread_cpu_seconds() - cpu_start_s_ + background_cpu_s_;
-  dirty_ = false;
   publish(s, whole);
 }
 

@@ -440,9 +440,7 @@ void FastSlam2::update_particle(Particle& p, const std::vector<RangeBearing>& de
     const bool readmit = lm->consecutive_rejections >= static_cast<std::uint32_t>(options_.gate_readmit_after);
     if (options_.gate_enabled && fit.mahalanobis2 > gate_d2_ && !readmit) {
       decision_[k] = Decision::kGated;
-      // An outlier costs the likelihood at the gate boundary, so particles that
-      // reject it are not favoured over those that explain it.
-      log_w += fit.log_likelihood + 0.5 * (fit.mahalanobis2 - gate_d2_);
+      log_w += outlier_log_likelihood(fit.log_likelihood, fit.mahalanobis2);
       continue;
     }
     decision_[k] = Decision::kUsed;
@@ -513,9 +511,8 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
   if (options_.delayed_sampling.split_heading) log_w += draw_heading_at_return(p);
   for (std::size_t k = 0; k < n; ++k) {
     if (decision_[k] == Decision::kNewDone) continue;
-    int i = g.find(slots_[k]);
+    const int i = joint_index(p, k);
     const Landmark* lm = p.map.find(slots_[k]);
-    if (i < 0) i = g.add_known(slots_[k], lm->mean, lm->cov);
     if ((g.landmark_mean(i) - g.mean.head<2>()).squaredNorm() < kMinLandmarkDistanceSq) {
       decision_[k] = Decision::kInvalid;
       continue;
@@ -541,7 +538,7 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
       // linear range can wreck it): a landmark due for readmission ends the
       // joint state instead, and plain FastSLAM 2.0 re-admits it next frame.
       decision_[k] = Decision::kGated;
-      log_w += fit.log_likelihood + 0.5 * (fit.mahalanobis2 - gate_d2_);
+      log_w += outlier_log_likelihood(fit.log_likelihood, fit.mahalanobis2);
       if (lm->consecutive_rejections + 1 >= static_cast<std::uint32_t>(options_.gate_readmit_after)) {
         end_joint = true;
       }
@@ -609,6 +606,13 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
   }
 }
 
+int FastSlam2::joint_index(Particle& p, std::size_t k) {
+  const int i = p.joint.find(slots_[k]);
+  if (i >= 0) return i;
+  const Landmark* lm = p.map.find(slots_[k]);
+  return p.joint.add_known(slots_[k], lm->mean, lm->cov);
+}
+
 double FastSlam2::draw_heading_at_return(Particle& p) {
   // Split only a heading too uncertain to sample from (the joint state's own
   // threshold), into components that narrow.
@@ -620,12 +624,7 @@ double FastSlam2::draw_heading_at_return(Particle& p) {
   known_.clear();
   for (std::size_t k = 0; k < decision_.size(); ++k) {
     if (decision_[k] == Decision::kNewDone) continue;
-    int i = g.find(slots_[k]);
-    if (i < 0) {
-      const Landmark* lm = p.map.find(slots_[k]);
-      i = g.add_known(slots_[k], lm->mean, lm->cov);
-    }
-    if (g.relative[static_cast<std::size_t>(i)] == 0) known_.push_back(k);
+    if (g.relative[static_cast<std::size_t>(joint_index(p, k))] == 0) known_.push_back(k);
   }
   if (known_.empty()) return 0.0;
   std::vector<HeadingComponent> components = split_heading(g, spacing);
@@ -643,7 +642,7 @@ double FastSlam2::draw_heading_at_return(Particle& p) {
       const JointFit fit = fit_observation(s, i, z_[k], r_[k]);
       if (!std::isfinite(fit.mahalanobis2) || !std::isfinite(fit.log_likelihood)) continue;
       if (options_.gate_enabled && fit.mahalanobis2 > gate_d2_) {
-        ll += fit.log_likelihood + 0.5 * (fit.mahalanobis2 - gate_d2_);
+        ll += outlier_log_likelihood(fit.log_likelihood, fit.mahalanobis2);
         continue;
       }
       ll += fit.log_likelihood;

@@ -215,9 +215,8 @@ class MapOptimizer {
   // The factors as added (snapshot()), landmarks by id.
   std::vector<OdometryFactor> odometry_factors_;
   struct ObservationRecord {
-    std::size_t keyframe;
     int landmark_id;
-    ObservationFactor factor;
+    ObservationFactor factor;  // its landmark index is set by snapshot()
   };
   std::vector<ObservationRecord> observation_records_;
   std::map<int, Eigen::Vector2d> landmark_guesses_;

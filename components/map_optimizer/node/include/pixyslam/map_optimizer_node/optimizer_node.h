@@ -124,8 +124,7 @@ class OptimizerNode {
   std::uint64_t epoch_ns_ = 0;  // the inbox's, from the first input on
   double last_t_s_ = 0.0;
   std::optional<map_optimizer::SolveSchedule> schedule_;  // from the first input's time
-  bool dirty_ = false;  // input since the last solve
-  bool whole_dirty_ = false;  // input since the last whole solve began
+  bool dirty_ = false;  // input since the last whole solve began (in the background or not)
   struct BackgroundWhole {
     map_optimizer::WholeSolution solution;
     double cpu_s = 0.0;

@@ -154,6 +154,14 @@ class FastSlam2 {
   // the frame's updates of the drawn component add (log of the mixture's
   // likelihood minus the component's).
   double draw_heading_at_return(Particle& p);
+  // Detection k's block in the particle's joint state; a mapped landmark not
+  // in it yet joins as known (independent of the rest).
+  int joint_index(Particle& p, std::size_t k);
+  // An outlier costs the likelihood at the gate boundary, so particles that
+  // reject it are not favoured over those that explain it.
+  double outlier_log_likelihood(double log_likelihood, double mahalanobis2) const {
+    return log_likelihood + 0.5 * (mahalanobis2 - gate_d2_);
+  }
   // The particles' weights normalised (from their log weights).
   std::vector<double> normalised_particle_weights() const;
   void resample_if_needed(const std::vector<double>& weights);
