@@ -99,7 +99,11 @@ grep -q "published 180 odometry, 18 observations, 180 ground truth, 3 robot sigh
 if grep "fewer than" "$work/dataset.log"; then fail "the bridge started before its 5 readers per topic matched"; fi
 if grep -E "received, [1-9][0-9]* lost" "$work/station.log"; then fail "messages lost"; fi
 grep -q "check passed" "$work/station.log" || fail "the log check"
-"$support/live_vs_offline.sh" "$bin" "$config" "$work/Dataset" "$work/run" "$work/station.log" 1,2 1 ||
+# Positions within 2 cm, not 1 mm: the live stamps are integer nanoseconds from
+# a per-run epoch, the offline times doubles, and in 2 of about 8 CI runs that
+# rounding flipped one draw of robot 1 (10.6 mm at one step, same steps, nothing
+# late or reordered, ATE equal); Dataset6 live vs offline shows up to 9.1 mm.
+"$support/live_vs_offline.sh" "$bin" "$config" "$work/Dataset" "$work/run" "$work/station.log" 1,2 1 0 0.02 ||
   fail "the containers' results differ from slam_offline's"
 "$bin/pixyslam_log" print "$work/run/run.mcap" --topic pixyslam/fleet_map --json > "$work/fleet.json" ||
   fail "print the fleet map"
