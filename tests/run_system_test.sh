@@ -37,6 +37,7 @@ for t in "${topics[@]}"; do
     --config "$work/config/slam_estimator.yaml" > "$work/echo_$t.jsonl" 2> "$work/echo_$t.err" &
   echoes+=($!)
 done
+trap 'kill "$launcher" "${echoes[@]}" 2>/dev/null || true; rm -rf "$work"' EXIT
 for pid in "${echoes[@]}"; do wait "$pid" || { echo "FAIL: pixyslam_spy echo failed"; cat "$work"/echo_*.err; exit 1; }; done
 wait "$launcher" || status=$?
 grep -v "robot_sim: t \|status: " "$work/out.log"

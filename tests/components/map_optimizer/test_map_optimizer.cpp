@@ -256,6 +256,20 @@ TEST(SolveSchedule, WholeSolvesTakeAtMostTheirDutyOfDataTime) {
   EXPECT_EQ(unbounded.due(20.0), SolveKind::kWhole);
 }
 
+// A whole solve due while the last one still runs elsewhere is not lost: it
+// stays due (windows go on meanwhile) and starts at the first call after, and
+// the period counts from that start.
+TEST(SolveSchedule, AWholeSolveDueWhileOneRunsWaitsForIt) {
+  SolveSchedule s({100, 1.0, 10.0, 0.0}, 0.0);
+  ASSERT_EQ(s.due(10.0), SolveKind::kWhole);
+  EXPECT_EQ(s.due(20.0, false), SolveKind::kWindow);
+  EXPECT_EQ(s.due(20.5, false), SolveKind::kNone);
+  EXPECT_EQ(s.due(21.0, false), SolveKind::kWindow);
+  EXPECT_EQ(s.due(21.2, true), SolveKind::kWhole);  // the last one is done
+  EXPECT_NE(s.due(31.1), SolveKind::kWhole);
+  EXPECT_EQ(s.due(31.2), SolveKind::kWhole);
+}
+
 // The whole problem copied out and solved elsewhere (the live process's
 // background solve) ends where solve() does, with the same covariances; data
 // added after the copy ride along rigidly with its newest keyframe.

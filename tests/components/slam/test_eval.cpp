@@ -157,6 +157,7 @@ TEST(CompareTrajectory, MaxAndRmseDiffer) {
   const TrajectoryErrors e = compare_trajectory(estimate, truth);
   EXPECT_EQ(e.samples, 3u);
   EXPECT_NEAR(e.max_position_error_m, 4.0, 1e-12);
+  EXPECT_EQ(e.max_position_error_t_s, 1.0);  // the truth pose of the maximum
   EXPECT_NEAR(e.ate_rmse_m, std::sqrt(25.0 / 3.0), 1e-12);
 }
 

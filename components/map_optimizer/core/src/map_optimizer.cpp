@@ -488,8 +488,8 @@ SolveSchedule::SolveSchedule(const SolveScheduleOptions& options, double start_s
       next_window_s_(start_s + options.window_period_s),
       next_whole_s_(start_s + options.whole_period_s) {}
 
-SolveKind SolveSchedule::due(double t_s) {
-  if (options_.whole_period_s > 0.0 && t_s >= next_whole_s_) {
+SolveKind SolveSchedule::due(double t_s, bool whole_possible) {
+  if (whole_possible && options_.whole_period_s > 0.0 && t_s >= next_whole_s_) {
     next_whole_s_ = t_s + options_.whole_period_s;
     next_window_s_ = t_s + options_.window_period_s;
     return SolveKind::kWhole;

@@ -177,25 +177,23 @@ void OptimizerNode::step(const slam::SensorInput& input) {
   last_t_s_ = std::max(last_t_s_, t);
   dirty_ = true;
   collect_whole(false);
-  map_optimizer::SolveKind due = schedule_->due(t);
+  // While the last whole solve still runs, the next one waits for it (and
+  // starts at the first input after); windows go on meanwhile.
+  const map_optimizer::SolveKind due = schedule_->due(t, !whole_job_.valid());
   if (due == map_optimizer::SolveKind::kWhole) {
-    if (!whole_job_.valid()) {
-      // In the background on a copy: the windows go on meanwhile.
-      dirty_ = false;
-      whole_job_ = std::async(std::launch::async, [problem = optimizer_->snapshot(), t] {
-        const double cpu_before = thread_cpu_seconds();
-        BackgroundWhole job;
-        job.solution = map_optimizer::solve_whole_problem(problem, true);
-        job.cpu_s = thread_cpu_seconds() - cpu_before;
-        job.due_t_s = t;
-        return job;
-      });
-      return;
-    }
-    due = map_optimizer::SolveKind::kWindow;  // the last one is still running
+    // In the background on a copy.
+    dirty_ = false;
+    whole_job_ = std::async(std::launch::async, [problem = optimizer_->snapshot(), t] {
+      const double cpu_before = thread_cpu_seconds();
+      BackgroundWhole job;
+      job.solution = map_optimizer::solve_whole_problem(problem, true);
+      job.cpu_s = thread_cpu_seconds() - cpu_before;
+      job.due_t_s = t;
+      return job;
+    });
+  } else if (due == map_optimizer::SolveKind::kWindow) {
+    solve(false);
   }
-  if (due == map_optimizer::SolveKind::kNone) return;
-  solve(false);
 }
 
 void OptimizerNode::collect_whole(bool wait) {

@@ -100,7 +100,10 @@ TrajectoryErrors compare_trajectory(const std::vector<TimedPose>& estimate, cons
     const double heading_err = wrap_angle(e.theta_rad - g.theta_rad);
     pos_sum_sq += pos_err * pos_err;
     heading_sum_sq += heading_err * heading_err;
-    errors.max_position_error_m = std::max(errors.max_position_error_m, pos_err);
+    if (est_xy.empty() || pos_err > errors.max_position_error_m) {
+      errors.max_position_error_m = pos_err;
+      errors.max_position_error_t_s = g.t_s;
+    }
     est_xy.push_back(pe);
     truth_xy.push_back(pg);
   });

@@ -253,8 +253,11 @@ class SolveSchedule {
  public:
   SolveSchedule(const SolveScheduleOptions& options, double start_s);
   // The solve due once the data reach t_s; a whole solve also restarts the
-  // window period (it solved the window too).
-  SolveKind due(double t_s);
+  // window period (it solved the window too). While the caller cannot start a
+  // whole solve (whole_possible false: the last one still runs elsewhere) a due
+  // whole solve stays due, to start at the first call after, and a window may
+  // be due meanwhile.
+  SolveKind due(double t_s, bool whole_possible = true);
   // A solve due at t_s took `seconds` (CPU): whole_max_duty spaces the next
   // whole solve by it.
   void solved(SolveKind kind, double t_s, double seconds);

@@ -25,7 +25,8 @@ struct LandmarkPoint {
 };
 
 // Trajectory error statistics over `samples` truth poses: RMSE and maximum of
-// the position error (m), RMSE of the wrapped heading error (rad), and the
+// the position error (m) and the truth time of that maximum (s), RMSE of the
+// wrapped heading error (rad), and the
 // position RMSE after the best rigid 2-D alignment of estimate onto truth (m;
 // equals ate_rmse_m when fewer than 2 samples).
 struct TrajectoryErrors {
@@ -33,6 +34,7 @@ struct TrajectoryErrors {
   double ate_rmse_m = 0;
   double heading_rmse_rad = 0;
   double max_position_error_m = 0;
+  double max_position_error_t_s = 0;
   double ate_rmse_aligned_m = 0;
 };
 
