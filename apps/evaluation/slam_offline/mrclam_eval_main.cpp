@@ -2,6 +2,7 @@
 // set for every robot, several seeds per robot.
 //   mrclam_eval --dataset DIR --config FILE [--robots 1,2,3,4,5] [--seeds 1,2,3]
 //               [--association known_id|maximum_likelihood] [--segments SECONDS] [--loro]
+//               [--blind-return] [--optimise] [--set filter.KEY=V|mrclam.KEY=V ...]
 // --association maximum_likelihood withholds the landmark ids from the filter
 // (the landmark columns then match nothing by id; ATE and heading still count).
 // Every run also reports the pose NEES against the truth (3 dof, ideal mean 3).
@@ -723,7 +724,7 @@ int main(int argc, char** argv) {
   app::add_config(cli, a.config_path, "filter options (filter:) and corrections (mrclam:)");
   app::add_set(cli, a.sets, "filter.delayed_sampling.split_heading=true or mrclam.odometry_delay_s=0, both listed below");
   cli.option("--robots", robots, "robots to run (default 1,2,3,4,5)").type("LIST");
-  cli.option("--seeds", seeds, "filter seeds per robot (default 1,2,3)").type("LIST");
+  cli.option("--seeds", seeds, "filter seeds per robot (default 1,2,3; they replace filter.seed)").type("LIST");
   cli.option("--association", a.association, "known_id (default) or maximum_likelihood (ids withheld)")
       .choices({"known_id", "maximum_likelihood"})
       .type("M");

@@ -70,8 +70,10 @@ struct OptimizerNodeCounters {
 // (SensorQueue, as the estimator) and solves the newest window every
 // window_period_s of data; every whole_period_s a copy of the whole problem
 // (MapOptimizer::snapshot) is solved in the background, with the landmarks'
-// marginal covariances, while the windows go on, and adopted when done; at the
-// end the whole problem once more. It publishes after each solve.
+// marginal covariances, while the windows go on, and adopted when done (one due
+// while the last still runs starts at the first input after it; whole_max_duty
+// spaces them as they grow); at the end the whole problem once more, unless a
+// background solve already covered every input. It publishes after each solve.
 // MapStates give the keyframes' starting poses (the filter's pose at a frame's
 // stamp, when it has arrived) and new landmarks' starting positions.
 class OptimizerNode {
