@@ -133,6 +133,22 @@ TEST_F(MrclamTest, MapsBarcodesDropsRobotsAndSpuriousAndGroupsFrames) {
   EXPECT_DOUBLE_EQ(d.frames[1].detections[0].range_m, 4.0);
 }
 
+// A data set converted from another robot may number its landmarks from 1: a
+// subject the landmark file lists is a landmark, even among the robots' 1-5.
+TEST_F(MrclamTest, ASubjectTheLandmarkFileListsIsALandmarkEvenBelowSix) {
+  write("Landmark_Groundtruth.dat", header("Landmark Groundtruth") +
+                                        "  3 \t 2.0 \t 1.0 \t 0.0001 \t 0.0002 \n"
+                                        "  6 \t 0.5 \t -4.25 \t 0.0001 \t 0.0002 \n");
+  const RobotData d = load_robot(dir(), 1);
+  EXPECT_EQ(d.counts.robot_rows, 1u);     // subject 2 (barcode 14) is still a robot
+  EXPECT_EQ(d.counts.landmark_rows, 4u);  // subject 3 (barcode 41) joined the landmarks
+  ASSERT_EQ(d.frames.size(), 3u);
+  EXPECT_DOUBLE_EQ(d.frames[1].t_s, 1248444190.0);
+  ASSERT_EQ(d.frames[1].detections.size(), 1u);
+  EXPECT_EQ(d.frames[1].detections[0].subject, 3);
+  EXPECT_DOUBLE_EQ(d.frames[1].detections[0].range_m, 1.5);
+}
+
 TEST_F(MrclamTest, MeasurementsOutOfOrderAreSortedBeforeGrouping) {
   write("Robot1_Measurement.dat", header("Measurement") +
                                       "20.0 63 1.0 0.0\n"

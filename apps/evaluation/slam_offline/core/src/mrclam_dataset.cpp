@@ -199,7 +199,9 @@ RobotData load_robot(const std::string& dataset_dir, int robot) {
       continue;
     }
     const int subject = it->second;
-    if (subject >= kFirstRobot && subject <= kLastRobot) {
+    // Subjects 1-5 are the robots, unless the landmark file lists one (a data
+    // set converted from another robot may number its landmarks from 1).
+    if (subject >= kFirstRobot && subject <= kLastRobot && landmark_ids.count(subject) == 0) {
       ++data.counts.robot_rows;
       if (data.robot_sightings.empty() || data.robot_sightings.back().t_s != m.t_s) {
         data.robot_sightings.push_back(MeasurementFrame{m.t_s, {}});
