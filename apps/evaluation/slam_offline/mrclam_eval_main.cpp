@@ -41,6 +41,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -573,16 +574,23 @@ int run(const EvalArguments& args) {
   int worst_robot = 0, worst_seed = 0;
   int runs = 0;
   offline::NeesStats nees_all;
+  // Landmark errors, NaN (printed "nan") without landmark ground truth.
+  const auto lm_raw = [](const offline::Report& r) {
+    return r.has_landmarks ? r.landmarks.rmse_m : std::numeric_limits<double>::quiet_NaN();
+  };
+  const auto lm_aligned = [](const offline::Report& r) {
+    return r.has_landmarks ? r.landmarks.rmse_aligned_m : std::numeric_limits<double>::quiet_NaN();
+  };
   // --optimise: the same sums for the map optimiser's solutions.
   struct Sums {
     double ate = 0, ate_aligned = 0, head = 0, lm = 0, lma = 0, worst = 0;
     int runs = 0;
-    void add(const offline::Report& r) {
+    void add(const offline::Report& r, double landmarks_raw, double landmarks_aligned) {
       ate += r.filter.ate_rmse_m;
       ate_aligned += r.filter.ate_rmse_aligned_m;
       head += r.filter.heading_rmse_rad * 180.0 / M_PI;
-      lm += r.landmarks.rmse_m;
-      lma += r.landmarks.rmse_aligned_m;
+      lm += landmarks_raw;
+      lma += landmarks_aligned;
       worst = std::max(worst, r.filter.ate_rmse_m);
       ++runs;
     }
@@ -602,8 +610,8 @@ int run(const EvalArguments& args) {
       const offline::Report rep = offline::evaluate(input, res);
       std::printf("%-6d %-5d %9.3f %9.3f %9.3f %10.2f %10.2f %11.3f %11.3f %8llu %5zu %8.2f %7.2f %6.1f %6.1f\n",
                   robot, seed, rep.filter.ate_rmse_m, rep.filter.ate_rmse_aligned_m, rep.dead_reckoning.ate_rmse_m,
-                  rep.filter.heading_rmse_rad * kDeg, rep.dead_reckoning.heading_rmse_rad * kDeg, rep.landmarks.rmse_m,
-                  rep.landmarks.rmse_aligned_m, static_cast<unsigned long long>(res.counters.observations_gated),
+                  rep.filter.heading_rmse_rad * kDeg, rep.dead_reckoning.heading_rmse_rad * kDeg, lm_raw(rep),
+                  lm_aligned(rep), static_cast<unsigned long long>(res.counters.observations_gated),
                   res.landmarks.size(), res.wall_time_s, rep.nees.mean(), 100.0 * rep.nees.fraction_inside(),
                   100.0 * rep.nees.fraction_below_upper());
       std::fflush(stdout);
@@ -614,9 +622,9 @@ int run(const EvalArguments& args) {
         const offline::Report o = offline::evaluate(input, *opt);
         std::printf("%-6d %-5d %9.3f %9.3f %9s %10.2f %10s %11.3f %11.3f %8s %5zu %8.2f  (map optimiser)\n", robot,
                     seed, o.filter.ate_rmse_m, o.filter.ate_rmse_aligned_m, "", o.filter.heading_rmse_rad * kDeg, "",
-                    o.landmarks.rmse_m, o.landmarks.rmse_aligned_m, "", opt->landmarks.size(), opt->wall_time_s);
+                    lm_raw(o), lm_aligned(o), "", opt->landmarks.size(), opt->wall_time_s);
         std::fflush(stdout);
-        opt_sum.add(o);
+        opt_sum.add(o, lm_raw(o), lm_aligned(o));
       }
       robot_ate += rep.filter.ate_rmse_m;
       robot_dr += rep.dead_reckoning.ate_rmse_m;
@@ -628,8 +636,8 @@ int run(const EvalArguments& args) {
       }
       sum_ate_aligned += rep.filter.ate_rmse_aligned_m;
       sum_head += rep.filter.heading_rmse_rad * kDeg;
-      sum_lm += rep.landmarks.rmse_m;
-      sum_lma += rep.landmarks.rmse_aligned_m;
+      sum_lm += lm_raw(rep);
+      sum_lma += lm_aligned(rep);
       sum_wall += res.wall_time_s;
       nees_all.merge(rep.nees);
       ++runs;

@@ -161,7 +161,8 @@ int run(const Args& args) {
     input = offline::mrclam_input(data, model);
     offline::keep_first_seconds(input, args.mrclam_duration_s);
     std::printf("MRCLAM %s robot %d: %zu odometry rows, %zu frames, landmarks from %s\n", dataset.c_str(), robot,
-                data.odometry.size(), data.frames.size(), data.landmark_file.c_str());
+                data.odometry.size(), data.frames.size(),
+                data.landmark_file.empty() ? "nowhere (no landmark file)" : data.landmark_file.c_str());
     std::printf("dropped rows           %zu robot (subjects 1-5 not in the landmark file), %zu unknown barcode\n", data.counts.robot_rows,
                 data.counts.unknown_barcode_rows);
     title = "MRCLAM robot " + std::to_string(robot);

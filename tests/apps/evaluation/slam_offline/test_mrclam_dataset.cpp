@@ -170,6 +170,18 @@ TEST_F(MrclamTest, MissingGroundtruthGivesEmptyTrajectory) {
   EXPECT_EQ(d.frames.size(), 2u);
 }
 
+// A recording without surveyed landmarks still loads: no landmark truth, the
+// detections all kept (subjects above 5), robots (1-5) dropped as before.
+TEST_F(MrclamTest, MissingLandmarkFileGivesNoLandmarkTruth) {
+  std::filesystem::remove(dir_ / "Landmark_Groundtruth.dat");
+  const RobotData d = load_robot(dir(), 1);
+  EXPECT_TRUE(d.landmarks.empty());
+  EXPECT_EQ(d.landmark_file, "");
+  EXPECT_EQ(d.counts.landmark_rows, 3u);
+  EXPECT_EQ(d.counts.robot_rows, 2u);
+  EXPECT_EQ(d.frames.size(), 2u);
+}
+
 TEST_F(MrclamTest, PrefersFixedLandmarkFile) {
   write("Landmark_Groundtruth_fixed_11_17.dat", header("Landmark Groundtruth") +
                                                     " 11 \t -2.0 \t 0.5 \t 0.0001 \t 0.0002 \n"

@@ -157,19 +157,26 @@ RobotData load_robot(const std::string& dataset_dir, int robot) {
     }
   });
 
-  // Landmark ground truth, preferring the corrected file.
-  data.landmark_file = fs::exists(dir / kLandmarkFixedFile, ec) ? kLandmarkFixedFile : kLandmarkFile;
-  const std::string landmark_path = file(data.landmark_file);
+  // Landmark ground truth, preferring the corrected file; optional (a robot of
+  // one's own may have no surveyed landmarks).
   std::set<int> landmark_ids;
-  read_table<5>(landmark_path, {Col::Int, Col::Real, Col::Real, Col::Real, Col::Real},
-                [&](const std::array<double, 5>& v, std::size_t line_no) {
-                  const int subject = static_cast<int>(v[0]);
-                  if (!landmark_ids.insert(subject).second) {
-                    throw std::runtime_error("mrclam: " + landmark_path + ":" + std::to_string(line_no) +
-                                             ": landmark " + std::to_string(subject) + " listed twice");
-                  }
-                  data.landmarks.push_back(eval::LandmarkPoint{subject, v[1], v[2]});
-                });
+  if (fs::exists(dir / kLandmarkFixedFile, ec)) {
+    data.landmark_file = kLandmarkFixedFile;
+  } else if (fs::exists(dir / kLandmarkFile, ec)) {
+    data.landmark_file = kLandmarkFile;
+  }
+  if (!data.landmark_file.empty()) {
+    const std::string landmark_path = file(data.landmark_file);
+    read_table<5>(landmark_path, {Col::Int, Col::Real, Col::Real, Col::Real, Col::Real},
+                  [&](const std::array<double, 5>& v, std::size_t line_no) {
+                    const int subject = static_cast<int>(v[0]);
+                    if (!landmark_ids.insert(subject).second) {
+                      throw std::runtime_error("mrclam: " + landmark_path + ":" + std::to_string(line_no) +
+                                               ": landmark " + std::to_string(subject) + " listed twice");
+                    }
+                    data.landmarks.push_back(eval::LandmarkPoint{subject, v[1], v[2]});
+                  });
+  }
 
   // Odometry.
   read_table<3>(file(prefix + "Odometry.dat"), {Col::Real, Col::Real, Col::Real},

@@ -59,7 +59,8 @@ struct ReadCounts {
 // RobotN_Groundtruth.dat is absent. landmarks come from
 // Landmark_Groundtruth_fixed_11_17.dat when that file exists (Dataset1's
 // original file has landmarks 11 and 17 swapped), else from
-// Landmark_Groundtruth.dat; landmark_file holds the file name used.
+// Landmark_Groundtruth.dat; landmark_file holds the file name used (empty, and
+// no landmarks, when neither exists: a recording without surveyed landmarks).
 struct RobotData {
   int robot = 0;
   std::vector<OdometryRow> odometry;
