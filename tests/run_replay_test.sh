@@ -2,7 +2,7 @@
 # Replays a recorded run's odometry and camera frames (pixyslam_play) through
 # a fresh estimator with the same config and seed (config/launch_replay.yaml,
 # on a DDS domain of its own) and passes only if every recorded MapState is
-# reproduced exactly (`pixyslam_log compare`: all fields but the stamps'
+# reproduced exactly (`pixyslam_log compare`: all fields but samples_late and the stamps'
 # clock and the step's CPU time).
 #   run_replay_test.sh BIN_DIR CONFIG_DIR LOG.mcap
 set -euo pipefail
