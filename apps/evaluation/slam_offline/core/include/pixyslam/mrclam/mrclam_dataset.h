@@ -47,7 +47,8 @@ struct MeasurementFrame {
 // which robot_rows saw another robot (subject 1..5 and not in the landmark
 // file), unknown_barcode_rows had a barcode absent from Barcodes.dat (spurious),
 // and landmark_rows were kept as detections (a subject the landmark file lists,
-// or any mapped subject above 5, even one missing from the landmark file). measurement_rows = robot_rows + unknown_barcode_rows + landmark_rows.
+// or any mapped subject above 5, even one missing from the landmark file).
+// measurement_rows = robot_rows + unknown_barcode_rows + landmark_rows.
 struct ReadCounts {
   std::size_t measurement_rows = 0, robot_rows = 0, unknown_barcode_rows = 0, landmark_rows = 0;
 };
