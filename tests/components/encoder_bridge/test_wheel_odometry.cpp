@@ -349,10 +349,46 @@ TEST(OdometryAccumulator, StalledStreamEmitsEmptyPeriodsOnMarkGap) {
   acc.add(0.05, step_of(0.05, 1.0, 0.0));
   const auto out = acc.mark_gap(0.35);
   ASSERT_EQ(out.size(), 3u);
-  EXPECT_NEAR(out[0].v_mps, 0.5, 1e-9);
+  // The period the stream stalled in: 1 m/s measured over its first half, the
+  // rest unknown, so 1 m/s over the whole of it.
+  EXPECT_NEAR(out[0].v_mps, 1.0, 1e-9);
+  EXPECT_NEAR(out[0].covered_s, 0.05, 1e-12);
+  EXPECT_EQ(acc.counters().stalled_periods_extrapolated, 1u);
   EXPECT_NEAR(out[1].v_mps, 0.0, 1e-15);
   EXPECT_NEAR(out[1].covered_s, 0.0, 1e-15);
   EXPECT_NEAR(out[2].t_s, 0.2, 1e-12);
+}
+
+TEST(OdometryAccumulator, ABacklogAfterAStallMarkIsNotCountedTwice) {
+  // Given a robot at 0.2 m/s whose steps (50 Hz) stop arriving at t = 1 s (the
+  // Arduino's writer stalled) and the bridge closing the periods up to 1.5 s as
+  // "no data" (the filter holds the last command through them),
+  OdometryAccumulator acc(10.0);
+  std::vector<OdometryOutput> out;
+  const auto keep = [&](const OdometryOutput& o) { out.push_back(o); };
+  acc.add(0.0, baseline(), keep);
+  for (int k = 1; k <= 50; ++k) acc.add(0.02 * k, step_of(0.02, 0.2, 0.1), keep);
+  acc.mark_gap(1.5, keep);
+  ASSERT_EQ(out.size(), 15u);
+  // when the backlog of 1.0..2.0 s arrives,
+  for (int k = 51; k <= 100; ++k) acc.add(0.02 * k, step_of(0.02, 0.2, 0.1), keep);
+  // the steps before 1.5 s are dropped, not piled into the next period: every
+  // period after the gap holds the true speed (a burst would show 0.2 m/s *
+  // (1 + 0.5 s / 0.1 s) = 1.2 m/s in the first),
+  ASSERT_EQ(out.size(), 20u);
+  for (std::size_t k = 15; k < out.size(); ++k) {
+    EXPECT_NEAR(out[k].v_mps, 0.2, 1e-9) << k;
+    EXPECT_NEAR(out[k].w_radps, 0.1, 1e-9) << k;
+  }
+  EXPECT_EQ(acc.counters().steps_after_gap, 25u);
+  // and a step that straddles the mark counts with its part after it.
+  OdometryAccumulator straddle(10.0);
+  straddle.add(0.0, baseline());
+  straddle.mark_gap(0.31);
+  const auto part = straddle.add(0.4, step_of(0.1, 0.5, 0.0));
+  ASSERT_EQ(part.size(), 1u);  // period [0.3, 0.4)
+  EXPECT_NEAR(part[0].distance_m, 0.5 * 0.09, 1e-12);
+  EXPECT_EQ(straddle.counters().steps_after_gap, 0u);
 }
 
 TEST(OdometryAccumulator, FirstStepCoversItsOwnInterval) {
@@ -391,7 +427,7 @@ TEST(OdometryAccumulator, OutputDistancesSumToTheStepsWithJitteryStamps) {
     rotation += u.step.rotation_rad;
     acc.add(host, u, keep);
   }
-  acc.mark_gap(30.05, keep);
+  acc.add(30.05, baseline(), keep);  // closes the last period uncovered (not a stall)
   EXPECT_NEAR(sum_d, distance, 1e-9);
   EXPECT_NEAR(sum_r, rotation, 1e-9);
   EXPECT_GT(acc.counters().host_time_backwards, 0u);

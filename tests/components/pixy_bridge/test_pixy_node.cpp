@@ -211,6 +211,23 @@ std::vector<pixy::PixyBlock> blocks_of_frame(std::size_t i) {
   }
 }
 
+// The shipped pixy options, on the test's loopback domain, latency kLatencyNs.
+PixyNodeOptions shipped_options() {
+  PixyNodeOptions options;
+  auto root = config::YamlReader::from_file(std::string(PIXYSLAM_CONFIG_DIR) + "/pixy_bridge.yaml");
+  options.pixy = read_pixy_node_options(root, PIXYSLAM_CONFIG_DIR).pixy;
+  options.dds = loopback_options();
+  options.camera_latency_s = 1e-9 * static_cast<double>(kLatencyNs);
+  options.process.status_period_s = 0.0;
+  return options;
+}
+
+// Starts the node once the test's reader matched its writer.
+void start_when_read(PixyNode& node) {
+  ASSERT_TRUE(node.wait_for_subscribers(1, std::chrono::seconds(10)));
+  node.start();
+}
+
 TEST(PixyNode, PublishesOneObservationPerFrameAndSkipsBadBytes) {
   // Given 20 camera frames, one chunk each, with garbage before some frames
   // and a corrupted block inside frame 5,
@@ -237,24 +254,17 @@ TEST(PixyNode, PublishesOneObservationPerFrameAndSkipsBadBytes) {
   // The camera then sends nothing: the last frame completes by frame_timeout_s.
   script->add_idle(arrival_ns(kFrames - 1) + 1000000000ull);
 
-  PixyNodeOptions options;
-  options.pixy = [] {
-    auto root = config::YamlReader::from_file(std::string(PIXYSLAM_CONFIG_DIR) + "/pixy_bridge.yaml");
-    return read_pixy_node_options(root, PIXYSLAM_CONFIG_DIR).pixy;
-  }();
-  options.dds = loopback_options();
-  options.camera_latency_s = 1e-9 * static_cast<double>(kLatencyNs);
-  options.process.status_period_s = 0.0;
+  const PixyNodeOptions options = shipped_options();
   LogLines log;
   ObservationInbox& inbox = observation_inbox();
   inbox.clear();
   PixyNode node(options, std::make_unique<bridge::ScriptedByteSource>(script, "/dev/pixy_test"), log.sink(),
                 bridge::ByteScript::clock(script));
-  ASSERT_TRUE(node.wait_for_subscribers(1, std::chrono::seconds(10)));
-  node.start();
+  start_when_read(node);
 
   // Then one observation per frame arrives, in order, also for frames without
-  // detections, stamped when the frame's last block was read minus the latency.
+  // detections, stamped when the frame's last block (or its start) was read
+  // minus the latency.
   std::vector<msg::LandmarkObservation> got = inbox.wait_for(kFrames, std::chrono::seconds(10));
   ASSERT_EQ(got.size(), kFrames);
   std::this_thread::sleep_for(milliseconds(200));
@@ -270,9 +280,9 @@ TEST(PixyNode, PublishesOneObservationPerFrameAndSkipsBadBytes) {
     EXPECT_EQ(m.header().frame_id(), "camera");
     EXPECT_EQ(m.camera_frame(), i);
     // A frame without blocks is known only when the next frame's first word
-    // arrives (a lone sync word is ambiguous until then).
-    const std::size_t read_with = blocks_of_frame(i).empty() ? i + 1 : i;
-    EXPECT_EQ(m.header().stamp_ns(), arrival_ns(read_with) - kLatencyNs);
+    // arrives (a lone sync word is ambiguous until then), a frame period
+    // later: it is stamped that period before.
+    EXPECT_EQ(m.header().stamp_ns(), arrival_ns(i) - kLatencyNs);
     switch (i % 4) {
       case 0:
         EXPECT_EQ(m.blocks_in_frame(), 1u);
@@ -321,6 +331,48 @@ TEST(PixyNode, PublishesOneObservationPerFrameAndSkipsBadBytes) {
   EXPECT_EQ(c.detections.detections, 5u * 1 + 5u * 2);
   EXPECT_EQ(c.detections.unknown_signature, 5u + 5u);
   EXPECT_TRUE(log.contains("final status: frames 20"));
+}
+
+TEST(PixyNode, FramesReadInOneChunkAreStampedWhenTheCameraSentThem) {
+  // Given a camera sending 24 frames at 10 Hz, each with landmark 1, of which
+  // the host read frames 12 to 19 in one chunk 60 ms after frame 19 (the
+  // reader, or the camera's writer, was left unscheduled for 0.8 s, as on a
+  // loaded host),
+  ObservationInbox& inbox = observation_inbox();
+  inbox.clear();
+  constexpr std::size_t kFrames = 24;
+  constexpr std::uint64_t kCameraNs = 100000000ull;
+  const auto sent_ns = [&](std::size_t i) { return kBaseNs + kCameraNs * i; };
+  auto script = std::make_shared<bridge::ByteScript>();
+  std::vector<std::uint8_t> bunch;
+  for (std::size_t i = 0; i < kFrames; ++i) {
+    const std::vector<std::uint8_t> frame = pixy::encode_frame({landmark_1()});
+    if (i < 12 || i >= 20) {
+      script->add_bytes(frame, sent_ns(i));
+      continue;
+    }
+    bunch.insert(bunch.end(), frame.begin(), frame.end());
+    if (i == 19) script->add_bytes(bunch, sent_ns(i) + 60000000ull);
+  }
+  script->add_idle(sent_ns(kFrames - 1) + 1000000000ull);
+  const PixyNodeOptions options = shipped_options();
+  ASSERT_EQ(options.pixy.rate.frame_rate_hz, 50.0);  // the Pixy's rate, faster than this camera's
+  LogLines log;
+  PixyNode node(options, std::make_unique<bridge::ScriptedByteSource>(script, "/dev/pixy_test"), log.sink(),
+                bridge::ByteScript::clock(script));
+  start_when_read(node);
+
+  // then every frame is published, stamped when the camera sent it: the
+  // bunched ones a period apart (100 ms, measured on the frames before), in
+  // the camera's phase, not all at the read.
+  const std::vector<msg::LandmarkObservation> got = inbox.wait_for(kFrames, std::chrono::seconds(10));
+  node.stop();
+  ASSERT_EQ(got.size(), kFrames);
+  for (std::size_t i = 0; i < kFrames; ++i) {
+    EXPECT_EQ(got[i].header().stamp_ns(), sent_ns(i) - kLatencyNs) << "frame " << i;
+    EXPECT_EQ(got[i].detections().size(), 1u) << "frame " << i;
+  }
+  EXPECT_EQ(node.counters().rate.rate_limited, 0u);
 }
 
 // The diagnostics reports of the node under test (robot id of loopback_options()).

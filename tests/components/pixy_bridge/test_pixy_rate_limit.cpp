@@ -3,7 +3,8 @@
 // with their arrival time, each frame the parser completes is offered at the
 // time of the chunk that completed it. A sync-word flood and valid frames at
 // 10 kHz are cut down to the configured rates and counted; a real camera's
-// 50 Hz (with read jitter and bunched reads) loses nothing. And the options.
+// 50 Hz (with read jitter and bunched reads) loses nothing. The stamps of
+// frames read in one chunk (bunched_frame_end_ns, FrameClock). And the options.
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -16,6 +17,7 @@
 
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/pixy/frame_rate_limiter.h"
+#include "pixyslam/pixy/frame_stamp.h"
 #include "pixyslam/pixy/pixy_block_parser.h"
 #include "pixyslam/pixy/pixy_options.h"
 
@@ -272,6 +274,115 @@ TEST(PixyRateLimitOptions, BadRatesAreNamed) {
   bad = FrameRateOptions{};
   bad.tolerance_s = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(validate(bad), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------- frames read in one chunk
+
+constexpr std::uint64_t kPeriodNs = 20000000ull;  // 50 Hz
+
+TEST(BunchedFrameEnd, FramesReadTogetherAreSpreadBackByTheFramePeriod) {
+  // Given a chunk read 0.2 s after the previous one (the reader was unscheduled),
+  const std::uint64_t previous = kBaseNs, read = kBaseNs + 10 * kPeriodNs;
+  // the frame still open at its end ended at the read, and each earlier one a
+  // frame period before the next.
+  EXPECT_EQ(bunched_frame_end_ns(read, previous, 0, kPeriodNs), read);
+  for (std::uint64_t k = 1; k < 10; ++k) {
+    EXPECT_EQ(bunched_frame_end_ns(read, previous, k, kPeriodNs), read - k * kPeriodNs);
+  }
+  // More frames than periods since the previous read (a flood, or a camera
+  // faster than the period): they ended after the previous read (the earliest
+  // time), so they pile up there, never earlier, and nothing overflows.
+  EXPECT_EQ(bunched_frame_end_ns(read, previous, 10, kPeriodNs), previous);
+  EXPECT_EQ(bunched_frame_end_ns(read, previous, 1000000, kPeriodNs), previous);
+  EXPECT_EQ(bunched_frame_end_ns(read, previous, ~0ull, ~0ull), previous);
+}
+
+TEST(BunchedFrameEnd, ChunksReadPromptlyKeepTheirReadTimes) {
+  // Read every 2 ms, a frame completed by the next one's start ended within
+  // the last read interval: the stamp moves by at most that interval.
+  const std::uint64_t previous = kBaseNs, read = kBaseNs + 2000000ull;
+  EXPECT_EQ(bunched_frame_end_ns(read, previous, 1, kPeriodNs), previous);
+  EXPECT_EQ(bunched_frame_end_ns(read, previous, 0, kPeriodNs), read);
+  // A host clock that stepped back (the earliest time after the read).
+  EXPECT_EQ(bunched_frame_end_ns(previous, read, 3, kPeriodNs), previous);
+}
+
+TEST(FramePeriodEstimate, MeasuresASlowerCameraAndIgnoresSkippedFrames) {
+  // A camera at 10 Hz behind a 50 Hz limit: the fastest period until 8
+  // intervals are in,
+  FramePeriodEstimate period(50.0);
+  EXPECT_EQ(period.period_ns(), kPeriodNs);
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<std::uint64_t> jitter(0, 4000000);  // read jitter up to 4 ms
+  for (int i = 0; i < 7; ++i) period.add_interval_ns(100000000ull + jitter(rng));
+  EXPECT_EQ(period.period_ns(), kPeriodNs);
+  // then the camera's period within the read jitter, also when one frame in
+  // five was not sent (an interval of two periods) and after silences (left out),
+  for (int i = 0; i < 100; ++i) {
+    period.add_interval_ns((i % 5 == 4 ? 200000000ull : 100000000ull) + jitter(rng));
+    if (i % 20 == 0) period.add_interval_ns(30000000000ull);
+  }
+  EXPECT_GE(period.period_ns(), 100000000ull);
+  EXPECT_LE(period.period_ns(), 104000000ull);
+  // and never faster than the camera can go.
+  for (int i = 0; i < 40; ++i) period.add_interval_ns(1000000ull);
+  EXPECT_EQ(period.period_ns(), kPeriodNs);
+}
+
+// A FrameClock fed frames 0..9 at 10 Hz, each read alone (measured).
+constexpr std::uint64_t kCameraNs = 100000000ull;  // 10 Hz
+std::uint64_t sent_ns(std::uint64_t i) { return kBaseNs + kCameraNs * i; }
+FrameClock clock_after_ten_frames() {
+  FrameClock clock(50.0);
+  for (std::uint64_t i = 0; i < 10; ++i) EXPECT_EQ(clock.measured(i, sent_ns(i)), sent_ns(i));
+  return clock;
+}
+
+TEST(FrameClock, PlacesBunchedFramesInTheCamerasPhase) {
+  // Given the camera's period measured on frames read alone,
+  FrameClock clock = clock_after_ten_frames();
+  EXPECT_EQ(clock.period_ns(), kCameraNs);
+  // frames 10..14 read in one chunk 70 ms after frame 14 was sent (the
+  // previous read was frame 9's) are placed where the camera sent them, not a
+  // period apart back from the read (70 ms late each),
+  const std::uint64_t read = sent_ns(14) + 70000000ull;
+  for (std::uint64_t i = 10; i < 14; ++i) EXPECT_EQ(clock.bunched(i, read, sent_ns(9), 14 - i), sent_ns(i)) << i;
+  // and so is the frame the chunk left open.
+  EXPECT_EQ(clock.bunched(14, read, sent_ns(9), 0), sent_ns(14));
+}
+
+TEST(FrameClock, AFrameTheCameraDidNotSendFallsBackToTheReadAndStaysWithinAPeriod) {
+  // Given the camera's period measured, then frames 10..14 sent at periods
+  // 10, 11, 13, 14, 15 (it saw nothing at 12) and read in one chunk at the
+  // last one's time,
+  FrameClock clock = clock_after_ten_frames();
+  const std::uint64_t truth[] = {sent_ns(10), sent_ns(11), sent_ns(13), sent_ns(14), sent_ns(15)};
+  const std::uint64_t read = sent_ns(15);
+  std::uint64_t previous = sent_ns(9);
+  for (std::uint64_t k = 0; k < 5; ++k) {
+    const std::uint64_t t = clock.bunched(10 + k, read, sent_ns(9), 4 - k);
+    // each stamp is at most a period after the truth (the forward guess would
+    // put the frames after the gap a period early), in order.
+    EXPECT_GE(t, truth[k]) << k;
+    EXPECT_LE(t, truth[k] + kCameraNs) << k;
+    EXPECT_GT(t, previous) << k;
+    previous = t;
+  }
+}
+
+TEST(FrameClock, AfterASilenceTheLastMeasurementDoesNotPullFramesBack) {
+  // Given a camera silent for 5 s after frame 9 (it saw nothing), whose next
+  // three frames come in one chunk,
+  FrameClock clock = clock_after_ten_frames();
+  const std::uint64_t read = sent_ns(60);
+  // they are placed back from the read, not after frame 9.
+  EXPECT_EQ(clock.bunched(10, read, sent_ns(9), 2), sent_ns(58));
+  EXPECT_EQ(clock.bunched(11, read, sent_ns(9), 1), sent_ns(59));
+  EXPECT_EQ(clock.bunched(12, read, sent_ns(9), 0), sent_ns(60));
+  // Estimated frames do not measure the period: it stays 100 ms.
+  EXPECT_EQ(clock.estimated(13, sent_ns(61) + 1), sent_ns(61) + 1);
+  clock.measured(14, sent_ns(61) + 2);  // 1 ns after frame 13: no interval measured
+  EXPECT_EQ(clock.period_ns(), kCameraNs);
 }
 
 }  // namespace

@@ -122,10 +122,19 @@ void OdometryAccumulator::add(double host_time_s, const WheelUpdate& update,
         started_ = true;
         t0_ = cursor_ = host_time_s - update.step.dt_s;
       }
+      if (const double start = host_time_s - update.step.dt_s; start < gap_until_) {
+        if (host_time_s <= gap_until_) {
+          ++counters_.steps_after_gap;
+          break;
+        }
+        const double kept = (host_time_s - gap_until_) / update.step.dt_s;
+        advance(host_time_s, true, kept * update.step.distance_m, kept * update.step.rotation_rad, on_output);
+        break;
+      }
       advance(host_time_s, true, update.step.distance_m, update.step.rotation_rad, on_output);
       break;
     case WheelStatus::kBaseline:
-      mark_gap(host_time_s, on_output);
+      close_uncovered(host_time_s, on_output, false);
       break;
     case WheelStatus::kDuplicate:
     case WheelStatus::kRejected:
@@ -144,12 +153,17 @@ void OdometryAccumulator::mark_gap(double host_time_s, const OutputCallback& on_
     ++counters_.invalid_host_times;
     return;
   }
+  close_uncovered(host_time_s, on_output, true);
+  gap_until_ = std::max(gap_until_, host_time_s);
+}
+
+void OdometryAccumulator::close_uncovered(double host_time_s, const OutputCallback& on_output, bool stalled) {
   ++counters_.gaps;
   if (!started_) {
     started_ = true;
     t0_ = cursor_ = host_time_s;
   }
-  advance(host_time_s, false, 0.0, 0.0, on_output);
+  advance(host_time_s, false, 0.0, 0.0, on_output, stalled);
 }
 
 std::vector<OdometryOutput> OdometryAccumulator::mark_gap(double host_time_s) {
@@ -158,7 +172,15 @@ std::vector<OdometryOutput> OdometryAccumulator::mark_gap(double host_time_s) {
   return out;
 }
 
-void OdometryAccumulator::emit(const OutputCallback& on_output) {
+void OdometryAccumulator::emit(const OutputCallback& on_output, bool stalled) {
+  if (stalled && covered_s_ > 0.0 && covered_s_ < period_s_) {
+    // The stream stalled inside this period: the rest of it is unknown, not
+    // standing still. Its mean velocity is that of the part measured.
+    const double scale = period_s_ / covered_s_;
+    distance_m_ *= scale;
+    rotation_rad_ *= scale;
+    ++counters_.stalled_periods_extrapolated;
+  }
   OdometryOutput o;
   o.t_s = period_start();
   o.duration_s = period_s_;
@@ -174,7 +196,7 @@ void OdometryAccumulator::emit(const OutputCallback& on_output) {
 }
 
 void OdometryAccumulator::advance(double end, bool covered, double distance_m, double rotation_rad,
-                                  const OutputCallback& on_output) {
+                                  const OutputCallback& on_output, bool stalled) {
   if (end < cursor_) {
     ++counters_.host_time_backwards;
     end = cursor_;
@@ -183,7 +205,7 @@ void OdometryAccumulator::advance(double end, bool covered, double distance_m, d
     // Too long a jump to fill period by period: close the open period and start
     // a new grid at `end`; the step's motion goes into the new period.
     ++counters_.grid_restarts;
-    emit(on_output);
+    emit(on_output, stalled);
     t0_ = cursor_ = end;
     index_ = 0;
     if (covered) {
@@ -209,7 +231,7 @@ void OdometryAccumulator::advance(double end, bool covered, double distance_m, d
       covered_s_ += boundary - cursor_;
     }
     cursor_ = boundary;
-    emit(on_output);
+    emit(on_output, stalled);
   }
   if (covered) {
     // The remainder (not a fraction) keeps the outputs' sum equal to the steps'.

@@ -51,7 +51,8 @@ std::vector<diagnostics::Counter> EncoderNode::diagnostic_counters_locked() cons
           {"sequence_backwards", w.sequence_backwards, true},
           {"time_gaps", w.time_gaps, true},
           {"implausible_steps", w.implausible, true},
-          {"empty_periods", stream_.empty_periods(), true}};
+          {"empty_periods", stream_.empty_periods(), true},
+          {"late_steps_dropped", stream_.accumulator_counters().steps_after_gap, true}};
 }
 
 void EncoderNode::stop() { runtime_.stop(); }
@@ -95,7 +96,8 @@ std::vector<std::string> EncoderNode::status_lines_locked() const {
          << w.ticks_per_revolution_mismatches << "; clock restarts " << k.restarts << ", jumps " << k.jumps
          << ", last excess delay " << static_cast<double>(stream_.clock().last_excess_delay_ns()) * 1e-6
          << " ms; odometry published " << runtime_.published() << ", failed " << runtime_.publish_failures()
-         << ", empty periods " << stream_.empty_periods();
+         << ", empty periods " << stream_.empty_periods() << " (late steps dropped "
+         << stream_.accumulator_counters().steps_after_gap << ")";
   return {runtime_.device_status_line(), lines.str(), motion.str()};
 }
 

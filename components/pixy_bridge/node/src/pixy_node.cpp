@@ -1,10 +1,12 @@
 #include "pixyslam/pixy_node/pixy_node.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <sstream>
 #include <utility>
 
+#include "pixyslam/pixy/frame_stamp.h"
 #include "pixyslam/pixy_node/observation_conversions.h"
 
 namespace pixyslam::pixy_node {
@@ -28,6 +30,7 @@ PixyNode::PixyNode(const PixyNodeOptions& options, std::unique_ptr<bridge::ByteS
                    bridge::LogFunction log, bridge::ClockFunction clock)
     : options_(validated(options)),
       rate_limiter_(options_.pixy.rate),
+      frame_clock_(options_.pixy.rate.frame_rate_hz),
       runtime_("pixy_bridge", options.dds, options.process, std::move(source), std::move(log), std::move(clock),
                mutex_) {}
 
@@ -115,28 +118,64 @@ std::vector<std::string> PixyNode::status_lines_locked() const {
 void PixyNode::on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns) {
   // A frame ends with its last block, but is known to be complete only when
   // the next frame starts. "Progress" (blocks + frame starts parsed) tells
-  // whether the frame being delivered got anything from this chunk.
+  // whether the frame being delivered got anything from this chunk; if it did,
+  // the frame starts after it in the chunk tell how long before the read it
+  // ended (pixy::FrameClock), so all of a chunk's frames are parsed before any
+  // is stamped.
   const auto progress = [this] { return parser_.counters().blocks_ok + parser_.counters().frame_syncs; };
   std::uint64_t mark = progress();
+  bool opened_here = false;  // the frame being delivered was opened in this chunk
+  chunk_frames_.clear();
   parser_.feed(data, size, [&](pixy::PixyFrame&& frame) {
     const std::uint64_t now = progress();  // includes the sync that opened the next frame
-    publish(frame, now - 1 > mark ? receive_ns : frame_end_ns_);
+    chunk_frames_.push_back({std::move(frame), opened_here || now - 1 > mark, parser_.counters().frame_syncs});
     mark = now;
-    frame_end_ns_ = receive_ns;  // the next frame opened in this chunk
+    opened_here = true;
   });
-  if (progress() > mark) frame_end_ns_ = receive_ns;
+  // Frames that ended in this chunk ended after the previous read (none is
+  // spread back before the first read). Read within a period of the previous
+  // read, their ends are known within that read interval; otherwise, if two or
+  // more frames had bytes in the chunk (the open one included), they came
+  // bunched up and pixy::FrameClock places them.
+  const std::uint64_t earliest_ns = previous_read_ns_ == 0 ? receive_ns : previous_read_ns_;
+  const bool prompt = receive_ns - earliest_ns < frame_clock_.period_ns();
+  const bool bunched = !prompt && std::any_of(chunk_frames_.begin(), chunk_frames_.end(),
+                                              [](const ChunkFrame& f) { return f.ended_in_chunk; });
+  const std::uint64_t starts = parser_.counters().frame_syncs;
+  for (const ChunkFrame& f : chunk_frames_) {
+    if (!f.ended_in_chunk) {
+      publish(f.frame, complete_open_frame(f.frame.index));
+    } else if (!bunched) {
+      publish(f.frame, frame_clock_.measured(f.frame.index, earliest_ns));
+    } else {
+      const std::uint64_t starts_after = starts - f.starts_seen + 1;
+      publish(f.frame, frame_clock_.bunched(f.frame.index, receive_ns, earliest_ns, starts_after));
+    }
+  }
+  if (!chunk_frames_.empty() || progress() > mark) {  // the open frame advanced
+    open_frame_read_ns_ = receive_ns;
+    open_frame_bunched_ = bunched;
+    frame_end_ns_ = bunched  // it came with the others: placed like them
+                        ? frame_clock_.bunched(chunk_frames_.back().frame.index + 1, receive_ns, earliest_ns, 0)
+                        : receive_ns;
+  }
+  previous_read_ns_ = receive_ns;
   log_rate_warning(receive_ns);
 }
 
 void PixyNode::on_poll(std::uint64_t now_ns) {
   const auto timeout_ns = static_cast<std::uint64_t>(std::llround(options_.frame_timeout_s * 1e9));
-  if (parser_.frame_open() && now_ns > frame_end_ns_ + timeout_ns) {
+  if (parser_.frame_open() && now_ns > open_frame_read_ns_ + timeout_ns) {
     if (std::optional<pixy::PixyFrame> frame = parser_.flush()) {
       ++frames_timed_out_;
-      publish(*frame, frame_end_ns_);
+      publish(*frame, complete_open_frame(frame->index));
     }
   }
   log_rate_warning(now_ns);
+}
+
+std::uint64_t PixyNode::complete_open_frame(std::uint64_t index) {
+  return open_frame_bunched_ ? frame_clock_.estimated(index, frame_end_ns_) : frame_clock_.measured(index, frame_end_ns_);
 }
 
 void PixyNode::log_rate_warning(std::uint64_t now_ns) {

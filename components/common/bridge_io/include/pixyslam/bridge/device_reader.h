@@ -29,7 +29,10 @@ struct DeviceReaderOptions {
   std::chrono::milliseconds reopen_period{1000};  // between open attempts after a failure or hang-up
   std::chrono::milliseconds poll_period{50};      // read timeout: on_poll runs at least this often
   std::chrono::seconds repeat_error_log{60};      // a persisting open failure is logged again after this
-  std::size_t buffer_bytes = 1024;                // most bytes handed over per on_bytes call
+  // Most bytes handed over per on_bytes call: one read takes all a tty holds
+  // (Linux buffers 4096 bytes per tty), so what a busy host left unread comes
+  // in one chunk, and the pixy bridge can spread its frames back in time.
+  std::size_t buffer_bytes = 4096;
 };
 
 // Running totals of a DeviceReader.

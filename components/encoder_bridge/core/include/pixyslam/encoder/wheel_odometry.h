@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "pixyslam/encoder/arduino_line_parser.h"
@@ -118,6 +119,8 @@ struct AccumulatorCounters {
   std::uint64_t host_time_backwards = 0;   // time stamps before the previous one (clamped)
   std::uint64_t invalid_host_times = 0;    // NaN or infinite stamps (the call is ignored)
   std::uint64_t grid_restarts = 0;         // jumps longer than kMaxCatchUpPeriods periods
+  std::uint64_t steps_after_gap = 0;       // steps wholly before a mark_gap() time: dropped
+  std::uint64_t stalled_periods_extrapolated = 0;  // periods a mark_gap() closed part-measured
 };
 
 // Resamples wheel steps to a fixed output rate (publish_rate_hz; seed paper:
@@ -146,11 +149,19 @@ class OdometryAccumulator {
 
   // kStep: covers (previous stamp, host_time_s] with the step. kBaseline: the
   // same interval is uncovered. kDuplicate and kRejected: nothing (a later step
-  // covers the interval). Calls `on_output` for every period completed.
+  // covers the interval). Calls `on_output` for every period completed. A step
+  // that began before the last mark_gap() time (the backlog of a stream that
+  // stalled: its periods already went out as "no data", and the filter held
+  // its last command through them) counts only with its part after that time;
+  // one wholly before it is dropped (steps_after_gap), so the motion is not
+  // counted twice, once held and once as a burst in the next period.
   void add(double host_time_s, const WheelUpdate& update, const OutputCallback& on_output);
   std::vector<OdometryOutput> add(double host_time_s, const WheelUpdate& update);
   // Declares that no wheel motion is known up to host_time_s (e.g. the serial
-  // stream stalled), completing the periods that end by then.
+  // stream stalled), completing the periods that end by then. The period the
+  // stream stalled in carries the mean velocity of its measured part over its
+  // whole length (the rest is unknown, not standing still); the periods after
+  // it go out with no motion and covered_s 0 ("no data").
   void mark_gap(double host_time_s, const OutputCallback& on_output);
   std::vector<OdometryOutput> mark_gap(double host_time_s);
 
@@ -160,11 +171,14 @@ class OdometryAccumulator {
  private:
   // Moves the cursor to `end`, spreading (distance, rotation) over the interval
   // when `covered`; a zero-length interval puts them in the open period.
+  // `stalled`: a mark_gap(); periods it closes extrapolate their measured part.
   void advance(double end, bool covered, double distance_m, double rotation_rad,
-               const OutputCallback& on_output);
+               const OutputCallback& on_output, bool stalled = false);
   double period_start() const { return t0_ + static_cast<double>(index_) * period_s_; }
   double period_end() const { return t0_ + static_cast<double>(index_ + 1) * period_s_; }
-  void emit(const OutputCallback& on_output);
+  void emit(const OutputCallback& on_output, bool stalled = false);
+  // Moves the cursor to host_time_s uncovered (a baseline, or mark_gap()).
+  void close_uncovered(double host_time_s, const OutputCallback& on_output, bool stalled);
 
   double period_s_ = 0.1;
   bool started_ = false;
@@ -174,6 +188,7 @@ class OdometryAccumulator {
   double distance_m_ = 0.0;  // of the open period so far
   double rotation_rad_ = 0.0;
   double covered_s_ = 0.0;
+  double gap_until_ = -std::numeric_limits<double>::infinity();  // the last mark_gap() time
   AccumulatorCounters counters_;
 };
 

@@ -12,6 +12,7 @@
 #include "pixyslam/bridge/byte_source.h"
 #include "pixyslam/bridge/device_reader.h"
 #include "pixyslam/pixy/frame_rate_limiter.h"
+#include "pixyslam/pixy/frame_stamp.h"
 #include "pixyslam/pixy/pixy_block_parser.h"
 #include "pixyslam/pixy/pixy_geometry.h"
 #include "pixyslam/pixy_node/pixy_node_options.h"
@@ -46,7 +47,9 @@ struct PixyNodeCounters {
 // every 5 s while it lasts.
 //
 // Stamp: the host time (dds::now_ns() domain) at which the frame's last block
-// was read (for a frame without blocks: its start), minus camera_latency_s.
+// was read (for a frame without blocks: its start), minus camera_latency_s;
+// frames that came bunched up in one read are placed a camera frame period
+// apart, the period measured on frames read one at a time (pixy::FrameClock).
 // A frame is complete when the next frame starts, or when no data came for it
 // for frame_timeout_s (the camera sends nothing while it sees nothing).
 //
@@ -79,6 +82,8 @@ class PixyNode {
   // The reader thread's handlers, called with mutex_ held (BridgeRuntime).
   void on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns);
   void on_poll(std::uint64_t now_ns);
+  // The end of the frame that was open before this chunk (frame_end_ns_), now complete.
+  std::uint64_t complete_open_frame(std::uint64_t index);
   // Publishes the frame unless the rate limiter drops it.
   void publish(const pixy::PixyFrame& frame, std::uint64_t end_ns);
   void log_rate_warning(std::uint64_t now_ns);
@@ -92,7 +97,18 @@ class PixyNode {
   pixy::PixyBlockParser parser_;
   pixy::DetectionCounters detection_counters_;
   pixy::FrameRateLimiter rate_limiter_;
-  std::uint64_t frame_end_ns_ = 0;  // host time the open frame last advanced (opened or got a block)
+  std::uint64_t open_frame_read_ns_ = 0;  // host time the open frame last advanced (opened or got a block)
+  std::uint64_t frame_end_ns_ = 0;        // its end: that time, or where FrameClock placed it
+  std::uint64_t previous_read_ns_ = 0;  // host time of the last chunk read
+  // The frames one chunk completed, stamped once the whole chunk is parsed.
+  struct ChunkFrame {
+    pixy::PixyFrame frame;
+    bool ended_in_chunk = false;   // its last block (or its start) came in this chunk
+    std::uint64_t starts_seen = 0;  // parser frame_syncs when it completed (with the next frame's start)
+  };
+  std::vector<ChunkFrame> chunk_frames_;
+  pixy::FrameClock frame_clock_;     // the frames' end times
+  bool open_frame_bunched_ = false;  // the open frame came in a chunk with others (frame_end_ns_ estimated)
   std::uint64_t frames_timed_out_ = 0;
   std::uint64_t detections_dropped_ = 0;
 
