@@ -1,6 +1,5 @@
 #include "pixyslam/bridge/bridge_options.h"
 
-#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -11,7 +10,6 @@ namespace pixyslam::bridge {
 DeviceReaderOptions device_reader_options(const BridgeProcessOptions& o) {
   DeviceReaderOptions d;
   d.reopen_period = std::chrono::milliseconds(std::llround(o.reopen_period_s * 1000.0));
-  d.poll_period = std::chrono::milliseconds(std::max<long long>(1, std::llround(o.poll_period_s * 1000.0)));
   return d;
 }
 

@@ -20,16 +20,6 @@ const PixyNodeOptions& validated(const PixyNodeOptions& options) {
   return options;
 }
 
-// The process options with the device read's timeout at half frame_timeout_s:
-// a frame the next one does not end is published within 1.5 frame_timeout_s
-// of its last byte, not when the read times out (50 ms: with a 10 Hz camera
-// every frame waited that long).
-bridge::BridgeProcessOptions process_options(const PixyNodeOptions& options) {
-  bridge::BridgeProcessOptions process = options.process;
-  process.poll_period_s = std::min(process.poll_period_s, 0.5 * options.frame_timeout_s);
-  return process;
-}
-
 }  // namespace
 
 PixyNode::PixyNode(const PixyNodeOptions& options, bridge::LogFunction log)
@@ -41,8 +31,8 @@ PixyNode::PixyNode(const PixyNodeOptions& options, std::unique_ptr<bridge::ByteS
     : options_(validated(options)),
       rate_limiter_(options_.pixy.rate),
       frame_clock_(options_.pixy.rate.frame_rate_hz),
-      runtime_("pixy_bridge", options.dds, process_options(options), std::move(source), std::move(log),
-               std::move(clock), mutex_) {}
+      runtime_("pixy_bridge", options.dds, options.process, std::move(source), std::move(log), std::move(clock),
+               mutex_) {}
 
 PixyNode::~PixyNode() { stop(); }
 

@@ -20,10 +20,6 @@ struct BridgeProcessOptions {
   // warning. The device is read meanwhile (BridgeRuntime).
   int wait_readers = 1;
   double wait_readers_timeout_s = 3.0;
-  // The device read's timeout: the bridge's on_poll runs at least this often
-  // while no bytes come. Not a `node:` key; a bridge whose on_poll has a
-  // deadline sets it (the pixy bridge: half its frame_timeout_s).
-  double poll_period_s = 0.05;
 };
 
 // The `node:` parameters every bridge has (reopen_period_s, status_period_s),
