@@ -380,7 +380,7 @@ TEST(FrameClock, AfterASilenceTheLastMeasurementDoesNotPullFramesBack) {
   EXPECT_EQ(clock.bunched(11, read, sent_ns(9), 1), sent_ns(59));
   EXPECT_EQ(clock.bunched(12, read, sent_ns(9), 0), sent_ns(60));
   // Estimated frames do not measure the period: it stays 100 ms.
-  EXPECT_EQ(clock.estimated(13, sent_ns(61) + 1), sent_ns(61) + 1);
+  EXPECT_EQ(clock.estimated(sent_ns(61) + 1), sent_ns(61) + 1);
   clock.measured(14, sent_ns(61) + 2);  // 1 ns after frame 13: no interval measured
   EXPECT_EQ(clock.period_ns(), kCameraNs);
 }

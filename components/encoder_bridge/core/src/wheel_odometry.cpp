@@ -115,24 +115,24 @@ void OdometryAccumulator::add(double host_time_s, const WheelUpdate& update,
     return;
   }
   switch (update.status) {
-    case WheelStatus::kStep:
+    case WheelStatus::kStep: {
       ++counters_.steps;
       if (!started_) {
         // The first step covers its own Arduino interval, ending at its stamp.
         started_ = true;
         t0_ = cursor_ = host_time_s - update.step.dt_s;
       }
-      if (const double start = host_time_s - update.step.dt_s; start < gap_until_) {
+      double kept = 1.0;  // the step's share after the last mark_gap() time
+      if (host_time_s - update.step.dt_s < gap_until_) {
         if (host_time_s <= gap_until_) {
           ++counters_.steps_after_gap;
           break;
         }
-        const double kept = (host_time_s - gap_until_) / update.step.dt_s;
-        advance(host_time_s, true, kept * update.step.distance_m, kept * update.step.rotation_rad, on_output);
-        break;
+        kept = (host_time_s - gap_until_) / update.step.dt_s;
       }
-      advance(host_time_s, true, update.step.distance_m, update.step.rotation_rad, on_output);
+      advance(host_time_s, true, kept * update.step.distance_m, kept * update.step.rotation_rad, on_output);
       break;
+    }
     case WheelStatus::kBaseline:
       close_uncovered(host_time_s, on_output, false);
       break;

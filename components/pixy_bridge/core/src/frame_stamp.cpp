@@ -55,7 +55,7 @@ std::uint64_t FrameClock::bunched(std::uint64_t index, std::uint64_t read_ns, st
   return std::max(forward, earliest_ns);
 }
 
-std::uint64_t FrameClock::estimated(std::uint64_t /*index*/, std::uint64_t end_ns) {
+std::uint64_t FrameClock::estimated(std::uint64_t end_ns) {
   last_measured_ = false;
   return end_ns;
 }

@@ -175,7 +175,7 @@ void PixyNode::on_poll(std::uint64_t now_ns) {
 }
 
 std::uint64_t PixyNode::complete_open_frame(std::uint64_t index) {
-  return open_frame_bunched_ ? frame_clock_.estimated(index, frame_end_ns_) : frame_clock_.measured(index, frame_end_ns_);
+  return open_frame_bunched_ ? frame_clock_.estimated(frame_end_ns_) : frame_clock_.measured(index, frame_end_ns_);
 }
 
 void PixyNode::log_rate_warning(std::uint64_t now_ns) {

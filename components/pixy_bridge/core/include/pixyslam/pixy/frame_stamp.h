@@ -77,10 +77,10 @@ class FrameClock {
   // previous read. Returns its estimated end.
   std::uint64_t bunched(std::uint64_t index, std::uint64_t read_ns, std::uint64_t earliest_ns,
                         std::uint64_t starts_after);
-  // Frame `index`, placed by bunched() earlier (the frame a bunched chunk left
-  // open, whose end was that chunk's read), ended at `end_ns`: not a
-  // measurement. Returns end_ns.
-  std::uint64_t estimated(std::uint64_t index, std::uint64_t end_ns);
+  // A frame placed by bunched() earlier (the frame a bunched chunk left open,
+  // whose end was that chunk's read) ended at `end_ns`: not a measurement.
+  // Returns end_ns.
+  std::uint64_t estimated(std::uint64_t end_ns);
 
   std::uint64_t period_ns() const { return period_.period_ns(); }
 
