@@ -827,14 +827,59 @@ TEST(FastSlam2, OutOfOrderSamplesAreCountedAndAppliedAtFilterTime) {
   EXPECT_EQ(f.counters().odometry_samples, 3u);
   EXPECT_DOUBLE_EQ(f.time_s(), 1.0);  // time does not run backwards
   // Its control (stop) is held from the filter time on: no further motion.
-  f.add_odometry({2.0, 0.0, 0.0});
+  f.add_odometry({2.0, 0.1, 0.0});
   EXPECT_NEAR(f.pose_estimate().mean.x(), 0.5, 0.05);
   expect_finite(f.pose_estimate());
 
-  f.add_observations({1.5, {{1, 2.0, 0.0}}});  // frame older than the filter time
+  // A frame older than the filter time but newer than the last frame is applied
+  // at its stamp: the robot was at x = 0.5 then, at 0.6 now.
+  f.add_odometry({3.0, 0.0, 0.0});
+  f.add_observations({1.5, {{1, 2.0, 0.0}}});
+  EXPECT_EQ(f.counters().frames_late, 1u);
+  EXPECT_EQ(f.counters().frames_out_of_order, 0u);
+  EXPECT_NEAR(f.pose_estimate().mean.x(), 0.6, 0.02);
+  ASSERT_EQ(f.landmarks_of_best().size(), 1u);
+  EXPECT_NEAR(f.landmarks_of_best()[0].mean.x(), 2.5, 0.02);
+  // One older than that frame (which is already applied) goes at the filter time, x = 0.6.
+  f.add_observations({1.2, {{2, 2.0, 0.0}}});
   EXPECT_EQ(f.counters().frames_out_of_order, 1u);
-  EXPECT_EQ(f.counters().observations_new_landmark, 1u);
-  EXPECT_DOUBLE_EQ(f.time_s(), 2.0);
+  EXPECT_EQ(f.counters().observations_new_landmark, 2u);
+  EXPECT_DOUBLE_EQ(f.time_s(), 3.0);
+  ASSERT_EQ(f.landmarks_of_best().size(), 2u);
+  EXPECT_NEAR(f.landmarks_of_best()[1].mean.x(), 2.6, 0.02);
+}
+
+// A camera delivered behind the odometry (its bridge stalled, or its link slower):
+// each frame arrives after the odometry of the next 0.45 s. Applied at their
+// stamps, the frames give the same result, bit for bit, as input in time order,
+// through a blind stretch in delayed sampling too.
+TEST(FastSlam2, FramesDeliveredBehindTheOdometryGiveTheSameResultAsInTimeOrder) {
+  sim::WorldOptions w;
+  sim::WorldRun run = noisy_world(31, 0.1, 0.15, w);
+  blind_camera(run, 20.0, 45.0);
+  FilterOptions o = options_for_world(w, 50, 7);
+  o.delayed_sampling.enabled = true;
+  FastSlam2 in_order(o, run.initial_pose);
+  feed(in_order, run);
+  ASSERT_GT(in_order.counters().delayed_sampling_starts, 0u);
+
+  FastSlam2 delayed(o, run.initial_pose);
+  std::size_t k = 0;
+  for (const OdometrySample& s : run.odometry) {
+    delayed.add_odometry(s);
+    while (k < run.frames.size() && run.frames[k].t_s + 0.45 <= s.t_s) delayed.add_observations(run.frames[k++]);
+  }
+  while (k < run.frames.size()) delayed.add_observations(run.frames[k++]);
+
+  const auto late = std::count_if(run.frames.begin(), run.frames.end(),
+                                  [&](const ObservationFrame& f) { return f.t_s < run.odometry.back().t_s; });
+  EXPECT_EQ(delayed.counters().frames_late, static_cast<std::uint64_t>(late));
+  EXPECT_GT(late, 500);
+  EXPECT_EQ(delayed.counters().frames_out_of_order, 0u);
+  expect_same_estimate(in_order.pose_estimate(), delayed.pose_estimate());
+  expect_same_landmarks(in_order.landmarks_of_best(), delayed.landmarks_of_best());
+  EXPECT_EQ(in_order.counters().resamples, delayed.counters().resamples);
+  EXPECT_EQ(in_order.counters().delayed_sampling_starts, delayed.counters().delayed_sampling_starts);
 }
 
 TEST(FastSlam2, HeldControlTimesOut) {

@@ -105,6 +105,8 @@ FastSlam2::FastSlam2(const FilterOptions& options, const PoseGaussian& initial_p
 }
 
 void FastSlam2::move_particles() {
+  moved_until_s_ = time_s_;
+  pending_steps_.clear();
   if (pending_.empty()) return;
   for (Particle& p : particles_) {
     if (p.joint.active()) {
@@ -179,6 +181,7 @@ void FastSlam2::advance_to(double t_s) {
   if (!has_time_) {
     has_time_ = true;
     time_s_ = t_s;
+    moved_until_s_ = t_s;
     return;
   }
   if (t_s <= time_s_) return;
@@ -186,12 +189,36 @@ void FastSlam2::advance_to(double t_s) {
   const double control_end = control_time_s_ + options_.control_timeout_s;
   const double moving_until = std::min(t_s, control_end);
   if (moving_until > time_s_ && (control_.v_mps != 0.0 || control_.w_radps != 0.0)) {
-    pending_.add(control_.v_mps, control_.w_radps, moving_until - time_s_, options_.motion);
+    add_pending({control_.v_mps, control_.w_radps, time_s_, moving_until});
   }
   if (t_s > control_end && time_s_ <= control_end && (control_.v_mps != 0.0 || control_.w_radps != 0.0)) {
     ++counters_.control_timeouts;
   }
   time_s_ = t_s;
+}
+
+void FastSlam2::add_pending(const MotionStep& step) {
+  pending_.add(step.v_mps, step.w_radps, step.to_s - step.from_s, options_.motion);
+  pending_steps_.push_back(step);
+}
+
+std::vector<FastSlam2::MotionStep> FastSlam2::split_pending_at(double t_s) {
+  std::vector<MotionStep> steps;
+  steps.swap(pending_steps_);
+  pending_.clear();
+  std::vector<MotionStep> later;
+  // The same steps, of the same lengths, as input in time order would have made.
+  for (const MotionStep& s : steps) {
+    if (s.to_s <= t_s) {
+      add_pending(s);
+    } else if (s.from_s >= t_s) {
+      later.push_back(s);
+    } else {
+      add_pending({s.v_mps, s.w_radps, s.from_s, t_s});
+      later.push_back({s.v_mps, s.w_radps, t_s, s.to_s});
+    }
+  }
+  return later;
 }
 
 void FastSlam2::add_odometry(const OdometrySample& sample) {
@@ -224,10 +251,25 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
     counters_.observations_invalid += frame.detections.size();
     return;
   }
-  if (has_time_ && frame.t_s < time_s_) ++counters_.frames_out_of_order;
-  advance_to(frame.t_s);
+  const bool late = has_time_ && frame.t_s < time_s_;
+  if (!late || frame.t_s < moved_until_s_) {
+    if (late) ++counters_.frames_out_of_order;
+    advance_to(frame.t_s);
+    move_particles();
+    update_with_frame(frame);
+    return;
+  }
+  // Late, but not older than the particles: the motion up to the stamp, the
+  // update, then the rest of the motion again.
+  ++counters_.frames_late;
+  const std::vector<MotionStep> later = split_pending_at(frame.t_s);
   move_particles();
+  moved_until_s_ = frame.t_s;
+  update_with_frame(frame);
+  for (const MotionStep& step : later) add_pending(step);
+}
 
+void FastSlam2::update_with_frame(const ObservationFrame& frame) {
   const std::size_t n = frame.detections.size();
   z_.resize(n);
   r_.resize(n);

@@ -110,13 +110,16 @@ diagnostics::Snapshot EstimatorNode::diagnostics_snapshot() const {
                 {"seq_jumps", c.seq_jumps, true},
                 {"other_robot_samples", c.other_robot_samples, false},
                 {"steps", c.steps, false},
-                {"samples_late", c.samples_late, true},
+                // A late frame is applied at its stamp (frames_late); what could not be
+                // warns as odometry_out_of_order / frames_out_of_order.
+                {"samples_late", c.samples_late, false},
                 {"samples_reordered", c.samples_reordered, false},
                 {"odometry_invalid", f.odometry_invalid, true},
                 {"odometry_out_of_order", f.odometry_out_of_order, true},
                 {"odometry_no_data", f.odometry_no_data, true},
                 {"control_timeouts", f.control_timeouts, false},
                 {"frames_invalid", f.frames_invalid, true},
+                {"frames_late", f.frames_late, false},
                 {"frames_out_of_order", f.frames_out_of_order, true},
                 {"observations_used", f.observations_used, false},
                 {"observations_new_landmark", f.observations_new_landmark, false},

@@ -53,7 +53,8 @@ struct FilterCounters {
   std::uint64_t control_timeouts = 0;
   std::uint64_t frames = 0;
   std::uint64_t frames_invalid = 0;  // non-finite time: dropped with their detections
-  std::uint64_t frames_out_of_order = 0;
+  std::uint64_t frames_late = 0;  // older than the filter time, newer than the last frame: applied at their stamp
+  std::uint64_t frames_out_of_order = 0;  // older than the last frame: applied at the filter time
   std::uint64_t observations_used = 0;
   std::uint64_t observations_new_landmark = 0;
   std::uint64_t observations_gated = 0;
@@ -74,8 +75,10 @@ struct FilterCounters {
 // folded into that Gaussian (the FastSLAM 2.0 proposal), the pose is SAMPLED from
 // the result, landmark EKFs are updated (or initialised) with the sampled pose and
 // the weight is multiplied by the observations' marginal likelihood (computed in
-// the same sequential pass, in log space). Time is passed in with the samples;
-// samples older than the filter time are counted and applied at the filter time.
+// the same sequential pass, in log space). Time is passed in with the samples.
+// A frame older than the filter time but not older than the last frame (a camera
+// delivered behind the odometry) is applied at its stamp, with the same result as
+// in time order; older samples are counted and applied at the filter time.
 // Same options, seed and input give bit-identical output. Thread-compatible.
 class FastSlam2 {
  public:
@@ -136,6 +139,16 @@ class FastSlam2 {
   enum class Decision : std::uint8_t { kUsed, kGated, kNew, kInvalid, kNewDone };
 
   void advance_to(double t_s);
+  // The odometry composed in pending_, step by step, so that a late frame can
+  // split it at its stamp.
+  struct MotionStep {
+    double v_mps, w_radps, from_s, to_s;
+  };
+  void add_pending(const MotionStep& step);
+  // Leaves in pending_ the motion up to t_s and returns the steps after it.
+  std::vector<MotionStep> split_pending_at(double t_s);
+  // The FastSLAM 2.0 update for a frame at the particles' time.
+  void update_with_frame(const ObservationFrame& frame);
   // Applies the odometry composed since the last frame to every particle.
   void move_particles();
   // cos and sin of each particle's heading (for pending_), and weights_.
@@ -189,6 +202,8 @@ class FastSlam2 {
   std::vector<Particle> particles_;
   std::vector<Particle> scratch_;
   ComposedMotion pending_;                   // odometry not yet applied to the particles
+  std::vector<MotionStep> pending_steps_;    // what pending_ composes
+  double moved_until_s_ = 0.0;               // the particles' time: pending_ starts here
   std::vector<Eigen::Vector2d> heading_cs_;  // per particle: cos, sin of its heading
   std::vector<double> weights_;              // normalised importance weights
   // Weighted particle moments at the last frame (positions relative to x, y;

@@ -52,8 +52,8 @@ struct SensorQueueCounters {
   std::uint64_t observations_in = 0;
   std::uint64_t released = 0;
   std::uint64_t reordered = 0;  // arrived after a younger sample of its stream; sorted in
-  std::uint64_t late = 0;       // older than what was already released: released at once,
-                                // the filter applies it at its current time
+  std::uint64_t late = 0;       // older than what was already released: released at once (the
+                                // filter applies a frame at its stamp, FastSlam2::frames_late)
 };
 
 // Merges the odometry and camera streams into one time-ordered sequence for
