@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -373,6 +374,63 @@ TEST(PixyNode, FramesReadInOneChunkAreStampedWhenTheCameraSentThem) {
     EXPECT_EQ(got[i].detections().size(), 1u) << "frame " << i;
   }
   EXPECT_EQ(node.counters().rate.rate_limited, 0u);
+}
+
+// A scripted device that records the timeout of every read.
+class TimeoutRecordingSource final : public bridge::ByteSource {
+ public:
+  explicit TimeoutRecordingSource(std::shared_ptr<bridge::ByteScript> script) : inner_(std::move(script)) {}
+  void open() override { inner_.open(); }
+  void close() override { inner_.close(); }
+  bool is_open() const override { return inner_.is_open(); }
+  serial::ReadResult read_some(std::uint8_t* buffer, std::size_t max, milliseconds timeout) override {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      timeouts_.push_back(timeout.count());
+    }
+    return inner_.read_some(buffer, max, timeout);
+  }
+  std::string name() const override { return inner_.name(); }
+  std::vector<long long> timeouts() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return timeouts_;
+  }
+
+ private:
+  bridge::ScriptedByteSource inner_;
+  mutable std::mutex mutex_;
+  std::vector<long long> timeouts_;
+};
+
+TEST(PixyNode, TheDeviceReadWaitsOnlyUntilTheOpenFrameTimesOut) {
+  // Given one frame and then silence (a camera that sees one landmark once),
+  ObservationInbox& inbox = observation_inbox();
+  inbox.clear();
+  auto script = std::make_shared<bridge::ByteScript>();
+  script->add_bytes(pixy::encode_frame({landmark_1()}), kBaseNs);
+  PixyNodeOptions options = shipped_options();
+  options.frame_timeout_s = 0.01;
+  auto source = std::make_unique<TimeoutRecordingSource>(script);
+  TimeoutRecordingSource& recorder = *source;
+  LogLines log;
+  PixyNode node(options, std::move(source), log.sink(), bridge::ByteScript::clock(script));
+  start_when_read(node);
+  // while the frame is open, every read waits until it times out (10 ms, rounded
+  // up to the next ms), not the whole 50 ms poll period;
+  std::this_thread::sleep_for(milliseconds(100));
+  EXPECT_TRUE(inbox.wait_for(1, milliseconds(1)).empty()) << "the script's clock has not passed the timeout";
+  script->add_idle(kBaseNs + 15000000ull);
+  ASSERT_EQ(inbox.wait_for(1, std::chrono::seconds(10)).size(), 1u);
+  std::this_thread::sleep_for(milliseconds(120));
+  node.stop();
+  const std::vector<long long> timeouts = recorder.timeouts();
+  ASSERT_GE(timeouts.size(), 4u);
+  EXPECT_EQ(timeouts.front(), 50) << "no frame open yet";
+  EXPECT_EQ(timeouts[1], 11);
+  EXPECT_GE(std::count(timeouts.begin(), timeouts.end(), 11), 3) << "while the frame was open";
+  // and once it is published, the reads wait the poll period again.
+  EXPECT_EQ(timeouts.back(), 50);
+  EXPECT_EQ(std::count_if(timeouts.begin(), timeouts.end(), [](long long t) { return t != 11 && t != 50; }), 0);
 }
 
 // The diagnostics reports of the node under test (robot id of loopback_options()).

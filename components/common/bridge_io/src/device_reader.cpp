@@ -55,6 +55,17 @@ std::string DeviceReader::status_line() const {
          std::to_string(d.read_errors) + ", bytes " + std::to_string(d.bytes);
 }
 
+std::chrono::milliseconds DeviceReader::read_timeout() {
+  if (!handlers_.poll_deadline_ns) return options_.poll_period;
+  std::uint64_t deadline_ns = 0;
+  run_handler("poll_deadline_ns", [&] { deadline_ns = handlers_.poll_deadline_ns(); });
+  if (deadline_ns == 0) return options_.poll_period;
+  const std::uint64_t now_ns = clock_();
+  const std::uint64_t wait_ns = deadline_ns > now_ns ? deadline_ns - now_ns : 0;
+  const auto wait_ms = static_cast<long long>((wait_ns + 999'999) / 1'000'000);  // rounded up
+  return std::clamp(std::chrono::milliseconds(wait_ms), std::chrono::milliseconds(1), options_.poll_period);
+}
+
 template <class Call>
 void DeviceReader::run_handler(const char* name, const Call& call) {
   try {
@@ -126,7 +137,7 @@ void DeviceReader::loop() {
 
     serial::ReadResult result;
     try {
-      result = source_->read_some(buffer.data(), buffer.size(), options_.poll_period);
+      result = source_->read_some(buffer.data(), buffer.size(), read_timeout());
     } catch (const std::exception& e) {
       {
         std::lock_guard<std::mutex> lock(counters_mutex_);

@@ -46,7 +46,8 @@ void PixyNode::start() {
                   },
                   [this](std::uint64_t now_ns) { on_poll(now_ns); },
                   [this] { return status_lines_locked(); },
-                  [this] { return diagnostic_counters_locked(); }});
+                  [this] { return diagnostic_counters_locked(); },
+                  [this] { return open_frame_deadline_ns(); }});
 }
 
 std::vector<diagnostics::Counter> PixyNode::diagnostic_counters_locked() const {
@@ -163,9 +164,16 @@ void PixyNode::on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_
   log_rate_warning(receive_ns);
 }
 
+std::uint64_t PixyNode::frame_timeout_ns() const {
+  return static_cast<std::uint64_t>(std::llround(options_.frame_timeout_s * 1e9));
+}
+
+std::uint64_t PixyNode::open_frame_deadline_ns() const {
+  return parser_.frame_open() ? open_frame_read_ns_ + frame_timeout_ns() + 1 : 0;
+}
+
 void PixyNode::on_poll(std::uint64_t now_ns) {
-  const auto timeout_ns = static_cast<std::uint64_t>(std::llround(options_.frame_timeout_s * 1e9));
-  if (parser_.frame_open() && now_ns > open_frame_read_ns_ + timeout_ns) {
+  if (parser_.frame_open() && now_ns > open_frame_read_ns_ + frame_timeout_ns()) {
     if (std::optional<pixy::PixyFrame> frame = parser_.flush()) {
       ++frames_timed_out_;
       publish(*frame, complete_open_frame(frame->index));

@@ -47,6 +47,8 @@ class BridgeRuntime {
     // Optional: the node's counters for the diagnostics topic (the device's are
     // added, and an ERROR while the device is not open).
     std::function<std::vector<diagnostics::Counter>()> diagnostics;
+    // Optional: DeviceReader::Handlers::poll_deadline_ns.
+    std::function<std::uint64_t()> poll_deadline_ns;
   };
 
   // `log` empty: stderr_log(process).
@@ -99,6 +101,12 @@ class BridgeRuntime {
         schedule_status();
       }
     };
+    if (handlers_.poll_deadline_ns) {
+      locked.poll_deadline_ns = [this] {
+        std::lock_guard<std::mutex> lock(mutex_);
+        return handlers_.poll_deadline_ns();
+      };
+    }
     reader_.start(std::move(locked));
     diagnostics_ = std::make_unique<diagnostics::DiagnosticsPublisher>(
         participant_, process_, participant_.options().diagnostics_period_s, [this] { return snapshot(); });

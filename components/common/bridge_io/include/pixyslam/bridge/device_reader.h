@@ -61,6 +61,10 @@ class DeviceReader {
     std::function<void()> on_open;  // after every successful open
     std::function<void(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns)> on_bytes;
     std::function<void(std::uint64_t now_ns)> on_poll;
+    // Optional: the clock time by which on_poll must run next (0: no deadline),
+    // e.g. when a frame the node holds times out. The read then waits only
+    // until then (at least 1 ms), not the whole poll_period.
+    std::function<std::uint64_t()> poll_deadline_ns;
   };
 
   DeviceReader(std::unique_ptr<ByteSource> source, const DeviceReaderOptions& options, LogFunction log,
@@ -81,6 +85,8 @@ class DeviceReader {
 
  private:
   void loop();
+  // The read's timeout: poll_period, or less when the node has an earlier deadline.
+  std::chrono::milliseconds read_timeout();
   // Waits `period` (or until stop), calling on_poll every poll_period.
   void wait(std::chrono::milliseconds period);
   bool stopping() const { return stop_.load(); }

@@ -82,6 +82,11 @@ class PixyNode {
   // The reader thread's handlers, called with mutex_ held (BridgeRuntime).
   void on_bytes(const std::uint8_t* data, std::size_t size, std::uint64_t receive_ns);
   void on_poll(std::uint64_t now_ns);
+  std::uint64_t frame_timeout_ns() const;
+  // When the open frame times out (0: none open): the device read waits no
+  // longer, so a frame no next frame ends goes out frame_timeout_s after its
+  // last byte, not at the next 50 ms read timeout.
+  std::uint64_t open_frame_deadline_ns() const;
   // The end of the frame that was open before this chunk (frame_end_ns_), now complete.
   std::uint64_t complete_open_frame(std::uint64_t index);
   // Publishes the frame unless the rate limiter drops it.
