@@ -45,6 +45,11 @@ foreach(component robot station)
       message(STATUS \"Installing: \${bin}/pixyslam-${short} -> \${target}\")" COMPONENT ${component})
   endforeach()
 endforeach()
+# Run by pixy_bridge in its place when a camera is wanted (components/pixy_bridge/main.cpp):
+# beside it, without a bin/ link of its own.
+if(TARGET pixy_bridge_camera)
+  install(TARGETS pixy_bridge_camera RUNTIME DESTINATION ${PIXYSLAM_PROGRAM_DIR} COMPONENT robot)
+endif()
 # Configuration lives in /etc whatever the prefix (the systemd units read it there).
 set(PIXYSLAM_SYSCONFDIR /etc CACHE PATH "Where config/ is installed (as pixyslam/)")
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/ DESTINATION ${PIXYSLAM_SYSCONFDIR}/pixyslam COMPONENT robot)

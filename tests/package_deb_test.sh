@@ -37,12 +37,17 @@ done
 dpkg-deb -e "$robot_deb" "$work/control"
 dpkg-deb -e "$station_deb" "$work/station_control"
 for f in usr/lib/pixyslam/bin/slam_estimator usr/lib/pixyslam/bin/encoder_bridge usr/lib/pixyslam/bin/pixy_bridge \
+         usr/lib/pixyslam/bin/pixy_bridge_camera \
          usr/lib/pixyslam/bin/logger usr/lib/pixyslam/bin/pixyslam_launch usr/lib/pixyslam/bin/pixyslam_calibrate \
          usr/bin/pixyslam-launch usr/bin/pixyslam-logger usr/bin/pixyslam-slam-estimator usr/bin/pixyslam-calibrate \
          etc/pixyslam/dds/profiles.xml etc/pixyslam/launch_robot.yaml etc/default/pixyslam \
          usr/lib/systemd/system/pixyslam-robot.service usr/lib/systemd/system/pixyslam-station.service; do
   [[ -e $work/root/$f ]] || fail "$f is in neither package"
 done
+# pixy_bridge runs pixy_bridge_camera from its own folder for a camera (and --help).
+"$work/root/usr/lib/pixyslam/bin/pixy_bridge" --help | grep -q "camera.input" ||
+  fail "the packaged pixy_bridge --help does not reach pixy_bridge_camera (no camera keys)"
+ldd "$work/root/usr/lib/pixyslam/bin/pixy_bridge" | grep -q opencv && fail "pixy_bridge loads OpenCV (only pixy_bridge_camera should)"
 dpkg-deb -c "$robot_deb" | grep -q "usr/lib/pixyslam/bin/map_view" && fail "map_view (GUI) is in pixyslam-robot"
 dpkg-deb -c "$station_deb" | grep -q "etc/pixyslam" && fail "pixyslam-station ships config files (pixyslam-robot's)"
 grep -qx "/etc/pixyslam/slam_estimator.yaml" "$work/control/conffiles" || fail "config files are not conffiles"

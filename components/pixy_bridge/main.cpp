@@ -9,12 +9,25 @@
 // --set pixy.KEY=V or dds.KEY=V a parameter. --verbose prints the effective
 // configuration to stdout; logs go to stderr. Exit status: 0 after a clean stop, 2 for a configuration or
 // command-line error, 1 for any other failure.
+//
+// Built twice: pixy_bridge without OpenCV, and pixy_bridge_camera with the camera
+// backend. OpenCV's videoio pulls in some 240 shared libraries (57 MB more
+// resident memory, and their loading at every start), which a robot with a Pixy
+// does not need: pixy_bridge runs pixy_bridge_camera, from its own folder, in
+// its place (same pid and arguments) for --camera, a camera: section, or --help
+// (which lists the camera's keys).
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include "pixyslam/app/cli.h"
 #include "pixyslam/app/process_main.h"
@@ -25,9 +38,52 @@
 #include "pixyslam/camera/camera_byte_source.h"
 #endif
 
+#ifdef PIXYSLAM_CAMERA_PROGRAM
+namespace {
+
+// Replaces this process by the camera program; returns only if that fails
+// (with the reason on stderr).
+void exec_camera_program(char** argv) {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  const std::string path = (self.parent_path() / PIXYSLAM_CAMERA_PROGRAM).string();
+  ::execv(path.c_str(), argv);
+  std::fprintf(stderr, "pixy_bridge: the camera backend is the program %s, which cannot be run: %s\n", path.c_str(),
+               std::strerror(errno));
+}
+
+bool any_argument(int argc, char** argv, bool (*match)(std::string_view)) {
+  for (int i = 1; i < argc; ++i) {
+    if (match(argv[i])) return true;
+  }
+  return false;
+}
+
+bool is_help(std::string_view a) { return a == "-h" || a == "--help"; }
+bool is_camera(std::string_view a) { return a == "--camera" || a.rfind("--camera=", 0) == 0; }
+
+// A config that cannot be read is reported by the normal reading below.
+bool has_camera_section(const std::string& config_path) {
+  try {
+    return pixyslam::config::YamlReader::from_file(config_path).has("camera");
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+}  // namespace
+#endif
+
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();  // first: every thread inherits the blocked signals
+#ifdef PIXYSLAM_CAMERA_PROGRAM
+  const bool help = any_argument(argc, argv, is_help);
+  if (help || any_argument(argc, argv, is_camera)) {
+    exec_camera_program(argv);
+    if (!help) return 2;  // --help goes on without it (and without the camera's keys)
+  }
+#endif
   bridge::BridgeCommandLine args;
   std::string camera_input;
   app::Cli cli{"pixy_bridge", "The Pixy's UART block stream (or a camera) -> one LandmarkObservation per frame over DDS, until "
@@ -43,6 +99,12 @@ int main(int argc, char** argv) {
   cli.footer(pixy_node::help_text());
 #endif
   if (const auto done = cli.parse(argc, argv)) return *done;
+#ifdef PIXYSLAM_CAMERA_PROGRAM
+  if (has_camera_section(args.config)) {
+    exec_camera_program(argv);
+    return 2;
+  }
+#endif
 
   pixy_node::PixyNodeOptions options;
   pixy_node::CameraSectionReader read_camera;
