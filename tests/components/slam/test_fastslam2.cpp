@@ -882,6 +882,32 @@ TEST(FastSlam2, FramesDeliveredBehindTheOdometryGiveTheSameResultAsInTimeOrder) 
   EXPECT_EQ(in_order.counters().delayed_sampling_starts, delayed.counters().delayed_sampling_starts);
 }
 
+// The odometry steps kept for late frames are bounded: after 65,536 of them
+// without a frame they are applied to the particles, and only frames after that
+// can still be applied at their stamps.
+TEST(FastSlam2, OdometryKeptForLateFramesIsBounded) {
+  FilterOptions o;
+  o.particles = 10;
+  o.motion.v_sigma_m_per_sqrt_s = 1e-4;  // the pose stays known to millimetres over the 700 s
+  o.motion.w_sigma_rad_per_sqrt_s = 1e-5;
+  FastSlam2 f(o, Pose2::Zero());
+  for (int k = 0; k <= 70000; ++k) f.add_odometry({0.01 * k, 0.1, 0.0});
+  EXPECT_NEAR(f.pose_estimate().mean.x(), 70.0, 0.5);
+  f.add_observations({699.0, {{1, 1.0, 0.0}}});  // after the bound: at its stamp, x = 69.9
+  EXPECT_EQ(f.counters().frames_late, 1u);
+  ASSERT_EQ(f.landmarks_of_best().size(), 1u);
+  EXPECT_NEAR(f.landmarks_of_best()[0].mean.x(), 70.9, 0.05);
+  f.add_observations({600.0, {{2, 1.0, 0.0}}});  // before it (and before that frame): at the filter time
+  EXPECT_EQ(f.counters().frames_out_of_order, 1u);
+  ASSERT_EQ(f.landmarks_of_best().size(), 2u);
+  EXPECT_NEAR(f.landmarks_of_best()[1].mean.x(), 71.0, 0.05);
+  FastSlam2 g(o, Pose2::Zero());
+  for (int k = 0; k <= 70000; ++k) g.add_odometry({0.01 * k, 0.1, 0.0});
+  g.add_observations({600.0, {{2, 1.0, 0.0}}});  // older than the bound alone
+  EXPECT_EQ(g.counters().frames_out_of_order, 1u);
+  EXPECT_EQ(g.counters().frames_late, 0u);
+}
+
 TEST(FastSlam2, HeldControlTimesOut) {
   FilterOptions o;
   o.particles = 20;

@@ -52,6 +52,10 @@ bool plausible_sigma(double sigma) {
 
 // Landmarks at most considered as anchors (the first ones seen).
 constexpr std::size_t kMaxAnchors = 16;
+// Odometry steps kept for late frames (2 MB): a longer time without frames
+// (16 min of 67 Hz odometry) applies them to the particles, so a dead camera
+// does not grow the filter's memory.
+constexpr std::size_t kMaxPendingSteps = 65536;
 
 // Whether a pose covariance exceeds a heading sd or a position sd (worst direction).
 bool exceeds(const Eigen::Matrix3d& cov, double heading_sigma, double position_sigma) {
@@ -198,6 +202,10 @@ void FastSlam2::advance_to(double t_s) {
 }
 
 void FastSlam2::add_pending(const MotionStep& step) {
+  if (pending_steps_.size() >= kMaxPendingSteps) {
+    move_particles();
+    moved_until_s_ = step.from_s;
+  }
   pending_.add(step.v_mps, step.w_radps, step.to_s - step.from_s, options_.motion);
   pending_steps_.push_back(step);
 }
