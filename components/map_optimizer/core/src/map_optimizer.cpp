@@ -25,23 +25,70 @@ T wrapped(const T& a) {
   return atan2(sin(a), cos(a));
 }
 
-// Keyframe b seen from keyframe a against the composed odometry (in a's frame).
+// Keyframe b seen from keyframe a against the composed odometry (in a's frame),
+// its rotation larger by `extra` (the turn-rate scale's share) and its
+// displacement turned by half of that (the chord of the arc).
+template <typename T>
+Eigen::Matrix<T, 3, 1> odometry_error(const T* a, const T* b, const T& extra, const Eigen::Vector3d& delta) {
+  using std::cos;
+  using std::sin;
+  const T dx = b[0] - a[0];
+  const T dy = b[1] - a[1];
+  const T c = cos(a[2]);
+  const T s = sin(a[2]);
+  const T ch = cos(extra * T(0.5));
+  const T sh = sin(extra * T(0.5));
+  const T px = ch * T(delta.x()) - sh * T(delta.y());
+  const T py = sh * T(delta.x()) + ch * T(delta.y());
+  Eigen::Matrix<T, 3, 1> e;
+  e << c * dx + s * dy - px, -s * dx + c * dy - py, wrapped(b[2] - a[2] - T(delta.z()) - extra);
+  return e;
+}
+
 struct OdometryResidual {
   Eigen::Vector3d delta;
   Eigen::Matrix3d sqrt_information;
 
   template <typename T>
   bool operator()(const T* a, const T* b, T* residual) const {
-    using std::cos;
-    using std::sin;
-    const T dx = b[0] - a[0];
-    const T dy = b[1] - a[1];
-    const T c = cos(a[2]);
-    const T s = sin(a[2]);
-    Eigen::Matrix<T, 3, 1> e;
-    e << c * dx + s * dy - T(delta.x()), -s * dx + c * dy - T(delta.y()), wrapped(b[2] - a[2] - T(delta.z()));
     Eigen::Map<Eigen::Matrix<T, 3, 1>> r(residual);
-    r = sqrt_information.cast<T>() * e;
+    r = sqrt_information.cast<T>() * odometry_error(a, b, T(0.0), delta);
+    return true;
+  }
+};
+
+// The same with a's turn-rate scale s: the rotation is (1 + s) times the odometry's.
+struct ScaledOdometryResidual {
+  Eigen::Vector3d delta;
+  Eigen::Matrix3d sqrt_information;
+
+  template <typename T>
+  bool operator()(const T* a, const T* b, const T* scale, T* residual) const {
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> r(residual);
+    r = sqrt_information.cast<T>() * odometry_error(a, b, scale[0] * T(delta.z()), delta);
+    return true;
+  }
+};
+
+// First-order Gauss-Markov step of the turn-rate scale: s_b = rho s_a + noise.
+struct ScaleStepResidual {
+  double rho;
+  double sqrt_information;
+
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* residual) const {
+    residual[0] = (b[0] - T(rho) * a[0]) * T(sqrt_information);
+    return true;
+  }
+};
+
+// The first keyframe's scale: zero mean, sd turn_scale_sigma (the process's stationary sd).
+struct ScalePriorResidual {
+  double sqrt_information;
+
+  template <typename T>
+  bool operator()(const T* s, T* residual) const {
+    residual[0] = s[0] * T(sqrt_information);
     return true;
   }
 };
@@ -69,8 +116,31 @@ struct RangeBearingResidual {
 
 bool finite(const slam::Pose2& p) { return p.allFinite(); }
 
-ceres::CostFunction* odometry_cost(const OdometryFactor& f) {
-  return new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(new OdometryResidual{f.delta, f.sqrt_information});
+bool scale_state(const MapOptimizerOptions& o) { return o.turn_scale_sigma > 0.0; }
+
+// An odometry factor between two keyframes' blocks, with the turn-rate scale
+// step when `scales` (from's, to's) are given.
+void add_odometry_factor(ceres::Problem& problem, const OdometryFactor& f, double* from, double* to,
+                         double* scale_from = nullptr, double* scale_to = nullptr) {
+  if (!scale_from) {
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(new OdometryResidual{f.delta, f.sqrt_information}),
+        nullptr, from, to);
+    return;
+  }
+  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ScaledOdometryResidual, 3, 3, 3, 1>(
+                               new ScaledOdometryResidual{f.delta, f.sqrt_information}),
+                           nullptr, from, to, scale_from);
+  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ScaleStepResidual, 1, 1, 1>(
+                               new ScaleStepResidual{f.scale_rho, f.scale_step_sqrt_information}),
+                           nullptr, scale_from, scale_to);
+}
+
+void add_scale_prior(ceres::Problem& problem, const MapOptimizerOptions& o, double* scale) {
+  problem.AddParameterBlock(scale, 1);
+  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ScalePriorResidual, 1, 1>(
+                               new ScalePriorResidual{1.0 / o.turn_scale_sigma}),
+                           nullptr, scale);
 }
 
 ceres::CostFunction* observation_cost(const ObservationFactor& f) {
@@ -155,6 +225,11 @@ const parameters::Table<MapOptimizerOptions>& map_optimizer_parameters() {
                  [](O& o) -> double& { return o.huber_threshold; }),
       P::integer<O, int>("max_iterations", 1, 10000, "", "Ceres iterations per solve at most",
                          [](O& o) -> int& { return o.max_iterations; }),
+      P::real<O>("turn_scale_sigma", 0.0, 1.0, "",
+                 "sd of the slowly varying turn-rate scale error (heading change (1 + s) x the odometry's; 0: none)",
+                 [](O& o) -> double& { return o.turn_scale_sigma; }),
+      P::real<O>("turn_scale_correlation_s", 0.1, 1e6, "s", "... its correlation time",
+                 [](O& o) -> double& { return o.turn_scale_correlation_s; }),
   };
   return table;
 }
@@ -186,6 +261,10 @@ MapOptimizer::MapOptimizer(const MapOptimizerOptions& options, const slam::Pose2
   pose_blocks_.push_back({start_pose.x(), start_pose.y(), slam::wrap_angle(start_pose.z())});
   problem_->AddParameterBlock(pose_blocks_.back().data(), 3);
   problem_->SetParameterBlockConstant(pose_blocks_.back().data());
+  if (scale_state(options_)) {
+    scale_blocks_.push_back(0.0);
+    add_scale_prior(*problem_, options_, &scale_blocks_.back());
+  }
   keyframes_.push_back({start_time_s, start_pose});
   last_time_s_ = start_time_s;
   last_measured_s_ = start_time_s;
@@ -246,7 +325,17 @@ void MapOptimizer::close_keyframe(double t_s, const std::optional<slam::Pose2>& 
   pose_blocks_.push_back({initial.x(), initial.y(), initial.z()});
   double* const before = previous.data();
   double* const after = pose_blocks_.back().data();
-  problem_->AddResidualBlock(odometry_cost(factor), nullptr, before, after);
+  if (scale_state(options_)) {
+    const double rho = std::exp(-(t_s - keyframes_.back().t_s) / options_.turn_scale_correlation_s);
+    factor.scale_rho = rho;
+    factor.scale_step_sqrt_information =
+        1.0 / (options_.turn_scale_sigma * std::sqrt(std::max(1e-12, 1.0 - rho * rho)));
+    double* const scale_before = &scale_blocks_.back();
+    scale_blocks_.push_back(rho * *scale_before);
+    add_odometry_factor(*problem_, factor, before, after, scale_before, &scale_blocks_.back());
+  } else {
+    add_odometry_factor(*problem_, factor, before, after);
+  }
   odometry_factors_.push_back(factor);
   keyframes_.push_back({t_s, initial});
   keyframe_due_s_ = t_s + options_.keyframe_interval_s;
@@ -335,6 +424,8 @@ SolveSummary MapOptimizer::solve(std::optional<std::size_t> window_keyframes) {
   std::size_t first_free = 1;
   if (window_keyframes) first_free = std::max<std::size_t>(1, n > *window_keyframes ? n - *window_keyframes : 0);
   for (std::size_t i = 1; i < first_free; ++i) problem_->SetParameterBlockConstant(pose_blocks_[i].data());
+  const std::size_t held_scales = first_free > 1 ? std::min(first_free, scale_blocks_.size()) : 0;
+  for (std::size_t i = 0; i < held_scales; ++i) problem_->SetParameterBlockConstant(&scale_blocks_[i]);
   for (auto& [id, lm] : landmarks_) {
     if (lm.last_keyframe < first_free) {
       problem_->SetParameterBlockConstant(lm.xy.data());
@@ -349,6 +440,7 @@ SolveSummary MapOptimizer::solve(std::optional<std::size_t> window_keyframes) {
   if (out.keyframes_free > 0 || out.landmarks_free > 0) ceres::Solve(solver_options(options_), problem_.get(), &summary);
 
   for (std::size_t i = 1; i < first_free; ++i) problem_->SetParameterBlockVariable(pose_blocks_[i].data());
+  for (std::size_t i = 0; i < held_scales; ++i) problem_->SetParameterBlockVariable(&scale_blocks_[i]);
   for (auto& [id, lm] : landmarks_) problem_->SetParameterBlockVariable(lm.xy.data());
   sync_keyframes();
   ++counters_.solves;
@@ -360,6 +452,7 @@ WholeProblem MapOptimizer::snapshot() const {
   WholeProblem p;
   p.options = options_;
   p.poses.assign(pose_blocks_.begin(), pose_blocks_.end());
+  p.turn_scales.assign(scale_blocks_.begin(), scale_blocks_.end());
   std::map<int, std::size_t> index;
   for (const auto& [id, lm] : landmarks_) {
     index[id] = p.landmark_ids.size();
@@ -379,6 +472,7 @@ WholeProblem MapOptimizer::snapshot() const {
 WholeSolution solve_whole_problem(const WholeProblem& problem, bool covariances) {
   WholeSolution out;
   out.poses = problem.poses;
+  out.turn_scales = problem.turn_scales;
   out.landmark_ids = problem.landmark_ids;
   out.landmarks = problem.landmarks;
   ceres::Problem::Options problem_options;
@@ -388,8 +482,15 @@ WholeSolution solve_whole_problem(const WholeProblem& problem, bool covariances)
   for (std::array<double, 3>& pose : out.poses) p.AddParameterBlock(pose.data(), 3);
   if (!out.poses.empty()) p.SetParameterBlockConstant(out.poses.front().data());
   for (std::array<double, 2>& l : out.landmarks) p.AddParameterBlock(l.data(), 2);
+  const bool scales = !out.turn_scales.empty();
+  if (scales) add_scale_prior(p, problem.options, &out.turn_scales.front());
   for (const OdometryFactor& f : problem.odometry) {
-    p.AddResidualBlock(odometry_cost(f), nullptr, out.poses.at(f.from).data(), out.poses.at(f.to).data());
+    if (scales) {
+      add_odometry_factor(p, f, out.poses.at(f.from).data(), out.poses.at(f.to).data(), &out.turn_scales.at(f.from),
+                          &out.turn_scales.at(f.to));
+    } else {
+      add_odometry_factor(p, f, out.poses.at(f.from).data(), out.poses.at(f.to).data());
+    }
   }
   for (const ObservationFactor& f : problem.observations) {
     p.AddResidualBlock(observation_cost(f), &loss, out.poses.at(f.keyframe).data(), out.landmarks.at(f.landmark).data());
@@ -419,6 +520,9 @@ void MapOptimizer::adopt(const WholeSolution& solution) {
   // The rigid correction of the snapshot's newest keyframe: solved o current^-1.
   const std::array<double, 3> correction = compose(solution.poses[n - 1], inverse(pose_blocks_[n - 1]));
   for (std::size_t i = 0; i < n; ++i) pose_blocks_[i] = solution.poses[i];
+  for (std::size_t i = 0; i < std::min(solution.turn_scales.size(), scale_blocks_.size()); ++i) {
+    scale_blocks_[i] = solution.turn_scales[i];
+  }
   for (std::size_t i = n; i < pose_blocks_.size(); ++i) pose_blocks_[i] = compose(correction, pose_blocks_[i]);
   std::map<int, std::size_t> solved;
   for (std::size_t i = 0; i < solution.landmark_ids.size(); ++i) solved[solution.landmark_ids[i]] = i;

@@ -39,7 +39,12 @@ namespace pixyslam::map_optimizer {
 //   its observation noise, under a Huber loss rho whose threshold is the 95 %
 //   chi-square quantile of 2 dof (inside it plain least squares);
 // - the first keyframe (the start pose the filter starts from) is held fixed: it
-//   defines the frame, as it does for the filter.
+//   defines the frame, as it does for the filter;
+// - a turn-rate scale error s per keyframe, slowly varying (first-order
+//   Gauss-Markov, sd turn_scale_sigma, correlation time turn_scale_correlation_s):
+//   the heading change between keyframes is (1 + s) times the odometry's. The
+//   filter's white noise allows a heading error that grows with the square root
+//   of the time; a turn rate off by a few percent for a minute is not white.
 // Keyframes: one at every camera frame with a valid detection, and one at least
 // every keyframe_interval_s in between, so a long blind stretch bends through
 // several factors instead of one badly linearised one; none while the odometry
@@ -60,6 +65,9 @@ struct MapOptimizerOptions {
   double keyframe_interval_s = 1.0;
   // Huber threshold on the whitened residual norm: sqrt(chi2_2(0.95)).
   double huber_threshold = 2.4477;
+  // The turn-rate scale state (0: none, the odometry factors alone).
+  double turn_scale_sigma = 0.05;
+  double turn_scale_correlation_s = 60.0;
   int max_iterations = 100;
   // Ceres stops when the cost changes by less than this fraction.
   double function_tolerance = 1e-8;
@@ -120,6 +128,10 @@ struct OdometryFactor {
   std::size_t to = 0;
   Eigen::Vector3d delta = Eigen::Vector3d::Zero();  // odometry composed between them, in from's frame
   Eigen::Matrix3d sqrt_information = Eigen::Matrix3d::Identity();
+  // The turn-rate scale from `to` against from's: s_to - rho s_from, times
+  // this (0 without the scale state).
+  double scale_rho = 0.0;
+  double scale_step_sqrt_information = 0.0;
 };
 struct ObservationFactor {
   std::size_t keyframe = 0;
@@ -132,6 +144,7 @@ struct ObservationFactor {
 struct WholeProblem {
   MapOptimizerOptions options;
   std::vector<std::array<double, 3>> poses;  // keyframes; the first held fixed
+  std::vector<double> turn_scales;           // per keyframe (empty without the scale state)
   std::vector<int> landmark_ids;
   std::vector<std::array<double, 2>> landmarks;
   std::vector<OdometryFactor> odometry;
@@ -139,6 +152,7 @@ struct WholeProblem {
 };
 struct WholeSolution {
   std::vector<std::array<double, 3>> poses;
+  std::vector<double> turn_scales;
   std::vector<int> landmark_ids;
   std::vector<std::array<double, 2>> landmarks;
   std::vector<Eigen::Matrix2d> landmark_covs;  // NaN when not computed or rank deficient
@@ -210,6 +224,7 @@ class MapOptimizer {
   std::unique_ptr<ceres::Problem> problem_;
   std::unique_ptr<ceres::LossFunction> loss_;  // shared by the observation factors
   std::deque<std::array<double, 3>> pose_blocks_;  // stable addresses for Ceres
+  std::deque<double> scale_blocks_;                // per keyframe, with the scale state
   std::vector<Keyframe> keyframes_;                // pose_blocks_ as poses
   std::map<int, LandmarkBlock> landmarks_;
   // The factors as added (snapshot()), landmarks by id.
