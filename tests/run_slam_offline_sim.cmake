@@ -1,7 +1,8 @@
 # Runs `slam_offline sim` and checks its outputs: both CSV files with their
 # headers, and a pose ATE RMSE under 0.15 m on the simulated world (dead reckoning: ~0.4 m).
 # With -DOPTIMISE=1 it runs with --optimise: the filter's files are there too
-# (filter_*.csv) and the optimised ATE is at most the filter's. Without, it also
+# (filter_*.csv) and the optimised ATE is at most the filter's, and a bad
+# --set optimizer.KEY=V is a usage error. Without, it also
 # writes the recording as an MRCLAM data set (--write-dataset) and runs
 # `slam_offline mrclam` on it: the same trajectory, byte for byte.
 file(REMOVE_RECURSE "${OUT}")
@@ -41,6 +42,12 @@ if(OPTIMISE)
   string(REGEX MATCH "[0-9.]+" optimised_ate "${second}")
   if(optimised_ate GREATER filter_ate)
     message(FATAL_ERROR "optimised ATE ${optimised_ate} m above the filter's ${filter_ate} m")
+  endif()
+  # The optimiser's keys by --set: a bad one is a usage error (2) naming it, before any run.
+  execute_process(COMMAND "${RUNNER}" sim --config "${CONFIG}" --out-dir "${OUT}/bad" --optimise
+    --set optimizer.turn_scale_sigma=7 OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "optimizer.turn_scale_sigma" OR EXISTS "${OUT}/bad/trajectory.csv")
+    message(FATAL_ERROR "--set optimizer.turn_scale_sigma=7: exit ${rc}, '${err}'")
   endif()
 endif()
 if(NOT OPTIMISE)

@@ -2,7 +2,7 @@
 // set for every robot, several seeds per robot.
 //   mrclam_eval --dataset DIR --config FILE [--robots 1,2,3,4,5] [--seeds 1,2,3]
 //               [--association known_id|maximum_likelihood] [--segments SECONDS] [--loro]
-//               [--blind-return] [--optimise] [--set filter.KEY=V|mrclam.KEY=V ...]
+//               [--blind-return] [--optimise] [--set filter.KEY=V|mrclam.KEY=V|optimizer.KEY=V ...]
 // --association maximum_likelihood withholds the landmark ids from the filter
 // (the landmark columns then match nothing by id; ATE and heading still count).
 // Every run also reports the pose NEES against the truth (3 dof, ideal mean 3).
@@ -67,11 +67,22 @@ namespace {
 
 using namespace pixyslam;
 
+// --optimise, with the optimizer. section of --set.
+struct OptimiseRequest {
+  bool on = false;
+  std::vector<std::string> sets;
+  explicit operator bool() const { return on; }
+};
+
 // The map optimiser's solution of a filter run, when asked for (--optimise).
-std::optional<offline::RunResult> optimised(bool optimise, const slam::FilterOptions& options,
+std::optional<offline::RunResult> optimised(const OptimiseRequest& optimise, const slam::FilterOptions& options,
                                             const offline::RunInput& input, const offline::RunResult& filter) {
 #ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
-  if (optimise) return offline::optimise_run(options, input, filter).result;
+  if (optimise) {
+    return offline::optimise_run(options, input, filter, map_optimizer::SolveScheduleOptions::at_end_only(),
+                                 optimise.sets)
+        .result;
+  }
 #else
   if (optimise) throw std::runtime_error("--optimise: this build has no map optimiser (built without Ceres)");
 #endif
@@ -127,7 +138,7 @@ void print_segment_summary(const std::string& label, const std::vector<Segment>&
 
 // The runs of one robot and seed restarted from the truth every every_s seconds.
 std::vector<Segment> run_segments(const slam::FilterOptions& options, const offline::RunInput& input, int robot,
-                                  double every_s, bool optimise) {
+                                  double every_s, const OptimiseRequest& optimise) {
   const std::vector<eval::TimedPose> truth = offline::sorted_by_time(input.truth);
   std::vector<Segment> out;
   for (double start : offline::segment_starts(truth, every_s)) {
@@ -192,7 +203,8 @@ void print_fit(const std::string& label, const mrclam::CorrectionFit& f) {
 // the main table's runs (config corrections, one per seed), `config_segments`
 // the segments run with them (empty without --segments).
 void run_loro(const std::string& dataset, slam::FilterOptions options, const offline::MrclamSensorModel& config_model,
-              const std::vector<int>& robots, const std::vector<int>& seeds, double segment_every_s, bool optimise,
+              const std::vector<int>& robots, const std::vector<int>& seeds, double segment_every_s,
+              const OptimiseRequest& optimise,
               const std::map<int, std::vector<RunScore>>& config_scores,
               const std::map<int, std::vector<Segment>>& config_segments) {
   constexpr double kDeg = 180.0 / M_PI;
@@ -277,7 +289,7 @@ void run_loro(const std::string& dataset, slam::FilterOptions options, const off
         for (const Segment& g : run_segments(options, with_fit, robot, segment_every_s, optimise)) {
           row.loro_segments.push_back(g);
         }
-        for (const Segment& g : run_segments(options, with_neutral, robot, segment_every_s, false)) {
+        for (const Segment& g : run_segments(options, with_neutral, robot, segment_every_s, OptimiseRequest{})) {
           row.neutral_segments.push_back(g);
         }
       }
@@ -345,7 +357,7 @@ void run_loro(const std::string& dataset, slam::FilterOptions options, const off
 
 // mrclam_eval --blind-return (see the top of this file).
 void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<int, offline::RunInput>>& inputs,
-                      const std::vector<int>& seeds, bool optimise) {
+                      const std::vector<int>& seeds, const OptimiseRequest& optimise) {
   constexpr double kDeg = 180.0 / M_PI;
   constexpr double kEveryS = 60.0;
   const offline::BlindReturnOptions cases;
@@ -529,9 +541,10 @@ void print_fleet(const std::map<int, FleetRuns>& fleet) {
 struct EvalArguments {
   std::string dataset, config_path, association = "known_id", out_dir;
   std::vector<int> robots{1, 2, 3, 4, 5}, seeds{1, 2, 3};
-  std::vector<std::string> sets;  // --set: filter.KEY=V or mrclam.KEY=V
+  std::vector<std::string> sets;  // --set: filter.KEY=V, mrclam.KEY=V or optimizer.KEY=V
   double segment_every_s = 0.0;  // 0: no segments
-  bool loro = false, blind_return = false, optimise = false;
+  bool loro = false, blind_return = false;
+  OptimiseRequest optimise;
 };
 
 int run(const EvalArguments& args) {
@@ -541,7 +554,8 @@ int run(const EvalArguments& args) {
   const std::vector<int>& robots = args.robots;
   const std::vector<int>& seeds = args.seeds;
   const double segment_every_s = args.segment_every_s;
-  const bool loro = args.loro, blind_return = args.blind_return, optimise = args.optimise;
+  const bool loro = args.loro, blind_return = args.blind_return;
+  OptimiseRequest optimise = args.optimise;
   if (!std::filesystem::is_directory(dataset)) {
     std::printf("SKIP: dataset folder %s not found\n", dataset.c_str());
     return 77;
@@ -553,7 +567,14 @@ int run(const EvalArguments& args) {
   root.finish();
   std::vector<std::string> filter_sets = args.sets;
   const std::vector<std::string> mrclam_sets = parameters::take_section(filter_sets, "mrclam");
+  optimise.sets = parameters::take_section(filter_sets, "optimizer");
   try {
+    if (!optimise.sets.empty() && !optimise) {
+      throw std::invalid_argument(optimise.sets.front() + ": optimizer. needs --optimise");
+    }
+#ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
+    offline::optimizer_options(options, optimise.sets);  // checked now, not after the first run
+#endif
     slam::apply_overrides(options, filter_sets);
     for (const std::string& a : mrclam_sets) {
       parameters::apply_override(model, offline::mrclam_sensor_parameters(), "mrclam", a);
@@ -745,7 +766,9 @@ int main(int argc, char** argv) {
   cli.flag("--blind-return", a.blind_return,
            "restarts every 60 s with a blind stretch, then far new landmarks, then the first ones again: the "
            "heading error before and after they return");
-  cli.flag("--optimise", a.optimise, "also the map optimiser (Ceres) over every run after the filter");
+  cli.flag("--optimise", a.optimise.on,
+           "also the map optimiser (Ceres) over every run after the filter (--set optimizer.KEY=V: map_optimizer "
+           "--help lists them)");
   cli.option("--out-dir", a.out_dir,
              "write runs.csv, segments.csv and errors_robotR_seedS.csv (error over time) there, for "
              "scripts/plot_results.py")

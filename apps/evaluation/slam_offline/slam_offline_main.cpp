@@ -103,6 +103,7 @@ int run(const Args& args) {
   // world. (sim) and mrclam. (mrclam) apply to those sections; the rest to filter:.
   const std::vector<std::string> world_sets = parameters::take_section(overrides, "world");
   const std::vector<std::string> mrclam_sets = parameters::take_section(overrides, "mrclam");
+  const std::vector<std::string> optimizer_sets = parameters::take_section(overrides, "optimizer");
   const auto set_error = [](const std::invalid_argument& e) { return app::UsageError(std::string("--seed/--set: ") + e.what()); };
   try {
     slam::apply_overrides(options, overrides);
@@ -110,6 +111,12 @@ int run(const Args& args) {
     if (!mrclam_sets.empty() && args.mode != "mrclam") {
       throw std::invalid_argument(mrclam_sets.front() + ": mrclam. is for slam_offline mrclam");
     }
+    if (!optimizer_sets.empty() && !args.optimise) {
+      throw std::invalid_argument(optimizer_sets.front() + ": optimizer. needs --optimise");
+    }
+#ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
+    offline::optimizer_options(options, optimizer_sets);  // checked now, not after the filter ran
+#endif
   } catch (const std::invalid_argument& e) {
     throw set_error(e);
   }
@@ -185,7 +192,8 @@ int run(const Args& args) {
   offline::print_report(title, offline::evaluate(input, result), result);
 #ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
   if (args.optimise) {
-    const offline::OptimisedRun opt = offline::optimise_run(options, input, result);
+    const offline::OptimisedRun opt = offline::optimise_run(
+        options, input, result, map_optimizer::SolveScheduleOptions::at_end_only(), optimizer_sets);
     offline::print_accuracy(title + ", map optimiser", offline::evaluate(input, opt.result));
     print_solve(opt);
     write("filter_", result);
@@ -209,7 +217,8 @@ int main(int argc, char** argv) {
     mode.option("--out-dir", args.out_dir, "write trajectory.csv and landmarks.csv into DIR").required().type("DIR");
     mode.option("--seed", args.seed, "the filter's seed (filter.seed)").type("S");
     app::add_set(mode, args.sets, "filter.particles=300 (slam_estimator --help lists them; sim also world.KEY=V, "
-                                  "mrclam also mrclam.KEY=V, both listed below)");
+                                  "mrclam also mrclam.KEY=V, both listed below; with --optimise optimizer.KEY=V, "
+                                  "map_optimizer --help lists them)");
     mode.flag("--optimise",
               args.optimise,
               "also solve the whole run with the map optimiser (Ceres): its solution goes to trajectory.csv and "

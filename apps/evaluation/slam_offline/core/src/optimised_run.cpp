@@ -5,13 +5,23 @@
 
 namespace pixyslam::offline {
 
+map_optimizer::MapOptimizerOptions optimizer_options(const slam::FilterOptions& options,
+                                                     const std::vector<std::string>& optimizer_sets) {
+  map_optimizer::MapOptimizerOptions o = map_optimizer::MapOptimizerOptions::from_filter(options);
+  for (const std::string& a : optimizer_sets) {
+    parameters::apply_override(o, map_optimizer::map_optimizer_parameters(), "optimizer", a);
+  }
+  return o;
+}
+
 OptimisedRun optimise_run(const slam::FilterOptions& options, const RunInput& input, const RunResult& filter,
-                          const map_optimizer::SolveScheduleOptions& schedule) {
+                          const map_optimizer::SolveScheduleOptions& schedule,
+                          const std::vector<std::string>& optimizer_sets) {
   OptimisedRun out;
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_seconds();
-  map_optimizer::MapOptimizer optimizer(map_optimizer::MapOptimizerOptions::from_filter(options),
-                                        input.initial_pose, input.start_time_s);
+  map_optimizer::MapOptimizer optimizer(optimizer_options(options, optimizer_sets), input.initial_pose,
+                                        input.start_time_s);
   for (const eval::LandmarkRow& row : filter.landmarks) optimizer.set_landmark_guess(row.id, {row.x_m, row.y_m});
   optimizer.add_odometry({input.start_time_s, 0.0, 0.0});
   std::vector<map_optimizer::MapOptimizer::PoseAnchor> anchors;

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include "pixyslam/offline/offline_run.h"
 #include "pixyslam/map_optimizer/map_optimizer.h"
 
@@ -21,9 +24,16 @@ struct OptimisedRun {
 // mrclam_eval --optimise): the same input in the filter's order, keyframes
 // started from the filter's poses at the camera frames and landmarks from its
 // map, one solve of the whole problem at the end (and on the way as `schedule`
-// says; the live process's schedule for bench_map_optimizer).
+// says; the live process's schedule for bench_map_optimizer). The optimiser's
+// own keys keep their defaults but for `optimizer_sets` ("KEY=V", the
+// optimizer. section of --set; std::invalid_argument naming a bad one).
 OptimisedRun optimise_run(const slam::FilterOptions& options, const RunInput& input, const RunResult& filter,
                           const map_optimizer::SolveScheduleOptions& schedule =
-                              map_optimizer::SolveScheduleOptions::at_end_only());
+                              map_optimizer::SolveScheduleOptions::at_end_only(),
+                          const std::vector<std::string>& optimizer_sets = {});
+
+// The optimiser's options for a run with these filter options and --set optimizer.KEY=V.
+map_optimizer::MapOptimizerOptions optimizer_options(const slam::FilterOptions& options,
+                                                     const std::vector<std::string>& optimizer_sets);
 
 }  // namespace pixyslam::offline
