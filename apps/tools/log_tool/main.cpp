@@ -8,7 +8,7 @@
 //   pixyslam_spy info FILE.mcap [--json]
 //   pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]
 //   pixyslam_spy print FILE.mcap [--topic T] [--json]
-//   pixyslam_spy compare A.mcap B.mcap --topic T [--ignore F,...] [--tolerance X]
+//   pixyslam_spy compare A.mcap B.mcap --topic T [--ignore F,...] [--tolerance X] [--match F,... [--max-unmatched N]]
 // DDS options: --config FILE (a YAML with a `dds:` mapping, e.g.
 // config/slam_estimator.yaml; default: config/dds/profiles.xml on domain 0),
 // --domain N. The same program is also built as pixyslam_log (info/check).
@@ -210,6 +210,14 @@ int main(int argc, char** argv) {
   compare.option("--tolerance", compare_request.tolerance, "largest difference of a number taken as equal")
       .non_negative()
       .type("X");
+  std::string match;
+  compare.option("--match", match,
+                 "pair messages by these fields instead of by position (e.g. odometry_sequence,observation_sequence: "
+                 "MapStates that include the same inputs)")
+      .type("FIELD,...");
+  compare.option("--max-unmatched", compare_request.max_unmatched,
+                 "messages of each file without a partner that still pass (default 0)")
+      .type("N");
 
   log_tool::FoxgloveRequest foxglove_request;
   std::vector<std::string> foxglove_files;
@@ -234,6 +242,7 @@ int main(int argc, char** argv) {
       compare_request.first_path = compare_files[0];
       compare_request.second_path = compare_files[1];
       for (std::string& field : parameters::split_list(ignored)) compare_request.ignored.push_back(std::move(field));
+      for (std::string& field : parameters::split_list(match)) compare_request.match.push_back(std::move(field));
       return log_tool::run_compare(compare_request, std::cout);
     }
     if (foxglove.chosen()) {

@@ -275,6 +275,34 @@ TEST(CompareValues, OptimisedMapBooleansAndLandmarksDiffer) {
   EXPECT_EQ(lines[1], "converged: false != true");
 }
 
+// pixyslam_log compare --match: MapStates paired by the inputs they include.
+// A replay that got frame 2 after odometry 3 (applied at its stamp) publishes
+// the state after odometry 3 without frame 2, then the one with both: the
+// states with the same inputs pair up, the two intermediate ones do not.
+TEST(PairMessages, ByKeyFieldsInOrderAndByPositionWithout) {
+  auto state = [](std::uint64_t odometry, std::uint64_t observation) {
+    msg::MapState m;
+    m.odometry_sequence(odometry);
+    m.observation_sequence(observation);
+    return to_value(m);
+  };
+  const std::vector<Value> live = {state(1, 0), state(2, 0), state(2, 1), state(2, 2), state(3, 2), state(3, 3)};
+  const std::vector<Value> replay = {state(1, 0), state(2, 0), state(2, 1), state(3, 1), state(3, 2), state(3, 3)};
+  const MessagePairs p = pair_messages(live, replay, {"odometry_sequence", "observation_sequence"});
+  const std::vector<std::pair<std::size_t, std::size_t>> expected = {{0, 0}, {1, 1}, {2, 2}, {4, 4}, {5, 5}};
+  EXPECT_EQ(p.pairs, expected);
+  EXPECT_EQ(p.only_first, std::vector<std::size_t>{3});
+  EXPECT_EQ(p.only_second, std::vector<std::size_t>{3});
+  // Repeated keys pair in order; by position without key fields.
+  const MessagePairs twice = pair_messages({state(1, 0), state(1, 0)}, {state(1, 0)}, {"odometry_sequence"});
+  EXPECT_EQ(twice.pairs.size(), 1u);
+  EXPECT_EQ(twice.only_first, std::vector<std::size_t>{1});
+  const MessagePairs by_position = pair_messages(live, {state(9, 9)}, {});
+  ASSERT_EQ(by_position.pairs.size(), 1u);
+  EXPECT_EQ(by_position.pairs[0], std::make_pair(std::size_t{0}, std::size_t{0}));
+  EXPECT_EQ(by_position.only_first.size(), 5u);
+}
+
 TEST(SpyFormat, StringsAreEscapedAndNonFiniteNumbersStayValid) {
   Value v = Value::structure();
   v.add("text", Value::string("a\"b\\c\nd\x01"))

@@ -4,6 +4,8 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <deque>
+#include <map>
 #include <stdexcept>
 #include <tuple>
 
@@ -528,6 +530,43 @@ struct Comparison {
 };
 
 }  // namespace
+
+MessagePairs pair_messages(const std::vector<Value>& first, const std::vector<Value>& second,
+                           const std::vector<std::string>& key_fields) {
+  MessagePairs out;
+  if (key_fields.empty()) {
+    const std::size_t n = std::min(first.size(), second.size());
+    for (std::size_t i = 0; i < n; ++i) out.pairs.emplace_back(i, i);
+    for (std::size_t i = n; i < first.size(); ++i) out.only_first.push_back(i);
+    for (std::size_t i = n; i < second.size(); ++i) out.only_second.push_back(i);
+    return out;
+  }
+  const auto key_of = [&](const Value& v) {
+    std::string key;
+    for (const std::string& f : key_fields) {
+      const Value* field = v.find(f);
+      key += (field ? to_json_line(*field) : std::string("-")) + "\x1f";
+    }
+    return key;
+  };
+  std::map<std::string, std::deque<std::size_t>> waiting;  // second's indices by key, in order
+  for (std::size_t j = 0; j < second.size(); ++j) waiting[key_of(second[j])].push_back(j);
+  std::vector<bool> paired(second.size(), false);
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    auto it = waiting.find(key_of(first[i]));
+    if (it == waiting.end() || it->second.empty()) {
+      out.only_first.push_back(i);
+      continue;
+    }
+    out.pairs.emplace_back(i, it->second.front());
+    paired[it->second.front()] = true;
+    it->second.pop_front();
+  }
+  for (std::size_t j = 0; j < second.size(); ++j) {
+    if (!paired[j]) out.only_second.push_back(j);
+  }
+  return out;
+}
 
 std::vector<std::string> compare_values(const Value& a, const Value& b, const std::vector<std::string>& ignored,
                                         double tolerance, std::size_t max_lines) {

@@ -474,28 +474,29 @@ int run_compare(const CompareRequest& request, std::ostream& out) {
   const std::vector<Value> second = decoded_messages(request.second_path, request.topic);
   out << request.topic << ": " << first.size() << " messages in " << request.first_path << ", " << second.size()
       << " in " << request.second_path << "\n";
-  bool same = first.size() == second.size();
+  const MessagePairs paired = pair_messages(first, second, request.match);
+  const std::size_t n = paired.pairs.size();
+  bool same = paired.only_first.size() <= request.max_unmatched && paired.only_second.size() <= request.max_unmatched;
 
-  const std::size_t n = std::min(first.size(), second.size());
   std::int64_t min_offset = std::numeric_limits<std::int64_t>::max();
   std::int64_t max_offset = std::numeric_limits<std::int64_t>::min();
   std::size_t differing = 0;
   std::size_t lines = 0;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (const auto& [i, j] : paired.pairs) {
     const Value* a = first[i].find("header.stamp_ns");
-    const Value* b = second[i].find("header.stamp_ns");
+    const Value* b = second[j].find("header.stamp_ns");
     if (a != nullptr && b != nullptr) {
       const auto offset = static_cast<std::int64_t>(b->uint_value() - a->uint_value());
       min_offset = std::min(min_offset, offset);
       max_offset = std::max(max_offset, offset);
     }
     const std::vector<std::string> differences = compare_values(
-        first[i], second[i], request.ignored, request.tolerance, std::max<std::size_t>(1, request.max_lines));
+        first[i], second[j], request.ignored, request.tolerance, std::max<std::size_t>(1, request.max_lines));
     if (differences.empty()) continue;
     ++differing;
     for (const std::string& d : differences) {
       if (lines >= request.max_lines) break;
-      out << "  message " << i << ": " << d << "\n";
+      out << "  message " << i << (i == j ? "" : " (" + std::to_string(j) + " in the second)") << ": " << d << "\n";
       ++lines;
     }
   }
@@ -517,7 +518,14 @@ int run_compare(const CompareRequest& request, std::ostream& out) {
     out << differing << " of " << n << " messages differ\n";
     same = false;
   }
-  if (first.size() != second.size()) out << "message counts differ\n";
+  if (!request.match.empty()) {
+    std::string fields;
+    for (const std::string& f : request.match) fields += (fields.empty() ? "" : ",") + f;
+    out << "paired by " << fields << ": " << paired.only_first.size() << " only in the first, "
+        << paired.only_second.size() << " only in the second (at most " << request.max_unmatched << " each)\n";
+  } else if (first.size() != second.size()) {
+    out << "message counts differ\n";
+  }
   out << (same ? "SAME" : "DIFFERENT") << "\n";
   return same ? 0 : 1;
 }

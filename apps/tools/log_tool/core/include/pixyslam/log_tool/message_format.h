@@ -89,6 +89,16 @@ std::string format_double(double v);
 std::vector<std::string> compare_values(const Value& a, const Value& b, const std::vector<std::string>& ignored,
                                         double tolerance, std::size_t max_lines);
 
+// Messages of two recordings paired by the values of `key_fields` (e.g. the
+// input sequence numbers a MapState includes), in order among equal keys;
+// without key fields, by position. Pure.
+struct MessagePairs {
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;  // (index in first, index in second)
+  std::vector<std::size_t> only_first, only_second;
+};
+MessagePairs pair_messages(const std::vector<Value>& first, const std::vector<Value>& second,
+                           const std::vector<std::string>& key_fields);
+
 // Inter-arrival statistics of a stream (pixyslam_spy hz), times in seconds.
 struct GapStats {
   std::size_t messages = 0;

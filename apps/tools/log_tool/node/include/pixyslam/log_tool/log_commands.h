@@ -51,14 +51,20 @@ struct CompareRequest {
   std::vector<std::string> ignored;  // field paths, e.g. header.stamp_ns, landmarks.times_observed
   double tolerance = 0.0;            // relative; 0: bit-for-bit
   std::size_t max_lines = 20;
+  // Pair messages by these fields' values instead of by position, e.g.
+  // odometry_sequence,observation_sequence: a MapState is compared with the one
+  // that includes the same inputs. Messages without a partner are counted.
+  std::vector<std::string> match;
+  std::size_t max_unmatched = 0;  // of each file
 };
 
 // `pixyslam_log compare A.mcap B.mcap --topic T`: decodes the topic's messages
 // of both files in order and compares them field by field (e.g. a recorded
 // MapState against the one a replay through the estimator produced). Reports
 // the count of each, the constant or varying offset of the header stamps, and
-// the first differences. Returns 0 only if both have the same number of
-// messages and every compared field agrees, else 1.
+// the first differences. Returns 0 only if every compared field of every pair
+// agrees and at most max_unmatched messages of each file have no partner (by
+// position: the same number of messages), else 1.
 int run_compare(const CompareRequest& request, std::ostream& out);
 
 struct FoxgloveRequest {
