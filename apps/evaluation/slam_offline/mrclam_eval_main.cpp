@@ -84,6 +84,7 @@ std::optional<offline::RunResult> optimised(const OptimiseRequest& optimise, con
         .result;
   }
 #else
+  (void)options, (void)input, (void)filter;
   if (optimise) throw std::runtime_error("--optimise: this build has no map optimiser (built without Ceres)");
 #endif
   return std::nullopt;

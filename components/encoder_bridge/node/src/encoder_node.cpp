@@ -34,7 +34,8 @@ void EncoderNode::start() {
                   },
                   [this](std::uint64_t now_ns) { on_poll(now_ns); },
                   [this] { return status_lines_locked(); },
-                  [this] { return diagnostic_counters_locked(); }});
+                  [this] { return diagnostic_counters_locked(); },
+                  {}});  // no poll deadline: its periods are checked every poll
 }
 
 std::vector<diagnostics::Counter> EncoderNode::diagnostic_counters_locked() const {

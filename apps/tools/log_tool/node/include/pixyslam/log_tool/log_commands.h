@@ -55,7 +55,7 @@ struct CompareRequest {
   // odometry_sequence,observation_sequence: a MapState is compared with the one
   // that includes the same inputs. Messages without a partner are counted.
   std::vector<std::string> match;
-  std::size_t max_unmatched = 0;  // of each file
+  std::uint64_t max_unmatched = 0;  // of each file (uint64: the CLI binds it on 32-bit hosts too)
 };
 
 // `pixyslam_log compare A.mcap B.mcap --topic T`: decodes the topic's messages
