@@ -882,6 +882,101 @@ TEST(FastSlam2, FramesDeliveredBehindTheOdometryGiveTheSameResultAsInTimeOrder) 
   EXPECT_EQ(in_order.counters().delayed_sampling_starts, delayed.counters().delayed_sampling_starts);
 }
 
+void expect_same_counters(const FilterCounters& a, const FilterCounters& b) {
+  EXPECT_EQ(a.frames, b.frames);
+  EXPECT_EQ(a.observations_used, b.observations_used);
+  EXPECT_EQ(a.observations_new_landmark, b.observations_new_landmark);
+  EXPECT_EQ(a.observations_gated, b.observations_gated);
+  EXPECT_EQ(a.observations_invalid, b.observations_invalid);
+  EXPECT_EQ(a.resamples, b.resamples);
+  EXPECT_EQ(a.delayed_sampling_starts, b.delayed_sampling_starts);
+  EXPECT_EQ(a.joint_breakdowns, b.joint_breakdowns);
+  EXPECT_EQ(a.joint_iterated_updates, b.joint_iterated_updates);
+  EXPECT_EQ(a.joint_heading_splits, b.joint_heading_splits);
+}
+
+// Resampled copies of a particle in delayed sampling share one joint state,
+// moved and updated once for all of them: the particles, estimates and
+// counters are bit-identical to updating every copy on its own, with known ids,
+// with the ids withheld and with heading splits (whose random draws end the
+// sharing for that frame). A particle copied out of the filter keeps its state.
+TEST(FastSlam2, CopiesOfAParticleShareOneJointStateWithTheSameResult) {
+  sim::WorldOptions w;
+  sim::WorldRun run = noisy_world(41, 0.1, 0.15, w);
+  blind_camera(run, 20.0, 50.0);
+  run.frames.erase(std::remove_if(run.frames.begin(), run.frames.end(),
+                                  [](const ObservationFrame& f) { return f.t_s > 90.0; }),
+                   run.frames.end());
+  // A start known only roughly in a map of three known poles: the particles
+  // begin with different headings, and the poles tell them apart.
+  PoseGaussian start;
+  start.mean = run.initial_pose;
+  start.cov = Eigen::Vector3d(0.2, 0.2, 0.1).asDiagonal();
+  std::vector<LandmarkEstimate> prior;
+  for (std::size_t i = 0; i < 3; ++i) {
+    prior.push_back({run.poles[i].id, Eigen::Vector2d(run.poles[i].x_m, run.poles[i].y_m), Eigen::Matrix2d::Identity() * 1e-4, 5});
+  }
+  for (int variant = 0; variant < 3; ++variant) {
+    SCOPED_TRACE(variant == 0 ? "known ids" : variant == 1 ? "ids withheld" : "heading split");
+    FilterOptions o = options_for_world(w, 60, 11);
+    o.delayed_sampling.enabled = true;
+    // Exit as config/slam_mrclam.yaml does: late, so joint states see resampling.
+    o.delayed_sampling.exit_heading_sigma_rad = 0.02;
+    o.delayed_sampling.exit_position_sigma_m = 0.06;
+    if (variant == 1) o.association = Association::kMaximumLikelihood;
+    if (variant == 2) o.delayed_sampling.split_heading = true;
+    FastSlam2 shared(o, start);
+    o.share_identical_particles = false;
+    FastSlam2 alone(o, start);
+    shared.set_prior_map(prior);
+    alone.set_prior_map(prior);
+    std::vector<Particle> copied_out;
+    std::vector<JointGaussian> copied_values;
+    std::size_t joint_particles = 0, joint_states = 0;  // summed over the frames
+    feed(shared, run, [&](std::size_t i) { alone.add_odometry(run.odometry[i]); }, [&]() {
+      alone.add_observations(run.frames[static_cast<std::size_t>(shared.counters().frames - 1)]);
+      expect_same_estimate(shared.pose_estimate(), alone.pose_estimate());
+      std::set<const JointGaussian*> states;
+      std::size_t joint = 0;
+      for (const Particle& p : shared.particles()) {
+        if (!p.joint.active()) continue;
+        ++joint;
+        states.insert(&*p.joint);
+      }
+      joint_particles += joint;
+      joint_states += states.size();
+      if (copied_out.empty() && joint > 0) {
+        copied_out = shared.particles();
+        for (const Particle& p : copied_out) copied_values.push_back(p.joint.active() ? *p.joint : JointGaussian{});
+      }
+    });
+    const std::vector<Particle>& a = shared.particles();
+    const std::vector<Particle>& b = alone.particles();
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_TRUE(a[i].pose.mean == b[i].pose.mean && a[i].pose.cov == b[i].pose.cov) << "particle " << i;
+      EXPECT_EQ(a[i].log_weight, b[i].log_weight) << "particle " << i;
+      ASSERT_EQ(a[i].joint.active(), b[i].joint.active()) << "particle " << i;
+      if (a[i].joint.active()) EXPECT_TRUE(a[i].joint->cov == b[i].joint->cov) << "particle " << i;
+    }
+    expect_same_landmarks(shared.landmarks_mixture(), alone.landmarks_mixture());
+    expect_same_counters(shared.counters(), alone.counters());
+    EXPECT_GT(shared.counters().delayed_sampling_starts, 0u);
+    if (variant == 2) EXPECT_GT(shared.counters().joint_heading_splits, 0u);
+    // Copies did share: fewer states than particles holding one.
+    // (Measured: 7,493 states for 9,237 particles with known ids.)
+    EXPECT_GT(joint_particles, 5000u);
+    EXPECT_LT(joint_states, joint_particles);
+    // The particles copied out were not moved or updated with the filter's.
+    ASSERT_FALSE(copied_out.empty());
+    for (std::size_t i = 0; i < copied_out.size(); ++i) {
+      if (!copied_out[i].joint.active()) continue;
+      EXPECT_TRUE(copied_out[i].joint->mean == copied_values[i].mean) << "particle " << i;
+      EXPECT_TRUE(copied_out[i].joint->cov == copied_values[i].cov) << "particle " << i;
+    }
+  }
+}
+
 // The odometry steps kept for late frames are bounded: after 65,536 of them
 // without a frame they are applied to the particles, and only frames after that
 // can still be applied at their stamps.

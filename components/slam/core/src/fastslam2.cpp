@@ -80,7 +80,7 @@ FastSlam2::FastSlam2(const FilterOptions& options, const PoseGaussian& initial_p
       initial_pose.cov.diagonal().minCoeff() < 0.0) {
     throw std::invalid_argument("FastSlam2: the initial pose and its covariance must be finite, variances >= 0");
   }
-  Particle p{initial_pose, 0.0, LandmarkMap(&pool_), JointGaussian{}};
+  Particle p{initial_pose, 0.0, LandmarkMap(&pool_), SharedJointGaussian{}};
   p.pose.mean.z() = wrap_angle(p.pose.mean.z());
   particles_.assign(static_cast<std::size_t>(options_.particles), p);
   const double heading_var = initial_pose.cov(2, 2);
@@ -112,14 +112,29 @@ void FastSlam2::move_particles() {
   moved_until_s_ = time_s_;
   pending_steps_.clear();
   if (pending_.empty()) return;
+  // A joint state shared by copies of a particle is moved once: in place when
+  // only particles of this filter hold it, else into a copy they all take.
+  const bool share = options_.share_identical_particles;
+  moved_states_.clear();
+  for (const Particle& p : particles_) {
+    if (share && p.joint.active()) ++moved_states_[&*p.joint].holders_here;
+  }
   for (Particle& p : particles_) {
     if (p.joint.active()) {
-      p.joint.apply_motion(pending_);
-      p.pose = p.joint.pose();
+      if (!share) {
+        p.joint.own().apply_motion(pending_);
+      } else if (MovedState& m = moved_states_.at(&*p.joint); m.moved.active()) {
+        p.joint = m.moved;
+      } else {
+        (m.holders_here == p.joint.holders() ? p.joint.shared() : p.joint.own()).apply_motion(pending_);
+        m.moved = p.joint;
+      }
+      p.pose = p.joint->pose();
     } else {
       pending_.apply(p.pose);
     }
   }
+  moved_states_.clear();
   pending_.clear();
   refresh_caches();
 }
@@ -313,13 +328,18 @@ void FastSlam2::update_with_frame(const ObservationFrame& frame) {
   std::vector<bool> any_new(valid.size(), false);
   new_slots_.assign(valid.size(), -1);
   for (Particle& p : particles_) {
-    if (options_.association == Association::kMaximumLikelihood) associate(p);
-    update_particle(p, valid);
+    CopyGroup* leader = nullptr;
+    if (!take_copy_update(p, leader)) {
+      if (options_.association == Association::kMaximumLikelihood) associate(p);
+      update_particle(p, valid);
+      if (leader != nullptr) finish_copy_group(*leader);
+    }
     for (std::size_t k = 0; k < valid.size(); ++k) {
       if (decision_[k] == Decision::kGated) ++gated_votes_[k];
       if (decision_[k] == Decision::kNew) any_new[k] = true;
     }
   }
+  copy_groups_.clear();
   for (std::size_t k = 0; k < valid.size(); ++k) {
     if (2 * gated_votes_[k] > options_.particles) {
       ++counters_.observations_gated;
@@ -414,11 +434,11 @@ void FastSlam2::associate(const Particle& p) {
     // A landmark in the particle's joint state moves with its pose: its fit
     // must use their cross-covariance, or its predicted spread counts the pose
     // uncertainty twice and an old landmark out-scores it.
-    const int joint_index = p.joint.active() ? p.joint.find(slot) : -1;
+    const int joint_index = p.joint.active() ? p.joint->find(slot) : -1;
     for (std::size_t k = 0; k < new_slots_.size(); ++k) {
       double m2 = 0.0, log_likelihood = 0.0;
       if (joint_index >= 0) {
-        const JointFit fit = fit_observation(p.joint, joint_index, z_[k], r_[k]);
+        const JointFit fit = fit_observation(*p.joint, joint_index, z_[k], r_[k]);
         m2 = fit.mahalanobis2;
         log_likelihood = fit.log_likelihood;
       } else {
@@ -454,6 +474,51 @@ void FastSlam2::associate(const Particle& p) {
     if (new_slots_[k] < 0) new_slots_[k] = slot_for(next_unlabelled_id_++);
     slots_[k] = static_cast<std::uint32_t>(new_slots_[k]);
   }
+}
+
+bool FastSlam2::take_copy_update(Particle& p, CopyGroup*& leader) {
+  // Only a state another particle holds too; with maximum-likelihood
+  // association each particle also associates on its own.
+  if (!options_.share_identical_particles || options_.association != Association::kKnownId ||
+      !options_.delayed_sampling.enabled || !p.joint.active() || p.joint.holders() < 2) {
+    return false;
+  }
+  const auto [it, first] = copy_groups_.try_emplace(&*p.joint);
+  CopyGroup& group = it->second;
+  if (first) {
+    group.joint = p.joint;
+    group.map = p.map;
+    group.pose_before = p.pose;
+    group.log_weight_before = p.log_weight;
+    group.leader = &p;
+    group.iterated_updates = counters_.joint_iterated_updates;
+    group.heading_splits = counters_.joint_heading_splits;
+    leader = &group;
+    return false;
+  }
+  const Particle& l = *group.leader;
+  // The leader's state before its update was the one p holds now; the rest of
+  // the particle must have been the same too.
+  if (!group.replicable || !p.map.same_tree_as(group.map) || p.log_weight != group.log_weight_before ||
+      p.pose.mean != group.pose_before.mean || p.pose.cov != group.pose_before.cov) {
+    return false;
+  }
+  p.joint = l.joint;
+  p.map = l.map;
+  p.pose = l.pose;
+  p.log_weight = l.log_weight;
+  decision_ = group.decisions;
+  counters_.joint_iterated_updates += group.iterated_updates;
+  return true;
+}
+
+void FastSlam2::finish_copy_group(CopyGroup& group) {
+  const Particle& l = *group.leader;
+  // Replicable when the update drew no random number: no heading split, and
+  // still joint (finish_joint and a breakdown sample a pose).
+  group.replicable = l.joint.active() && counters_.joint_heading_splits == group.heading_splits;
+  group.iterated_updates = counters_.joint_iterated_updates - group.iterated_updates;
+  group.decisions = decision_;
 }
 
 void FastSlam2::update_particle(Particle& p, const std::vector<RangeBearing>& detections) {
@@ -538,11 +603,8 @@ void FastSlam2::update_particle(Particle& p, const std::vector<RangeBearing>& de
 }
 
 void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearing>& detections) {
-  if (!p.joint.active()) {
-    p.joint.begin(p.pose);
-    ++counters_.delayed_sampling_starts;
-  }
-  JointGaussian& g = p.joint;
+  if (!p.joint.active()) ++counters_.delayed_sampling_starts;
+  JointGaussian& g = p.joint.active() ? p.joint.own() : p.joint.begin(p.pose);
   const PoseGaussian before = g.pose();
   g.begin_frame();
   const std::size_t n = detections.size();
@@ -558,10 +620,10 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
     if (decision_[k] == Decision::kNewDone) log_w += new_log_likelihood_[k];
   }
   bool end_joint = false;
-  if (options_.delayed_sampling.split_heading) log_w += draw_heading_at_return(p);
+  if (options_.delayed_sampling.split_heading) log_w += draw_heading_at_return(p, g);
   for (std::size_t k = 0; k < n; ++k) {
     if (decision_[k] == Decision::kNewDone) continue;
-    const int i = joint_index(p, k);
+    const int i = joint_index(p, g, k);
     const Landmark* lm = p.map.find(slots_[k]);
     if ((g.landmark_mean(i) - g.mean.head<2>()).squaredNorm() < kMinLandmarkDistanceSq) {
       decision_[k] = Decision::kInvalid;
@@ -613,7 +675,7 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
     // has not written to the map yet).
     ++counters_.joint_breakdowns;
     decision_.assign(n, Decision::kInvalid);
-    g.clear();
+    p.joint.clear();
     p.pose.mean = sample_pose(before, rng_);
     p.pose.cov.setZero();
     return;
@@ -656,17 +718,16 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
   }
 }
 
-int FastSlam2::joint_index(Particle& p, std::size_t k) {
-  const int i = p.joint.find(slots_[k]);
+int FastSlam2::joint_index(const Particle& p, JointGaussian& g, std::size_t k) {
+  const int i = g.find(slots_[k]);
   if (i >= 0) return i;
   const Landmark* lm = p.map.find(slots_[k]);
-  return p.joint.add_known(slots_[k], lm->mean, lm->cov);
+  return g.add_known(slots_[k], lm->mean, lm->cov);
 }
 
-double FastSlam2::draw_heading_at_return(Particle& p) {
+double FastSlam2::draw_heading_at_return(Particle& p, JointGaussian& g) {
   // Split only a heading too uncertain to sample from (the joint state's own
   // threshold), into components that narrow.
-  JointGaussian& g = p.joint;
   const double spacing = options_.delayed_sampling.enter_heading_sigma_rad;
   if (!(std::sqrt(g.cov(2, 2)) > spacing)) return 0.0;
   // The frame's detections of landmarks mapped outside this state (absolute
@@ -674,7 +735,7 @@ double FastSlam2::draw_heading_at_return(Particle& p) {
   known_.clear();
   for (std::size_t k = 0; k < decision_.size(); ++k) {
     if (decision_[k] == Decision::kNewDone) continue;
-    if (g.relative[static_cast<std::size_t>(joint_index(p, k))] == 0) known_.push_back(k);
+    if (g.relative[static_cast<std::size_t>(joint_index(p, g, k))] == 0) known_.push_back(k);
   }
   if (known_.empty()) return 0.0;
   std::vector<HeadingComponent> components = split_heading(g, spacing);
@@ -718,8 +779,8 @@ double FastSlam2::draw_heading_at_return(Particle& p) {
 }
 
 void FastSlam2::finish_joint(Particle& p) {
-  const Pose2 x = sample_pose(p.joint.pose(), rng_);
-  for (const ConditionedLandmark& c : condition_on_pose(p.joint, x)) {
+  const Pose2 x = sample_pose(p.joint->pose(), rng_);
+  for (const ConditionedLandmark& c : condition_on_pose(*p.joint, x)) {
     Landmark& lm = p.map.modify(c.slot);
     lm.mean = c.mean;
     lm.cov = c.cov;

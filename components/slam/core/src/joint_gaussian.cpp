@@ -77,6 +77,17 @@ void JointGaussian::clear() {
   relative.clear();
 }
 
+JointGaussian& SharedJointGaussian::begin(const PoseGaussian& pose) {
+  state_ = std::make_shared<JointGaussian>();
+  state_->begin(pose);
+  return *state_;
+}
+
+JointGaussian& SharedJointGaussian::own() {
+  if (state_.use_count() > 1) state_ = std::make_shared<JointGaussian>(*state_);
+  return *state_;
+}
+
 void JointGaussian::end_frame() {
   // After a large jump (a loop closure) the motion Jacobian keeps the updated
   // pose: inflating by a metre-sized correction would wreck the covariance.

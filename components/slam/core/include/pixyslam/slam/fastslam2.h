@@ -24,7 +24,7 @@ struct Particle {
   PoseGaussian pose;
   double log_weight = 0.0;
   LandmarkMap map;
-  JointGaussian joint;
+  SharedJointGaussian joint;
 };
 
 struct LandmarkEstimate {
@@ -160,16 +160,35 @@ class FastSlam2 {
   void update_particle(Particle& p, const std::vector<RangeBearing>& detections);
   void update_particle_joint(Particle& p, const std::vector<RangeBearing>& detections);
   void finish_joint(Particle& p);
+  // Copies of one particle in delayed sampling (same joint state, map, pose
+  // and weight) stay identical through a frame whose update draws no random
+  // number: the first copy is updated, the others take its result
+  // (FilterOptions::share_identical_particles). True when p took it; otherwise
+  // p is to be updated, and if it leads a group of copies, `leader` is set.
+  struct CopyGroup {
+    // The leader before its update (the joint state keeps the key alive).
+    SharedJointGaussian joint;
+    LandmarkMap map;
+    PoseGaussian pose_before;
+    double log_weight_before = 0.0;
+    Particle* leader = nullptr;
+    bool replicable = false;
+    std::vector<Decision> decisions;
+    std::uint64_t iterated_updates = 0;
+    std::uint64_t heading_splits = 0;
+  };
+  bool take_copy_update(Particle& p, CopyGroup*& leader);
+  void finish_copy_group(CopyGroup& group);
   // DelayedSamplingOptions::split_heading: at a frame that sees landmarks mapped
   // outside the joint state, the state is split along its heading
   // (split_heading()) and one component drawn by prior weight times the
   // likelihood of those detections. Returns the log weight to add beyond what
   // the frame's updates of the drawn component add (log of the mixture's
   // likelihood minus the component's).
-  double draw_heading_at_return(Particle& p);
-  // Detection k's block in the particle's joint state; a mapped landmark not
+  double draw_heading_at_return(Particle& p, JointGaussian& g);
+  // Detection k's block in the particle's joint state g; a mapped landmark not
   // in it yet joins as known (independent of the rest).
-  int joint_index(Particle& p, std::size_t k);
+  int joint_index(const Particle& p, JointGaussian& g, std::size_t k);
   // An outlier costs the likelihood at the gate boundary, so particles that
   // reject it are not favoured over those that explain it.
   double outlier_log_likelihood(double log_likelihood, double mahalanobis2) const {
@@ -266,6 +285,12 @@ class FastSlam2 {
   std::vector<std::size_t> known_;  // detections of landmarks mapped outside the joint state
   std::vector<Landmark*> landmarks_;
   std::vector<int> gated_votes_;
+  std::unordered_map<const JointGaussian*, CopyGroup> copy_groups_;  // this frame's, by state before
+  struct MovedState {
+    long holders_here = 0;       // particles of this filter holding the state
+    SharedJointGaussian moved;   // the state after the motion
+  };
+  std::unordered_map<const JointGaussian*, MovedState> moved_states_;  // move_particles, by state before
   FilterCounters counters_;
 };
 

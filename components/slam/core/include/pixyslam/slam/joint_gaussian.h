@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -65,6 +66,30 @@ struct JointGaussian {
   // pose, with its correlation to the pose: P_ll = Gx Pxx Gx^T + Gz R Gz^T,
   // P_l* = Gx P_x*. Add new landmarks before the frame's updates.
   int add_new(std::uint32_t slot, const Eigen::Vector2d& z, const Eigen::Matrix2d& r);
+};
+
+// A particle's joint state, shared by the copies resampling makes of the
+// particle (copy on write). Copies in delayed sampling stay identical, their
+// updates draw no random numbers, so FastSlam2 moves and updates a shared state
+// once for all its holders; own() gives a holder that changes alone its copy.
+class SharedJointGaussian {
+ public:
+  bool active() const { return state_ != nullptr && state_->active(); }
+  // The state; active() must be true.
+  const JointGaussian& operator*() const { return *state_; }
+  const JointGaussian* operator->() const { return state_.get(); }
+  // A new state for this holder alone.
+  JointGaussian& begin(const PoseGaussian& pose);
+  // This holder's state, copied first if another holds it too.
+  JointGaussian& own();
+  // The state as every holder sees it: a change here changes it for all.
+  JointGaussian& shared() { return *state_; }
+  // How many hold the state, this one included.
+  long holders() const { return state_.use_count(); }
+  void clear() { state_.reset(); }
+
+ private:
+  std::shared_ptr<JointGaussian> state_;
 };
 
 // How an observation of state landmark i fits the joint Gaussian: innovation

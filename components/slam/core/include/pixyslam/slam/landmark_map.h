@@ -51,6 +51,8 @@ class LandmarkMap {
   void for_each(const std::function<void(std::uint32_t slot, const Landmark&)>& visit) const;
   // True if both maps reach the very same node for `slot` (no copy was made).
   bool shares_node_with(const LandmarkMap& other, std::uint32_t slot) const;
+  // True if both maps are the very same tree (one is an unchanged copy of the other).
+  bool same_tree_as(const LandmarkMap& other) const { return root_ == other.root_ && pool_ == other.pool_; }
 
   struct Node;  // opaque tree node
 

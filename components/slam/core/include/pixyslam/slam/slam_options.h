@@ -129,6 +129,10 @@ struct FilterOptions {
   // frame that saw two or more imply by that uncertainty alone
   // ((sum H_x^T (H_m W_j H_m^T)^-1 H_x)^-1, W_j the spread at mapping).
   bool landmark_uncertainty = false;
+  // Not a YAML key: results are bit-identical either way. Resampled copies of
+  // a particle in delayed sampling share one joint state, moved and updated
+  // once for all; off measures what that saves (bench_mrclam_frame).
+  bool share_identical_particles = true;
 };
 
 // Every parameter of FilterOptions, once: YAML key below `filter:`, range,
