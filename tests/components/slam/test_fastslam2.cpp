@@ -957,12 +957,16 @@ TEST(FastSlam2, CopiesOfAParticleShareOneJointStateWithTheSameResult) {
       EXPECT_TRUE(a[i].pose.mean == b[i].pose.mean && a[i].pose.cov == b[i].pose.cov) << "particle " << i;
       EXPECT_EQ(a[i].log_weight, b[i].log_weight) << "particle " << i;
       ASSERT_EQ(a[i].joint.active(), b[i].joint.active()) << "particle " << i;
-      if (a[i].joint.active()) EXPECT_TRUE(a[i].joint->cov == b[i].joint->cov) << "particle " << i;
+      if (a[i].joint.active()) {
+        EXPECT_TRUE(a[i].joint->cov == b[i].joint->cov) << "particle " << i;
+      }
     }
     expect_same_landmarks(shared.landmarks_mixture(), alone.landmarks_mixture());
     expect_same_counters(shared.counters(), alone.counters());
     EXPECT_GT(shared.counters().delayed_sampling_starts, 0u);
-    if (variant == 2) EXPECT_GT(shared.counters().joint_heading_splits, 0u);
+    if (variant == 2) {
+      EXPECT_GT(shared.counters().joint_heading_splits, 0u);
+    }
     // Copies did share: fewer states than particles holding one.
     // (Measured: 7,493 states for 9,237 particles with known ids.)
     EXPECT_GT(joint_particles, 5000u);

@@ -112,29 +112,30 @@ void FastSlam2::move_particles() {
   moved_until_s_ = time_s_;
   pending_steps_.clear();
   if (pending_.empty()) return;
-  // A joint state shared by copies of a particle is moved once: in place when
-  // only particles of this filter hold it, else into a copy they all take.
+  // Copies of a particle sit side by side (resampling keeps the order) and may
+  // share their joint state: it is moved once, in place when they are its only
+  // holders, else into a copy that they take.
   const bool share = options_.share_identical_particles;
-  moved_states_.clear();
-  for (const Particle& p : particles_) {
-    if (share && p.joint.active()) ++moved_states_[&*p.joint].holders_here;
-  }
-  for (Particle& p : particles_) {
-    if (p.joint.active()) {
-      if (!share) {
-        p.joint.own().apply_motion(pending_);
-      } else if (MovedState& m = moved_states_.at(&*p.joint); m.moved.active()) {
-        p.joint = m.moved;
-      } else {
-        (m.holders_here == p.joint.holders() ? p.joint.shared() : p.joint.own()).apply_motion(pending_);
-        m.moved = p.joint;
-      }
-      p.pose = p.joint->pose();
-    } else {
+  for (std::size_t i = 0; i < particles_.size();) {
+    Particle& p = particles_[i];
+    if (!p.joint.active()) {
       pending_.apply(p.pose);
+      ++i;
+      continue;
     }
+    std::size_t end = i + 1;
+    while (share && end < particles_.size() && particles_[end].joint.same_state(p.joint)) ++end;
+    if (share && static_cast<long>(end - i) == p.joint.holders()) {
+      p.joint.shared().apply_motion(pending_);
+    } else {
+      p.joint.own().apply_motion(pending_);
+    }
+    for (std::size_t k = i; k < end; ++k) {
+      particles_[k].joint = p.joint;
+      particles_[k].pose = p.joint->pose();
+    }
+    i = end;
   }
-  moved_states_.clear();
   pending_.clear();
   refresh_caches();
 }
@@ -325,25 +326,24 @@ void FastSlam2::update_with_frame(const ObservationFrame& frame) {
 
   // Which detections are new is the same for every particle only with known
   // association; decide per particle anyway.
-  std::vector<bool> any_new(valid.size(), false);
+  any_new_.assign(valid.size(), 0);
   new_slots_.assign(valid.size(), -1);
-  for (Particle& p : particles_) {
-    CopyGroup* leader = nullptr;
-    if (!take_copy_update(p, leader)) {
-      if (options_.association == Association::kMaximumLikelihood) associate(p);
-      update_particle(p, valid);
-      if (leader != nullptr) finish_copy_group(*leader);
+  for (std::size_t i = 0; i < particles_.size();) {
+    const std::size_t end = copies_end(i);
+    if (end - i > 1) {
+      update_copies(i, end, valid.size());
+      i = end;
+      continue;
     }
-    for (std::size_t k = 0; k < valid.size(); ++k) {
-      if (decision_[k] == Decision::kGated) ++gated_votes_[k];
-      if (decision_[k] == Decision::kNew) any_new[k] = true;
-    }
+    Particle& p = particles_[i++];
+    if (options_.association == Association::kMaximumLikelihood) associate(p);
+    update_particle(p, valid);
+    count_votes();
   }
-  copy_groups_.clear();
   for (std::size_t k = 0; k < valid.size(); ++k) {
     if (2 * gated_votes_[k] > options_.particles) {
       ++counters_.observations_gated;
-    } else if (any_new[k]) {
+    } else if (any_new_[k] != 0) {
       ++counters_.observations_new_landmark;
     } else {
       ++counters_.observations_used;
@@ -476,49 +476,57 @@ void FastSlam2::associate(const Particle& p) {
   }
 }
 
-bool FastSlam2::take_copy_update(Particle& p, CopyGroup*& leader) {
-  // Only a state another particle holds too; with maximum-likelihood
-  // association each particle also associates on its own.
-  if (!options_.share_identical_particles || options_.association != Association::kKnownId ||
-      !options_.delayed_sampling.enabled || !p.joint.active() || p.joint.holders() < 2) {
-    return false;
+void FastSlam2::count_votes() {
+  for (std::size_t k = 0; k < decision_.size(); ++k) {
+    if (decision_[k] == Decision::kGated) ++gated_votes_[k];
+    if (decision_[k] == Decision::kNew) any_new_[k] = 1;
   }
-  const auto [it, first] = copy_groups_.try_emplace(&*p.joint);
-  CopyGroup& group = it->second;
-  if (first) {
-    group.joint = p.joint;
-    group.map = p.map;
-    group.pose_before = p.pose;
-    group.log_weight_before = p.log_weight;
-    group.leader = &p;
-    group.iterated_updates = counters_.joint_iterated_updates;
-    group.heading_splits = counters_.joint_heading_splits;
-    leader = &group;
-    return false;
-  }
-  const Particle& l = *group.leader;
-  // The leader's state before its update was the one p holds now; the rest of
-  // the particle must have been the same too.
-  if (!group.replicable || !p.map.same_tree_as(group.map) || p.log_weight != group.log_weight_before ||
-      p.pose.mean != group.pose_before.mean || p.pose.cov != group.pose_before.cov) {
-    return false;
-  }
-  p.joint = l.joint;
-  p.map = l.map;
-  p.pose = l.pose;
-  p.log_weight = l.log_weight;
-  decision_ = group.decisions;
-  counters_.joint_iterated_updates += group.iterated_updates;
-  return true;
 }
 
-void FastSlam2::finish_copy_group(CopyGroup& group) {
-  const Particle& l = *group.leader;
-  // Replicable when the update drew no random number: no heading split, and
-  // still joint (finish_joint and a breakdown sample a pose).
-  group.replicable = l.joint.active() && counters_.joint_heading_splits == group.heading_splits;
-  group.iterated_updates = counters_.joint_iterated_updates - group.iterated_updates;
-  group.decisions = decision_;
+std::size_t FastSlam2::copies_end(std::size_t first) const {
+  const Particle& p = particles_[first];
+  if (!options_.share_identical_particles || !options_.delayed_sampling.enabled || !p.joint.active()) {
+    return first + 1;
+  }
+  // A heading split draws a random number in the middle of the update.
+  const double spacing = options_.delayed_sampling.enter_heading_sigma_rad;
+  if (options_.delayed_sampling.split_heading && std::sqrt(p.joint->cov(2, 2)) > spacing) return first + 1;
+  std::size_t end = first + 1;
+  for (; end < particles_.size(); ++end) {
+    const Particle& q = particles_[end];
+    if (!q.joint.same_state(p.joint) || !q.map.same_tree_as(p.map) || q.log_weight != p.log_weight ||
+        q.pose.mean != p.pose.mean || q.pose.cov != p.pose.cov) {
+      break;
+    }
+  }
+  // Updated in place only when no one else holds the state.
+  return static_cast<long>(end - first) == p.joint.holders() ? end : first + 1;
+}
+
+void FastSlam2::update_copies(std::size_t first, std::size_t end, std::size_t detections) {
+  Particle& leader = particles_[first];
+  if (options_.association == Association::kMaximumLikelihood) associate(leader);  // the same for every copy
+  JointGaussian& g = leader.joint.shared();
+  const PoseGaussian before = g.pose();
+  const std::uint64_t iterated = counters_.joint_iterated_updates;
+  const std::uint64_t breakdowns = counters_.joint_breakdowns;
+  const JointOutcome outcome = update_joint_state(leader, g, detections);
+  const Particle updated = leader;
+  copy_decisions_ = decision_;
+  const std::uint64_t more_iterated = counters_.joint_iterated_updates - iterated;
+  const std::uint64_t more_breakdowns = counters_.joint_breakdowns - breakdowns;
+  // The random part (a pose sampled when the state ends) stays each copy's own.
+  end_joint_update(leader, outcome, before);
+  count_votes();
+  for (std::size_t k = first + 1; k < end; ++k) {
+    Particle& p = particles_[k];
+    p = updated;
+    decision_ = copy_decisions_;
+    counters_.joint_iterated_updates += more_iterated;
+    counters_.joint_breakdowns += more_breakdowns;
+    end_joint_update(p, outcome, before);
+    count_votes();
+  }
 }
 
 void FastSlam2::update_particle(Particle& p, const std::vector<RangeBearing>& detections) {
@@ -606,8 +614,11 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
   if (!p.joint.active()) ++counters_.delayed_sampling_starts;
   JointGaussian& g = p.joint.active() ? p.joint.own() : p.joint.begin(p.pose);
   const PoseGaussian before = g.pose();
+  end_joint_update(p, update_joint_state(p, g, detections.size()), before);
+}
+
+FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian& g, std::size_t n) {
   g.begin_frame();
-  const std::size_t n = detections.size();
   decision_.assign(n, Decision::kNew);
   // First sightings join the state first, at the frame pose; they carry no weight.
   for (std::size_t k = 0; k < n; ++k) {
@@ -675,10 +686,7 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
     // has not written to the map yet).
     ++counters_.joint_breakdowns;
     decision_.assign(n, Decision::kInvalid);
-    p.joint.clear();
-    p.pose.mean = sample_pose(before, rng_);
-    p.pose.cov.setZero();
-    return;
+    return JointOutcome::kBrokeDown;
   }
   for (std::size_t k = 0; k < n; ++k) {
     switch (decision_[k]) {
@@ -708,13 +716,30 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
   const DelayedSamplingOptions& delayed = options_.delayed_sampling;
   if (end_joint || !exceeds(p.pose.cov, delayed.exit_heading_sigma_rad, delayed.exit_position_sigma_m) ||
       g.landmark_count() >= delayed.max_landmarks) {
-    finish_joint(p);
-    return;
+    return JointOutcome::kEnds;
   }
   for (int i = 0; i < g.landmark_count(); ++i) {
     Landmark& lm = p.map.modify(g.slots[static_cast<std::size_t>(i)]);
     lm.mean = g.landmark_mean(i);
     lm.cov = g.landmark_cov(i);
+  }
+  return JointOutcome::kStays;
+}
+
+void FastSlam2::end_joint_update(Particle& p, JointOutcome outcome, const PoseGaussian& before) {
+  switch (outcome) {
+    case JointOutcome::kStays:
+      break;
+    case JointOutcome::kEnds:
+      finish_joint(p);
+      break;
+    case JointOutcome::kBrokeDown:
+      // The frame is dropped for this particle, which goes on in plain FastSLAM
+      // 2.0 from its pose before the frame and the map's marginals.
+      p.joint.clear();
+      p.pose.mean = sample_pose(before, rng_);
+      p.pose.cov.setZero();
+      break;
   }
 }
 

@@ -160,25 +160,22 @@ class FastSlam2 {
   void update_particle(Particle& p, const std::vector<RangeBearing>& detections);
   void update_particle_joint(Particle& p, const std::vector<RangeBearing>& detections);
   void finish_joint(Particle& p);
-  // Copies of one particle in delayed sampling (same joint state, map, pose
-  // and weight) stay identical through a frame whose update draws no random
-  // number: the first copy is updated, the others take its result
-  // (FilterOptions::share_identical_particles). True when p took it; otherwise
-  // p is to be updated, and if it leads a group of copies, `leader` is set.
-  struct CopyGroup {
-    // The leader before its update (the joint state keeps the key alive).
-    SharedJointGaussian joint;
-    LandmarkMap map;
-    PoseGaussian pose_before;
-    double log_weight_before = 0.0;
-    Particle* leader = nullptr;
-    bool replicable = false;
-    std::vector<Decision> decisions;
-    std::uint64_t iterated_updates = 0;
-    std::uint64_t heading_splits = 0;
-  };
-  bool take_copy_update(Particle& p, CopyGroup*& leader);
-  void finish_copy_group(CopyGroup& group);
+  // The deterministic part of a joint-state update, on g: p's own state, or
+  // the state p's copies share. end_joint_update() then does the random part
+  // (the pose sampled when the state ends or broke down) for each particle.
+  enum class JointOutcome : std::uint8_t { kStays, kEnds, kBrokeDown };
+  JointOutcome update_joint_state(Particle& p, JointGaussian& g, std::size_t detections);
+  void end_joint_update(Particle& p, JointOutcome outcome, const PoseGaussian& before);
+  // Copies of one particle in delayed sampling (resampling puts them side by
+  // side: the same joint state, map, pose and weight) stay identical through a
+  // frame's deterministic update: it is made once, on their shared state, and
+  // the others take the result (FilterOptions::share_identical_particles).
+  // copies_end(i) is the end of particle i's run of such copies (i + 1 when it
+  // has none, or its update may draw a random number in the middle).
+  std::size_t copies_end(std::size_t first) const;
+  void update_copies(std::size_t first, std::size_t end, std::size_t detections);
+  // Adds decision_ to gated_votes_ and any_new_.
+  void count_votes();
   // DelayedSamplingOptions::split_heading: at a frame that sees landmarks mapped
   // outside the joint state, the state is split along its heading
   // (split_heading()) and one component drawn by prior weight times the
@@ -285,12 +282,8 @@ class FastSlam2 {
   std::vector<std::size_t> known_;  // detections of landmarks mapped outside the joint state
   std::vector<Landmark*> landmarks_;
   std::vector<int> gated_votes_;
-  std::unordered_map<const JointGaussian*, CopyGroup> copy_groups_;  // this frame's, by state before
-  struct MovedState {
-    long holders_here = 0;       // particles of this filter holding the state
-    SharedJointGaussian moved;   // the state after the motion
-  };
-  std::unordered_map<const JointGaussian*, MovedState> moved_states_;  // move_particles, by state before
+  std::vector<char> any_new_;            // per detection: some particle started a landmark with it
+  std::vector<Decision> copy_decisions_;  // update_copies: the decisions of the first copy
   FilterCounters counters_;
 };
 

@@ -86,6 +86,7 @@ class SharedJointGaussian {
   JointGaussian& shared() { return *state_; }
   // How many hold the state, this one included.
   long holders() const { return state_.use_count(); }
+  bool same_state(const SharedJointGaussian& other) const { return state_ == other.state_; }
   void clear() { state_.reset(); }
 
  private:
