@@ -58,6 +58,18 @@ constexpr std::size_t kMaxAnchors = 16;
 constexpr std::size_t kMaxPendingSteps = 65536;
 
 // Whether a pose covariance exceeds a heading sd or a position sd (worst direction).
+// Particle p's landmark in `slot` (`in_map` its map's entry): one in the
+// particle's joint state has its marginal there, the map catches up when the
+// state ends.
+Landmark landmark_now(const Particle& p, std::uint32_t slot, const Landmark& in_map) {
+  const int i = p.joint.active() ? p.joint->find(slot) : -1;
+  if (i < 0) return in_map;
+  Landmark lm = in_map;
+  lm.mean = p.joint->landmark_mean(i);
+  lm.cov = p.joint->landmark_cov(i);
+  return lm;
+}
+
 bool exceeds(const Eigen::Matrix3d& cov, double heading_sigma, double position_sigma) {
   if (cov(2, 2) > heading_sigma * heading_sigma) return true;
   const double half_trace = 0.5 * (cov(0, 0) + cov(1, 1));
@@ -384,11 +396,12 @@ void FastSlam2::capture_mapped_spread(const std::vector<RangeBearing>& valid, co
     Eigen::Vector2d m = Eigen::Vector2d::Zero();
     Eigen::Matrix2d second = Eigen::Matrix2d::Zero();
     for (std::size_t i = 0; i < particles_.size(); ++i) {
-      const Landmark* lm = particles_[i].map.find(slot);
-      if (lm == nullptr) continue;
+      const Landmark* in_map = particles_[i].map.find(slot);
+      if (in_map == nullptr) continue;
+      const Eigen::Vector2d mean = landmark_now(particles_[i], slot, *in_map).mean;
       total += w[i];
-      m += w[i] * lm->mean;
-      second += w[i] * lm->mean * lm->mean.transpose();  // the means' spread: the pose's part, not the sensor's
+      m += w[i] * mean;
+      second += w[i] * mean * mean.transpose();  // the means' spread: the pose's part, not the sensor's
     }
     // Mapped once most particles hold it (the rest still carry it in their joint state).
     if (total < 0.5) continue;
@@ -405,9 +418,10 @@ void FastSlam2::update_landmark_floor(const std::vector<RangeBearing>& valid) {
   for (std::size_t k = 0; k < valid.size(); ++k) {
     const Eigen::Matrix2d& spread = mapped_spread_[slots_[k]];
     if (std::isnan(spread(0, 0))) continue;
-    const Landmark* lm = particles_[best_index()].map.find(slots_[k]);
-    if (lm == nullptr) continue;
-    const PredictedObservation p = predict_observation(pose, lm->mean);
+    const Particle& best = particles_[best_index()];
+    const Landmark* in_map = best.map.find(slots_[k]);
+    if (in_map == nullptr) continue;
+    const PredictedObservation p = predict_observation(pose, landmark_now(best, slots_[k], *in_map).mean);
     const Eigen::Matrix2d a = p.h_landmark * spread * p.h_landmark.transpose() + 1e-12 * Eigen::Matrix2d::Identity();
     information += p.h_pose.transpose() * a.inverse() * p.h_pose;
     ++landmarks;
@@ -429,7 +443,8 @@ void FastSlam2::associate(const Particle& p) {
     std::uint32_t slot;
   };
   std::vector<Candidate> candidates;
-  p.map.for_each([&](std::uint32_t slot, const Landmark& lm) {
+  p.map.for_each([&](std::uint32_t slot, const Landmark& in_map) {
+    const Landmark lm = landmark_now(p, slot, in_map);
     if ((lm.mean - p.pose.mean.head<2>()).squaredNorm() < kMinLandmarkDistanceSq) return;
     // A landmark in the particle's joint state moves with its pose: its fit
     // must use their cross-covariance, or its predicted spread counts the pose
@@ -618,6 +633,11 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
 }
 
 FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian& g, std::size_t n) {
+  // The map holds the state's landmarks only from its end on: kept for a breakdown.
+  marginals_before_.clear();
+  for (int i = 0; i < g.landmark_count(); ++i) {
+    marginals_before_.push_back({g.slots[static_cast<std::size_t>(i)], g.landmark_mean(i), g.landmark_cov(i)});
+  }
   g.begin_frame();
   decision_.assign(n, Decision::kNew);
   // First sightings join the state first, at the frame pose; they carry no weight.
@@ -718,11 +738,6 @@ FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian
       g.landmark_count() >= delayed.max_landmarks) {
     return JointOutcome::kEnds;
   }
-  for (int i = 0; i < g.landmark_count(); ++i) {
-    Landmark& lm = p.map.modify(g.slots[static_cast<std::size_t>(i)]);
-    lm.mean = g.landmark_mean(i);
-    lm.cov = g.landmark_cov(i);
-  }
   return JointOutcome::kStays;
 }
 
@@ -735,7 +750,12 @@ void FastSlam2::end_joint_update(Particle& p, JointOutcome outcome, const PoseGa
       break;
     case JointOutcome::kBrokeDown:
       // The frame is dropped for this particle, which goes on in plain FastSLAM
-      // 2.0 from its pose before the frame and the map's marginals.
+      // 2.0 from its pose and the state's marginals before the frame.
+      for (const ConditionedLandmark& c : marginals_before_) {
+        Landmark& lm = p.map.modify(c.slot);
+        lm.mean = c.mean;
+        lm.cov = c.cov;
+      }
       p.joint.clear();
       p.pose.mean = sample_pose(before, rng_);
       p.pose.cov.setZero();
@@ -971,7 +991,7 @@ void FastSlam2::mean_positions(const std::vector<std::uint32_t>& slots, std::vec
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     for (std::size_t k = 0; k < slots.size(); ++k) {
       if (const Landmark* lm = particles_[i].map.find(slots[k])) {
-        means[k] += w[i] * lm->mean;
+        means[k] += w[i] * landmark_now(particles_[i], slots[k], *lm).mean;
         total[k] += w[i];
       }
     }
@@ -1069,7 +1089,9 @@ void FastSlam2::update_output_frame() {
 
 std::vector<LandmarkEstimate> FastSlam2::landmarks_of_best() const {
   std::vector<LandmarkEstimate> out;
-  particles_[best_index()].map.for_each([&](std::uint32_t, const Landmark& lm) {
+  const Particle& best = particles_[best_index()];
+  best.map.for_each([&](std::uint32_t slot, const Landmark& in_map) {
+    const Landmark lm = landmark_now(best, slot, in_map);
     out.push_back(to_output(LandmarkEstimate{lm.id, lm.mean, lm.cov, lm.times_observed}));
   });
   return out;
@@ -1085,7 +1107,8 @@ std::vector<LandmarkEstimate> FastSlam2::landmarks_mixture() const {
   };
   std::vector<Sum> sums(id_of_slot_.size());
   for (std::size_t i = 0; i < particles_.size(); ++i) {
-    particles_[i].map.for_each([&](std::uint32_t slot, const Landmark& lm) {
+    particles_[i].map.for_each([&](std::uint32_t slot, const Landmark& in_map) {
+      const Landmark lm = landmark_now(particles_[i], slot, in_map);
       Sum& s = sums[slot];
       s.weight += w[i];
       s.m += w[i] * lm.mean;

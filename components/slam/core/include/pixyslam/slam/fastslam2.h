@@ -19,7 +19,9 @@ namespace pixyslam::slam {
 // One hypothesis: the pose Gaussian accumulated since its last sampled pose
 // (zero covariance right after sampling), a log importance weight, and its map.
 // While sampling is delayed, joint holds the pose and the landmarks seen since;
-// pose is then its pose marginal and the map mirrors the landmark marginals.
+// pose is then its pose marginal, and a landmark in joint has its current mean
+// and covariance there (the map's entry keeps its id and counts, and takes the
+// values when the joint state ends).
 struct Particle {
   PoseGaussian pose;
   double log_weight = 0.0;
@@ -284,6 +286,7 @@ class FastSlam2 {
   std::vector<int> gated_votes_;
   std::vector<char> any_new_;            // per detection: some particle started a landmark with it
   std::vector<Decision> copy_decisions_;  // update_copies: the decisions of the first copy
+  std::vector<ConditionedLandmark> marginals_before_;  // update_joint_state: the landmarks before the frame
   FilterCounters counters_;
 };
 
