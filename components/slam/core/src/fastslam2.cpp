@@ -120,36 +120,49 @@ FastSlam2::FastSlam2(const FilterOptions& options, const PoseGaussian& initial_p
   refresh_caches();
 }
 
-void FastSlam2::move_particles() {
+void FastSlam2::move_particles(bool joint_states_later) {
   moved_until_s_ = time_s_;
   pending_steps_.clear();
   if (pending_.empty()) return;
+  if (joint_states_later) {
+    for (Particle& p : particles_) {
+      if (!p.joint.active()) pending_.apply(p.pose);
+    }
+    joint_motion_ = pending_;
+    pending_.clear();
+    return;
+  }
+  for (std::size_t i = 0; i < particles_.size();) {
+    if (particles_[i].joint.active()) {
+      i = move_joint_run(i, pending_);
+    } else {
+      pending_.apply(particles_[i++].pose);
+    }
+  }
+  pending_.clear();
+  refresh_caches();
+}
+
+std::size_t FastSlam2::move_joint_run(std::size_t first, const ComposedMotion& motion) {
+  Particle& p = particles_[first];
+  if (!p.joint.active()) return first + 1;
   // Copies of a particle sit side by side (resampling keeps the order) and may
   // share their joint state: it is moved once, in place when they are its only
   // holders, else into a copy that they take.
   const bool share = options_.share_identical_particles;
-  for (std::size_t i = 0; i < particles_.size();) {
-    Particle& p = particles_[i];
-    if (!p.joint.active()) {
-      pending_.apply(p.pose);
-      ++i;
-      continue;
-    }
-    std::size_t end = i + 1;
-    while (share && end < particles_.size() && particles_[end].joint.same_state(p.joint)) ++end;
-    if (share && static_cast<long>(end - i) == p.joint.holders()) {
-      p.joint.shared().apply_motion(pending_);
-    } else {
-      p.joint.own().apply_motion(pending_);
-    }
-    for (std::size_t k = i; k < end; ++k) {
-      particles_[k].joint = p.joint;
-      particles_[k].pose = p.joint->pose();
-    }
-    i = end;
+  std::size_t end = first + 1;
+  while (share && end < particles_.size() && particles_[end].joint.same_state(p.joint)) ++end;
+  if (motion.empty()) return end;
+  if (share && static_cast<long>(end - first) == p.joint.holders()) {
+    p.joint.shared().apply_motion(motion);
+  } else {
+    p.joint.own().apply_motion(motion);
   }
-  pending_.clear();
-  refresh_caches();
+  for (std::size_t k = first; k < end; ++k) {
+    particles_[k].joint = p.joint;
+    particles_[k].pose = p.joint->pose();
+  }
+  return end;
 }
 
 void FastSlam2::refresh_caches() {
@@ -291,7 +304,7 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
   if (!late || frame.t_s < moved_until_s_) {
     if (late) ++counters_.frames_out_of_order;
     advance_to(frame.t_s);
-    move_particles();
+    move_particles(true);
     update_with_frame(frame);
     return;
   }
@@ -299,7 +312,7 @@ void FastSlam2::add_observations(const ObservationFrame& frame) {
   // update, then the rest of the motion again.
   ++counters_.frames_late;
   const std::vector<MotionStep> later = split_pending_at(frame.t_s);
-  move_particles();
+  move_particles(true);
   moved_until_s_ = frame.t_s;
   update_with_frame(frame);
   for (const MotionStep& step : later) add_pending(step);
@@ -334,24 +347,35 @@ void FastSlam2::update_with_frame(const ObservationFrame& frame) {
     if (options_.error_correlation_s > 0.0) r_[k] *= correlated_error_factor(slots_[k], frame.t_s);
     new_log_likelihood_[k] = 0.0;  // associate() sets it per particle
   }
-  if (valid.empty()) return;
+  if (valid.empty()) {
+    if (joint_motion_.empty()) return;
+    for (std::size_t i = 0; i < particles_.size();) i = move_joint_run(i, joint_motion_);
+    joint_motion_.clear();
+    refresh_caches();
+    return;
+  }
 
   // Which detections are new is the same for every particle only with known
   // association; decide per particle anyway.
   any_new_.assign(valid.size(), 0);
   new_slots_.assign(valid.size(), -1);
   for (std::size_t i = 0; i < particles_.size();) {
-    const std::size_t end = copies_end(i);
-    if (end - i > 1) {
-      update_copies(i, end, valid.size());
-      i = end;
-      continue;
+    // A joint state is moved just before its update: one pass over its memory.
+    const std::size_t moved_end = move_joint_run(i, joint_motion_);
+    while (i < moved_end) {
+      const std::size_t end = copies_end(i);
+      if (end - i > 1) {
+        update_copies(i, end, valid.size());
+        i = end;
+        continue;
+      }
+      Particle& p = particles_[i++];
+      if (options_.association == Association::kMaximumLikelihood) associate(p);
+      update_particle(p, valid);
+      count_votes();
     }
-    Particle& p = particles_[i++];
-    if (options_.association == Association::kMaximumLikelihood) associate(p);
-    update_particle(p, valid);
-    count_votes();
   }
+  joint_motion_.clear();
   for (std::size_t k = 0; k < valid.size(); ++k) {
     if (2 * gated_votes_[k] > options_.particles) {
       ++counters_.observations_gated;
@@ -655,7 +679,6 @@ FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian
   for (std::size_t k = 0; k < n; ++k) {
     if (decision_[k] == Decision::kNewDone) continue;
     const int i = joint_index(p, g, k);
-    const Landmark* lm = p.map.find(slots_[k]);
     if ((g.landmark_mean(i) - g.mean.head<2>()).squaredNorm() < kMinLandmarkDistanceSq) {
       decision_[k] = Decision::kInvalid;
       continue;
@@ -682,6 +705,7 @@ FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian
       // joint state instead, and plain FastSLAM 2.0 re-admits it next frame.
       decision_[k] = Decision::kGated;
       log_w += outlier_log_likelihood(fit.log_likelihood, fit.mahalanobis2);
+      const Landmark* lm = p.map.find(slots_[k]);
       if (lm->consecutive_rejections + 1 >= static_cast<std::uint32_t>(options_.gate_readmit_after)) {
         end_joint = true;
       }

@@ -151,8 +151,13 @@ class FastSlam2 {
   std::vector<MotionStep> split_pending_at(double t_s);
   // The FastSLAM 2.0 update for a frame at the particles' time.
   void update_with_frame(const ObservationFrame& frame);
-  // Applies the odometry composed since the last frame to every particle.
-  void move_particles();
+  // Applies the odometry composed since the last frame to every particle; with
+  // joint_states_later, the joint states are left to the frame's update, which
+  // moves each (joint_motion_) just before updating it.
+  void move_particles(bool joint_states_later = false);
+  // Moves the run of particles side by side that hold particle `first`'s joint
+  // state (once for all); returns the run's end (first + 1 without one).
+  std::size_t move_joint_run(std::size_t first, const ComposedMotion& motion);
   // cos and sin of each particle's heading (for pending_), and weights_.
   void refresh_caches();
   std::uint32_t slot_for(int landmark_id);
@@ -220,6 +225,7 @@ class FastSlam2 {
   std::vector<Particle> particles_;
   std::vector<Particle> scratch_;
   ComposedMotion pending_;                   // odometry not yet applied to the particles
+  ComposedMotion joint_motion_;              // odometry due to the joint states in update_with_frame
   std::vector<MotionStep> pending_steps_;    // what pending_ composes
   double moved_until_s_ = 0.0;               // the particles' time: pending_ starts here
   std::vector<Eigen::Vector2d> heading_cs_;  // per particle: cos, sin of its heading
