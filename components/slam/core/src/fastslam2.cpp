@@ -57,7 +57,6 @@ constexpr std::size_t kMaxAnchors = 16;
 // does not grow the filter's memory.
 constexpr std::size_t kMaxPendingSteps = 65536;
 
-// Whether a pose covariance exceeds a heading sd or a position sd (worst direction).
 // Particle p's landmark in `slot` (`in_map` its map's entry): one in the
 // particle's joint state has its marginal there, the map catches up when the
 // state ends.
@@ -70,6 +69,7 @@ Landmark landmark_now(const Particle& p, std::uint32_t slot, const Landmark& in_
   return lm;
 }
 
+// Whether a pose covariance exceeds a heading sd or a position sd (worst direction).
 bool exceeds(const Eigen::Matrix3d& cov, double heading_sigma, double position_sigma) {
   if (cov(2, 2) > heading_sigma * heading_sigma) return true;
   const double half_trace = 0.5 * (cov(0, 0) + cov(1, 1));
@@ -725,9 +725,7 @@ FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian
   g.end_frame();
   if (!g.healthy()) {
     // A breakdown no single update showed (a first sighting from a wild pose):
-    // the frame is dropped for this particle, which goes on in plain FastSLAM
-    // 2.0 from its pose before the frame and the map's marginals (this frame
-    // has not written to the map yet).
+    // the frame is dropped (this frame has not written to the map yet).
     ++counters_.joint_breakdowns;
     decision_.assign(n, Decision::kInvalid);
     return JointOutcome::kBrokeDown;
