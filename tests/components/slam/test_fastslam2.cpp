@@ -981,6 +981,51 @@ TEST(FastSlam2, CopiesOfAParticleShareOneJointStateWithTheSameResult) {
   }
 }
 
+// A joint state that an update would break (a first sighting with sigmas of
+// 1 km and 1,000 rad, the most a detection may carry: a landmark variance over (1 km)^2)
+// is dropped for that frame: the particle samples its pose, and its map holds
+// the state's landmarks as they were before the frame. With copies sharing
+// their state and without, the same particles.
+TEST(FastSlam2, AJointStateThatBreaksDownLeavesItsLandmarksAsBeforeTheFrame) {
+  PoseGaussian start;
+  start.mean = Pose2::Zero();
+  start.cov = Eigen::Vector3d(0.2, 0.2, 0.04).asDiagonal();
+  std::vector<std::vector<Pose2>> after;  // poses only: maps must not outlive their filter's pool
+  for (const bool share : {true, false}) {
+    FilterOptions o;
+    o.particles = 40;
+    o.delayed_sampling.enabled = true;
+    o.delayed_sampling.exit_heading_sigma_rad = 0.001;  // stays joint
+    o.delayed_sampling.exit_position_sigma_m = 0.001;
+    o.resample_mode = ResampleMode::kEveryFrame;
+    o.share_identical_particles = share;
+    FastSlam2 f(o, start);
+    f.set_prior_map({{1, Eigen::Vector2d(2.0, 0.0), Eigen::Matrix2d::Identity() * 1e-4, 5}});
+    f.add_odometry({0.0, 0.0, 0.0});
+    for (int k = 1; k <= 10; ++k) f.add_observations({0.1 * k, {{1, 2.0, 0.0}, {2, 2.0, M_PI / 2}}});
+    std::set<const JointGaussian*> states;
+    for (const Particle& p : f.particles()) {
+      ASSERT_TRUE(p.joint.active());
+      states.insert(&*p.joint);
+    }
+    if (share) {
+      EXPECT_LT(states.size(), 40u);  // resampled copies share their state
+    }
+    const std::vector<LandmarkEstimate> before = f.landmarks_mixture();
+    ASSERT_EQ(before.size(), 2u);
+    f.add_observations({1.1, {{3, 3.0, 0.0, 1e3, 1e3}}});
+    EXPECT_EQ(f.counters().joint_breakdowns, 40u);
+    for (const Particle& p : f.particles()) {
+      EXPECT_FALSE(p.joint.active());
+      EXPECT_EQ(p.map.size(), 2u);  // landmark 3 not mapped
+    }
+    expect_same_landmarks(f.landmarks_mixture(), before);
+    after.emplace_back();
+    for (const Particle& p : f.particles()) after.back().push_back(p.pose.mean);
+  }
+  EXPECT_TRUE(after[0] == after[1]);
+}
+
 // The odometry steps kept for late frames are bounded: after 65,536 of them
 // without a frame they are applied to the particles, and only frames after that
 // can still be applied at their stamps.
