@@ -56,6 +56,7 @@
 #include "pixyslam/mrclam/mrclam_dataset.h"
 #include "pixyslam/mrclam/mrclam_fit.h"
 #include "pixyslam/offline/offline_run.h"
+#include "pixyslam/offline/optimizer_sets.h"
 #ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
 #include "pixyslam/offline/optimised_run.h"
 #endif
@@ -570,12 +571,7 @@ int run(const EvalArguments& args) {
   const std::vector<std::string> mrclam_sets = parameters::take_section(filter_sets, "mrclam");
   optimise.sets = parameters::take_section(filter_sets, "optimizer");
   try {
-    if (!optimise.sets.empty() && !optimise) {
-      throw std::invalid_argument(optimise.sets.front() + ": optimizer. needs --optimise");
-    }
-#ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
-    offline::optimizer_options(options, optimise.sets);  // checked now, not after the first run
-#endif
+    offline::check_optimizer_sets(options, optimise.sets, optimise.on);
     slam::apply_overrides(options, filter_sets);
     for (const std::string& a : mrclam_sets) {
       parameters::apply_override(model, offline::mrclam_sensor_parameters(), "mrclam", a);

@@ -18,6 +18,7 @@
 #include "pixyslam/offline/hardware_input.h"
 #include "pixyslam/mrclam/mrclam_dataset.h"
 #include "pixyslam/offline/offline_run.h"
+#include "pixyslam/offline/optimizer_sets.h"
 #ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
 #include "pixyslam/offline/optimised_run.h"
 #endif
@@ -111,12 +112,7 @@ int run(const Args& args) {
     if (!mrclam_sets.empty() && args.mode != "mrclam") {
       throw std::invalid_argument(mrclam_sets.front() + ": mrclam. is for slam_offline mrclam");
     }
-    if (!optimizer_sets.empty() && !args.optimise) {
-      throw std::invalid_argument(optimizer_sets.front() + ": optimizer. needs --optimise");
-    }
-#ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
-    offline::optimizer_options(options, optimizer_sets);  // checked now, not after the filter ran
-#endif
+    offline::check_optimizer_sets(options, optimizer_sets, args.optimise);
   } catch (const std::invalid_argument& e) {
     throw set_error(e);
   }
