@@ -218,6 +218,9 @@ int main(int argc, char** argv) {
   compare.option("--max-unmatched", compare_request.max_unmatched,
                  "messages of each file without a partner that still pass (default 0)")
       .type("N");
+  compare.flag("--until-unmatched", compare_request.until_unmatched,
+               "with --match: pairs after the first message without a partner may differ (inputs taken in "
+               "another order from there); those before it must agree and be at least half");
 
   log_tool::FoxgloveRequest foxglove_request;
   std::vector<std::string> foxglove_files;
@@ -243,6 +246,9 @@ int main(int argc, char** argv) {
       compare_request.second_path = compare_files[1];
       for (std::string& field : parameters::split_list(ignored)) compare_request.ignored.push_back(std::move(field));
       for (std::string& field : parameters::split_list(match)) compare_request.match.push_back(std::move(field));
+      if (compare_request.until_unmatched && compare_request.match.empty()) {
+        throw app::UsageError("--until-unmatched needs --match");
+      }
       return log_tool::run_compare(compare_request, std::cout);
     }
     if (foxglove.chosen()) {

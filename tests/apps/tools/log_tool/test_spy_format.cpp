@@ -293,6 +293,7 @@ TEST(PairMessages, ByKeyFieldsInOrderAndByPositionWithout) {
   EXPECT_EQ(p.pairs, expected);
   EXPECT_EQ(p.only_first, std::vector<std::size_t>{3});
   EXPECT_EQ(p.only_second, std::vector<std::size_t>{3});
+  EXPECT_EQ(pairs_before_first_unmatched(p), 3u);  // (0, 0), (1, 1), (2, 2)
   // Repeated keys pair in order; by position without key fields.
   const MessagePairs twice = pair_messages({state(1, 0), state(1, 0)}, {state(1, 0)}, {"odometry_sequence"});
   EXPECT_EQ(twice.pairs.size(), 1u);
@@ -301,6 +302,8 @@ TEST(PairMessages, ByKeyFieldsInOrderAndByPositionWithout) {
   ASSERT_EQ(by_position.pairs.size(), 1u);
   EXPECT_EQ(by_position.pairs[0], std::make_pair(std::size_t{0}, std::size_t{0}));
   EXPECT_EQ(by_position.only_first.size(), 5u);
+  EXPECT_EQ(pairs_before_first_unmatched(by_position), 1u);
+  EXPECT_EQ(pairs_before_first_unmatched(pair_messages(live, live, {"odometry_sequence"})), live.size());
 }
 
 TEST(SpyFormat, StringsAreEscapedAndNonFiniteNumbersStayValid) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <deque>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <tuple>
@@ -566,6 +567,15 @@ MessagePairs pair_messages(const std::vector<Value>& first, const std::vector<Va
     if (!paired[j]) out.only_second.push_back(j);
   }
   return out;
+}
+
+std::size_t pairs_before_first_unmatched(const MessagePairs& p) {
+  const std::size_t none = std::numeric_limits<std::size_t>::max();
+  const std::size_t first = p.only_first.empty() ? none : p.only_first.front();
+  const std::size_t second = p.only_second.empty() ? none : p.only_second.front();
+  std::size_t k = 0;
+  while (k < p.pairs.size() && p.pairs[k].first < first && p.pairs[k].second < second) ++k;
+  return k;
 }
 
 std::vector<std::string> compare_values(const Value& a, const Value& b, const std::vector<std::string>& ignored,

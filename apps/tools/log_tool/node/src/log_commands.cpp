@@ -480,9 +480,11 @@ int run_compare(const CompareRequest& request, std::ostream& out) {
 
   std::int64_t min_offset = std::numeric_limits<std::int64_t>::max();
   std::int64_t max_offset = std::numeric_limits<std::int64_t>::min();
-  std::size_t differing = 0;
+  std::size_t differing = 0, differing_after = 0;
   std::size_t lines = 0;
-  for (const auto& [i, j] : paired.pairs) {
+  const std::size_t before_unmatched = request.until_unmatched ? pairs_before_first_unmatched(paired) : n;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto [i, j] = paired.pairs[k];
     const Value* a = first[i].find("header.stamp_ns");
     const Value* b = second[j].find("header.stamp_ns");
     if (a != nullptr && b != nullptr) {
@@ -493,6 +495,10 @@ int run_compare(const CompareRequest& request, std::ostream& out) {
     const std::vector<std::string> differences = compare_values(
         first[i], second[j], request.ignored, request.tolerance, std::max<std::size_t>(1, request.max_lines));
     if (differences.empty()) continue;
+    if (k >= before_unmatched) {
+      ++differing_after;
+      continue;
+    }
     ++differing;
     for (const std::string& d : differences) {
       if (lines >= request.max_lines) break;
@@ -511,12 +517,20 @@ int run_compare(const CompareRequest& request, std::ostream& out) {
   std::string ignored;
   for (const std::string& f : request.ignored) ignored += (ignored.empty() ? "" : ", ") + f;
   if (differing == 0) {
-    out << n << " messages compared: identical in every field"
+    out << n - differing_after << " messages compared: identical in every field"
         << (ignored.empty() ? "" : " except the ignored " + ignored)
         << (request.tolerance > 0 ? " (relative tolerance " + format_double(request.tolerance) + ")" : "") << "\n";
   } else {
     out << differing << " of " << n << " messages differ\n";
     same = false;
+  }
+  if (request.until_unmatched) {
+    out << before_unmatched << " of " << n << " pairs before the first message without a partner; "
+        << differing_after << " after it differ (allowed: --until-unmatched)\n";
+    if (2 * before_unmatched < n) {
+      out << "too few pairs before the first message without a partner\n";
+      same = false;
+    }
   }
   if (!request.match.empty()) {
     std::string fields;

@@ -98,6 +98,9 @@ struct MessagePairs {
 };
 MessagePairs pair_messages(const std::vector<Value>& first, const std::vector<Value>& second,
                            const std::vector<std::string>& key_fields);
+// How many of p.pairs come before the first message of either file that has no
+// partner (all of them when every message has one). Pure.
+std::size_t pairs_before_first_unmatched(const MessagePairs& p);
 
 // Inter-arrival statistics of a stream (pixyslam_spy hz), times in seconds.
 struct GapStats {

@@ -56,6 +56,11 @@ struct CompareRequest {
   // that includes the same inputs. Messages without a partner are counted.
   std::vector<std::string> match;
   std::uint64_t max_unmatched = 0;  // of each file (uint64: the CLI binds it on 32-bit hosts too)
+  // With match: pairs after the first message without a partner may differ
+  // (a replayed estimator that took an odometry sample after a newer frame,
+  // where the live one did not, applies it at another time from there on);
+  // every pair before it must agree, and they must be at least half.
+  bool until_unmatched = false;
 };
 
 // `pixyslam_log compare A.mcap B.mcap --topic T`: decodes the topic's messages
