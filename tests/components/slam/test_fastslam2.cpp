@@ -1013,6 +1013,8 @@ TEST(FastSlam2, AJointStateThatBreaksDownLeavesItsLandmarksAsBeforeTheFrame) {
     }
     const std::vector<LandmarkEstimate> before = f.landmarks_mixture();
     ASSERT_EQ(before.size(), 2u);
+    EXPECT_EQ(before[0].times_observed, 15u);  // 5 in the prior map, 10 in the state
+    EXPECT_EQ(before[1].times_observed, 10u);
     f.add_observations({1.1, {{3, 3.0, 0.0, 1e3, 1e3}}});
     EXPECT_EQ(f.counters().joint_breakdowns, 40u);
     for (const Particle& p : f.particles()) {
@@ -1024,6 +1026,50 @@ TEST(FastSlam2, AJointStateThatBreaksDownLeavesItsLandmarksAsBeforeTheFrame) {
     for (const Particle& p : f.particles()) after.back().push_back(p.pose.mean);
   }
   EXPECT_TRUE(after[0] == after[1]);
+}
+
+// Inside a joint state a landmark's counters live in the state: an outlier
+// gated gate_readmit_after times in a row ends the state (plain FastSLAM 2.0
+// readmits it next frame), the map then holds the counters, and the
+// readmission resets them.
+TEST(FastSlam2, AJointStateCountsGatedObservationsAndEndsForReadmission) {
+  PoseGaussian start;
+  start.mean = Pose2::Zero();
+  start.cov = Eigen::Vector3d(0.2, 0.2, 0.04).asDiagonal();
+  FilterOptions o;
+  o.particles = 20;
+  o.gate_enabled = true;
+  o.gate_probability = 0.999;
+  o.gate_readmit_after = 3;
+  o.delayed_sampling.enabled = true;
+  o.delayed_sampling.exit_heading_sigma_rad = 1e-6;  // stays joint until the gate ends it
+  o.delayed_sampling.exit_position_sigma_m = 1e-6;
+  FastSlam2 f(o, start);
+  f.set_prior_map({{7, Eigen::Vector2d(2.0, 0.0), Eigen::Matrix2d::Identity() * 1e-4, 4}});
+  f.add_odometry({0.0, 0.0, 0.0});
+  double t = 0.0;
+  for (int i = 0; i < 5; ++i) f.add_observations({t += 0.1, {{7, 2.0, 0.0}}});
+  for (const Particle& p : f.particles()) ASSERT_TRUE(p.joint.active());
+  EXPECT_EQ(f.landmarks_of_best().at(0).times_observed, 9u);
+  for (int i = 1; i <= 2; ++i) {
+    f.add_observations({t += 0.1, {{7, 7.0, 0.0}}});
+    for (const Particle& p : f.particles()) {
+      ASSERT_TRUE(p.joint.active());
+      EXPECT_EQ(p.joint->counts.at(0).consecutive_rejections, static_cast<std::uint32_t>(i));
+      EXPECT_EQ(p.map.find(0)->consecutive_rejections, 0u);  // the map catches up later
+    }
+  }
+  f.add_observations({t += 0.1, {{7, 7.0, 0.0}}});
+  EXPECT_EQ(f.counters().observations_gated, 3u);
+  for (const Particle& p : f.particles()) {
+    ASSERT_FALSE(p.joint.active());
+    EXPECT_EQ(p.map.find(0)->consecutive_rejections, 3u);
+    EXPECT_EQ(p.map.find(0)->times_observed, 9u);
+  }
+  const std::uint64_t used = f.counters().observations_used;
+  f.add_observations({t += 0.1, {{7, 7.0, 0.0}}});
+  EXPECT_EQ(f.counters().observations_used, used + 1);
+  EXPECT_EQ(f.landmarks_of_best().at(0).times_observed, 10u);
 }
 
 // The odometry steps kept for late frames are bounded: after 65,536 of them

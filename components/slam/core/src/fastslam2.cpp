@@ -58,15 +58,26 @@ constexpr std::size_t kMaxAnchors = 16;
 constexpr std::size_t kMaxPendingSteps = 65536;
 
 // Particle p's landmark in `slot` (`in_map` its map's entry): one in the
-// particle's joint state has its marginal there, the map catches up when the
-// state ends.
+// particle's joint state has its marginal and counters there, the map catches
+// up when the state ends.
 Landmark landmark_now(const Particle& p, std::uint32_t slot, const Landmark& in_map) {
   const int i = p.joint.active() ? p.joint->find(slot) : -1;
   if (i < 0) return in_map;
   Landmark lm = in_map;
   lm.mean = p.joint->landmark_mean(i);
   lm.cov = p.joint->landmark_cov(i);
+  lm.times_observed = p.joint->counts[static_cast<std::size_t>(i)].times_observed;
+  lm.consecutive_rejections = p.joint->counts[static_cast<std::size_t>(i)].consecutive_rejections;
   return lm;
+}
+
+// The map takes a landmark of a joint state that ends.
+void map_takes(LandmarkMap& map, const ConditionedLandmark& c) {
+  Landmark& lm = map.modify(c.slot);
+  lm.mean = c.mean;
+  lm.cov = c.cov;
+  lm.times_observed = c.counts.times_observed;
+  lm.consecutive_rejections = c.counts.consecutive_rejections;
 }
 
 // Whether a pose covariance exceeds a heading sd or a position sd (worst direction).
@@ -660,7 +671,8 @@ FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian
   // The map holds the state's landmarks only from its end on: kept for a breakdown.
   marginals_before_.clear();
   for (int i = 0; i < g.landmark_count(); ++i) {
-    marginals_before_.push_back({g.slots[static_cast<std::size_t>(i)], g.landmark_mean(i), g.landmark_cov(i)});
+    const auto u = static_cast<std::size_t>(i);
+    marginals_before_.push_back({g.slots[u], g.landmark_mean(i), g.landmark_cov(i), g.counts[u]});
   }
   g.begin_frame();
   decision_.assign(n, Decision::kNew);
@@ -705,8 +717,8 @@ FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian
       // joint state instead, and plain FastSLAM 2.0 re-admits it next frame.
       decision_[k] = Decision::kGated;
       log_w += outlier_log_likelihood(fit.log_likelihood, fit.mahalanobis2);
-      const Landmark* lm = p.map.find(slots_[k]);
-      if (lm->consecutive_rejections + 1 >= static_cast<std::uint32_t>(options_.gate_readmit_after)) {
+      if (g.counts[static_cast<std::size_t>(i)].consecutive_rejections + 1 >=
+          static_cast<std::uint32_t>(options_.gate_readmit_after)) {
         end_joint = true;
       }
       continue;
@@ -730,23 +742,23 @@ FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian
     decision_.assign(n, Decision::kInvalid);
     return JointOutcome::kBrokeDown;
   }
+  // The counters live in the state (JointGaussian::counts); the map gets an
+  // entry for a first sighting only, so that later frames know it is mapped.
   for (std::size_t k = 0; k < n; ++k) {
+    if (decision_[k] == Decision::kNew || decision_[k] == Decision::kInvalid) continue;
+    LandmarkCounts& counts = g.counts[static_cast<std::size_t>(g.find(slots_[k]))];
     switch (decision_[k]) {
-      case Decision::kNewDone: {
-        Landmark& added = p.map.modify(slots_[k]);
-        added.id = id_of_slot_[slots_[k]];
-        ++added.times_observed;
+      case Decision::kNewDone:
+        p.map.modify(slots_[k]).id = id_of_slot_[slots_[k]];
+        ++counts.times_observed;
         decision_[k] = Decision::kNew;
         break;
-      }
-      case Decision::kUsed: {
-        Landmark& lm = p.map.modify(slots_[k]);
-        ++lm.times_observed;
-        lm.consecutive_rejections = 0;
+      case Decision::kUsed:
+        ++counts.times_observed;
+        counts.consecutive_rejections = 0;
         break;
-      }
       case Decision::kGated:
-        ++p.map.modify(slots_[k]).consecutive_rejections;
+        ++counts.consecutive_rejections;
         break;
       case Decision::kNew:
       case Decision::kInvalid:
@@ -773,11 +785,7 @@ void FastSlam2::end_joint_update(Particle& p, JointOutcome outcome, const PoseGa
     case JointOutcome::kBrokeDown:
       // The frame is dropped for this particle, which goes on in plain FastSLAM
       // 2.0 from its pose and the state's marginals before the frame.
-      for (const ConditionedLandmark& c : marginals_before_) {
-        Landmark& lm = p.map.modify(c.slot);
-        lm.mean = c.mean;
-        lm.cov = c.cov;
-      }
+      for (const ConditionedLandmark& c : marginals_before_) map_takes(p.map, c);
       p.joint.clear();
       p.pose.mean = sample_pose(before, rng_);
       p.pose.cov.setZero();
@@ -789,7 +797,7 @@ int FastSlam2::joint_index(const Particle& p, JointGaussian& g, std::size_t k) {
   const int i = g.find(slots_[k]);
   if (i >= 0) return i;
   const Landmark* lm = p.map.find(slots_[k]);
-  return g.add_known(slots_[k], lm->mean, lm->cov);
+  return g.add_known(slots_[k], lm->mean, lm->cov, {lm->times_observed, lm->consecutive_rejections});
 }
 
 double FastSlam2::draw_heading_at_return(Particle& p, JointGaussian& g) {
@@ -847,11 +855,7 @@ double FastSlam2::draw_heading_at_return(Particle& p, JointGaussian& g) {
 
 void FastSlam2::finish_joint(Particle& p) {
   const Pose2 x = sample_pose(p.joint->pose(), rng_);
-  for (const ConditionedLandmark& c : condition_on_pose(*p.joint, x)) {
-    Landmark& lm = p.map.modify(c.slot);
-    lm.mean = c.mean;
-    lm.cov = c.cov;
-  }
+  for (const ConditionedLandmark& c : condition_on_pose(*p.joint, x)) map_takes(p.map, c);
   p.pose.mean = x;
   p.pose.cov.setZero();
   p.joint.clear();
@@ -1030,8 +1034,11 @@ bool FastSlam2::frame_pinned(std::vector<std::uint32_t>* anchor_slots) const {
   const AnchorFrameOptions& a = options_.anchor_frame;
   // Candidates: the first landmarks the best particle has seen often enough.
   std::vector<std::uint32_t> slots;
-  particles_[best_index()].map.for_each([&](std::uint32_t slot, const Landmark& lm) {
-    if (lm.times_observed >= static_cast<std::uint32_t>(a.min_observations)) slots.push_back(slot);
+  const Particle& best = particles_[best_index()];
+  best.map.for_each([&](std::uint32_t slot, const Landmark& in_map) {
+    if (landmark_now(best, slot, in_map).times_observed >= static_cast<std::uint32_t>(a.min_observations)) {
+      slots.push_back(slot);
+    }
   });
   std::sort(slots.begin(), slots.end());
   if (slots.size() > kMaxAnchors) slots.resize(kMaxAnchors);

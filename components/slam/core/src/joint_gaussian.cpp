@@ -30,6 +30,7 @@ int append_block(JointGaussian& g, std::uint32_t slot) {
   g.slots.push_back(slot);
   g.first.emplace_back(Eigen::Vector2d::Zero());
   g.relative.push_back(0);
+  g.counts.emplace_back();
   return g.landmark_count() - 1;
 }
 
@@ -66,6 +67,7 @@ void JointGaussian::begin(const PoseGaussian& pose) {
   slots.clear();
   first.clear();
   relative.clear();
+  counts.clear();
   frame_pose = pose.mean;
 }
 
@@ -75,6 +77,7 @@ void JointGaussian::clear() {
   slots.clear();
   first.clear();
   relative.clear();
+  counts.clear();
 }
 
 JointGaussian& SharedJointGaussian::begin(const PoseGaussian& pose) {
@@ -128,11 +131,12 @@ void JointGaussian::apply_motion(const ComposedMotion& motion) {
 }
 
 int JointGaussian::add_known(std::uint32_t slot, const Eigen::Vector2d& landmark_mean,
-                             const Eigen::Matrix2d& landmark_cov) {
+                             const Eigen::Matrix2d& landmark_cov, LandmarkCounts landmark_counts) {
   const int i = append_block(*this, slot);
   mean.tail<2>() = landmark_mean;
   cov.bottomRightCorner<2, 2>() = landmark_cov;
   first.back() = landmark_mean;
+  counts.back() = landmark_counts;
   return i;
 }
 
@@ -378,6 +382,7 @@ std::vector<ConditionedLandmark> condition_on_pose(const JointGaussian& g, const
     const Eigen::Matrix<double, 2, 3> a = ldlt.solve(pxi).transpose();  // P_ix Pxx^-1
     ConditionedLandmark c;
     c.slot = g.slots[static_cast<std::size_t>(i)];
+    c.counts = g.counts[static_cast<std::size_t>(i)];
     c.mean = g.mean.segment<2>(j) + a * dx;
     c.cov = g.cov.block<2, 2>(j, j) - a * pxi;
     c.cov = 0.5 * (c.cov + c.cov.transpose()).eval();

@@ -12,6 +12,12 @@
 
 namespace pixyslam::slam {
 
+// A landmark's Landmark::times_observed and consecutive_rejections.
+struct LandmarkCounts {
+  std::uint32_t times_observed = 0;
+  std::uint32_t consecutive_rejections = 0;
+};
+
 // One particle's pose and the landmarks it saw while its pose was too uncertain
 // to sample (delayed sampling, see FastSlam2): a single Gaussian over
 // (x, y, theta, m1x, m1y, m2x, ...), updated like EKF-SLAM. Landmarks seen from
@@ -35,6 +41,10 @@ struct JointGaussian {
   // Landmark i was first seen in this state (add_new): placed relative to the
   // pose, it turns with it when a mapped landmark corrects the heading.
   std::vector<std::uint8_t> relative;
+  // Landmark i's counters. While a landmark is in the state its counters live
+  // here with its mean and covariance, so a frame's bookkeeping does not copy the
+  // particle's map tree; the map takes them when the state ends.
+  std::vector<LandmarkCounts> counts;
   Eigen::Vector3d frame_pose = Eigen::Vector3d::Zero();  // pose predicted for the frame
 
   bool active() const { return mean.size() != 0; }
@@ -61,7 +71,8 @@ struct JointGaussian {
   void begin_frame() { frame_pose = mean.head<3>(); }
   void end_frame();
   // Appends a mapped landmark, independent of the rest (FastSLAM's factorisation).
-  int add_known(std::uint32_t slot, const Eigen::Vector2d& landmark_mean, const Eigen::Matrix2d& landmark_cov);
+  int add_known(std::uint32_t slot, const Eigen::Vector2d& landmark_mean, const Eigen::Matrix2d& landmark_cov,
+                LandmarkCounts landmark_counts = {});
   // Appends a first sighting through the inverse observation model at the frame
   // pose, with its correlation to the pose: P_ll = Gx Pxx Gx^T + Gz R Gz^T,
   // P_l* = Gx P_x*. Add new landmarks before the frame's updates.
@@ -145,6 +156,7 @@ struct ConditionedLandmark {
   std::uint32_t slot = 0;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  LandmarkCounts counts;
 };
 std::vector<ConditionedLandmark> condition_on_pose(const JointGaussian& g, const Pose2& pose);
 
