@@ -37,6 +37,104 @@ Eigen::Vector2d observe(const Pose2& pose, const Eigen::Vector2d& landmark) {
   return predict_observation(pose, landmark).z;
 }
 
+// JointGaussian keeps only the lower triangle of its covariance. A plain dense
+// EKF over the same state, written out here with full matrices, must give the
+// same covariance through every operation: motion (one step and composed),
+// mapped and new landmarks, updates on pose and landmark blocks, and the
+// frame's re-linearisation.
+TEST(JointGaussian, LowerTriangleMatchesADenseEkf) {
+  std::mt19937_64 prng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  MotionNoise mn;
+  mn.v_sigma_m_per_sqrt_s = 0.05;
+  mn.w_sigma_rad_per_sqrt_s = 0.1;
+  JointGaussian g;
+  g.begin(pose_gaussian(Pose2(0.5, -0.3, 0.4), Eigen::Vector3d(0.03, 0.02, 0.05)));
+  Eigen::MatrixXd p = g.covariance();
+  const auto grow = [&](const Eigen::MatrixXd& cross, const Eigen::Matrix2d& block) {
+    const Eigen::Index n = p.rows();
+    Eigen::MatrixXd q(n + 2, n + 2);
+    q << p, cross.transpose(), cross, block;
+    p = q;
+  };
+  const auto expect_same = [&](const char* step) {
+    ASSERT_EQ(g.cov_lower.rows(), p.rows()) << step;
+    const double scale = p.cwiseAbs().maxCoeff();
+    EXPECT_LE((g.covariance() - p).cwiseAbs().maxCoeff(), 1e-12 * scale) << step;
+    EXPECT_TRUE(g.pose().cov.isApprox(p.topLeftCorner<3, 3>(), 1e-12)) << step;
+  };
+  for (int frame = 0; frame < 6; ++frame) {
+    // Motion: one step, then a composed run of steps.
+    const Eigen::Vector3d before = g.mean.head<3>();
+    const MotionStep step = motion_step(before, 0.3, 0.2, 0.1, mn);
+    g.propagate(0.3, 0.2, 0.1, mn);
+    Eigen::MatrixXd f = Eigen::MatrixXd::Identity(p.rows(), p.cols());
+    f.topLeftCorner<3, 3>() = step.f;
+    p = f * p * f.transpose();
+    p.topLeftCorner<3, 3>() += step.q;
+    expect_same("propagate");
+    ComposedMotion motion;
+    for (int k = 0; k < 5; ++k) motion.add(0.2 + 0.05 * k, -0.1 * k, 0.03, mn);
+    const double c = std::cos(g.mean(2)), s = std::sin(g.mean(2));
+    f.topLeftCorner<3, 3>() = motion.jacobian(c, s);
+    g.apply_motion(motion);
+    p = f * p * f.transpose();
+    p.topLeftCorner<3, 3>() += motion.noise(c, s);
+    expect_same("apply_motion");
+
+    g.begin_frame();
+    const Eigen::Vector3d frame_pose = g.mean.head<3>();
+    // A mapped landmark, independent of the state.
+    Eigen::Matrix2d lm_cov;
+    lm_cov << 0.02, 0.005, 0.005, 0.03;
+    const Eigen::Vector2d lm = frame_pose.head<2>() + Eigen::Vector2d(2.0 + unit(prng), unit(prng));
+    g.add_known(static_cast<std::uint32_t>(2 * frame), lm, lm_cov);
+    grow(Eigen::MatrixXd::Zero(2, p.rows()), lm_cov);
+    expect_same("add_known");
+    // A first sighting, correlated with the pose: Gx P_x., Gx Pxx Gx^T + Gz R Gz^T.
+    const Eigen::Vector2d z(1.5 + 0.5 * unit(prng), 0.4 * unit(prng));
+    const Eigen::Matrix2d r = noise(0.1, 0.03);
+    const double heading = frame_pose(2) + z.y();
+    Eigen::Matrix<double, 2, 3> gx;
+    gx << 1.0, 0.0, -z.x() * std::sin(heading), 0.0, 1.0, z.x() * std::cos(heading);
+    Eigen::Matrix2d gz;
+    gz << std::cos(heading), -z.x() * std::sin(heading), std::sin(heading), z.x() * std::cos(heading);
+    g.add_new(static_cast<std::uint32_t>(2 * frame + 1), z, r);
+    const Eigen::MatrixXd cross = gx * p.topRows<3>();
+    grow(cross, gx * p.topLeftCorner<3, 3>() * gx.transpose() + gz * r * gz.transpose());
+    expect_same("add_new");
+    // Updates on every landmark: P <- P - K S K^T with H on the pose and landmark blocks.
+    for (int i = 0; i < g.landmark_count(); i += 1 + frame % 2) {
+      const Eigen::Vector2d zi = observe(g.mean.head<3>(), g.landmark_mean(i)) + Eigen::Vector2d(0.05, 0.01);
+      const JointFit fit = fit_observation(g, i, zi, r);
+      Eigen::MatrixXd h = Eigen::MatrixXd::Zero(2, p.rows());
+      h.leftCols<3>() = fit.h_pose;
+      h.middleCols<2>(3 + 2 * i) = fit.h_landmark;
+      EXPECT_TRUE(fit.s.isApprox(h * p * h.transpose() + r, 1e-10)) << "S of landmark " << i;
+      ASSERT_TRUE(apply_observation(g, fit));
+      const Eigen::MatrixXd k = p * h.transpose() * fit.s.inverse();
+      p -= k * fit.s * k.transpose();
+      expect_same("apply_observation");
+    }
+    // Re-linearisation at the frame's end: Fc P Fc^T.
+    const Eigen::Vector2d moved = g.mean.head<2>() - frame_pose.head<2>();
+    g.end_frame();
+    if (moved.norm() <= 0.25) {
+      Eigen::MatrixXd fc = Eigen::MatrixXd::Identity(p.rows(), p.cols());
+      fc(0, 2) = -moved.y();
+      fc(1, 2) = moved.x();
+      p = fc * p * fc.transpose();
+    }
+    expect_same("end_frame");
+    for (int i = 0; i < g.landmark_count(); ++i) {
+      const Eigen::Index j = 3 + 2 * i;
+      EXPECT_TRUE(g.landmark_cov(i).isApprox(p.block<2, 2>(j, j), 1e-12));
+      EXPECT_TRUE(g.pose_landmark_cov(i).isApprox(p.block<3, 2>(0, j), 1e-10));
+    }
+  }
+  EXPECT_EQ(g.landmark_count(), 12);
+}
+
 TEST(JointGaussian, KnownLandmarkGivesTheFastSlam2ProposalAndLikelihood) {
   const PoseGaussian pose = pose_gaussian(Pose2(1.0, 2.0, 0.3), Eigen::Vector3d(0.04, 0.02, 0.01));
   const Eigen::Vector2d lm(3.5, 3.0);
@@ -77,7 +175,7 @@ TEST(JointGaussian, NewLandmarkFromACertainPoseMatchesInitialisation) {
   initialise_landmark(pose.mean, z, r, mean, cov);
   EXPECT_TRUE(g.landmark_mean(i).isApprox(mean, 1e-12));
   EXPECT_TRUE(g.landmark_cov(i).isApprox(cov, 1e-12)) << g.landmark_cov(i) << "\nvs\n" << cov;
-  EXPECT_TRUE((g.cov.topRightCorner<3, 2>().isZero(0.0)));
+  EXPECT_TRUE((g.pose_landmark_cov(i).isZero(0.0)));
 }
 
 TEST(JointGaussian, ConditioningOnAShiftedPoseMovesTheLandmarkWithIt) {
@@ -136,7 +234,7 @@ TEST(JointGaussian, RelativeObservationsLeaveTheAbsoluteHeadingUncertain) {
     }
     g.end_frame();
     ASSERT_TRUE(g.healthy()) << "step " << step;
-    ASSERT_GE(g.cov(2, 2), 0.97 * heading_var) << "step " << step << ": the heading became observable";
+    ASSERT_GE(g.heading_variance(), 0.97 * heading_var) << "step " << step << ": the heading became observable";
   }
 }
 
@@ -162,7 +260,7 @@ TEST(JointGaussian, LoopClosureCorrectsThePoseAndTheLandmarksSeenFromIt) {
     g.end_frame();
   }
   EXPECT_LT(std::abs(wrap_angle(g.mean(2) - truth.z())), 0.03) << g.mean.transpose();
-  EXPECT_LT(std::sqrt(g.cov(2, 2)), 0.03);
+  EXPECT_LT(std::sqrt(g.heading_variance()), 0.03);
   EXPECT_LT((g.landmark_mean(ib) - b).norm(), 0.25 * b_error_before) << g.landmark_mean(ib).transpose();
 }
 
@@ -173,7 +271,7 @@ TEST(JointGaussian, HealthRejectsNonFiniteAndNegativeVariances) {
   g.mean(0) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(g.healthy());
   g.mean(0) = 0.0;
-  g.cov(2, 2) = -1e-3;
+  g.cov_lower(2, 2) = -1e-3;
   EXPECT_FALSE(g.healthy());
   g.clear();
   EXPECT_FALSE(g.active());
@@ -195,14 +293,14 @@ TEST(JointGaussian, AnUpdateThatWouldBreakTheStateIsRefusedAndChangesNothing) {
   fit.s = 1e-3 * fit.s;
   EXPECT_FALSE(apply_observation(g, fit));
   EXPECT_EQ(g.mean, before.mean);
-  EXPECT_EQ(g.cov, before.cov);
+  EXPECT_EQ(g.cov_lower, before.cov_lower);
   fit.s = Eigen::Matrix2d::Zero();  // S^-1 not finite
   EXPECT_FALSE(apply_observation(g, fit));
-  EXPECT_EQ(g.cov, before.cov);
+  EXPECT_EQ(g.cov_lower, before.cov_lower);
   fit = fit_observation(g, i, z, noise(0.1, 0.03));
   EXPECT_TRUE(apply_observation(g, fit));
   EXPECT_TRUE(g.healthy());
-  EXPECT_LT(g.cov(0, 0), before.cov(0, 0));
+  EXPECT_LT(g.cov_lower(0, 0), before.cov_lower(0, 0));
 }
 
 }  // namespace
@@ -225,7 +323,7 @@ TEST(JointGaussian, IteratedFitReachesTheMapOfALargeCorrection) {
   g.begin(pose_gaussian(Pose2(0.0, 0.0, 0.0), Eigen::Vector3d(0.25, 0.25, 0.25)));
   const int i = g.add_known(7, landmark, 1e-4 * Eigen::Matrix2d::Identity());
   const Eigen::VectorXd x0 = g.mean;
-  const Eigen::MatrixXd p_inverse = g.cov.inverse();
+  const Eigen::MatrixXd p_inverse = g.covariance().inverse();
   const auto cost = [&](const Eigen::VectorXd& x) {
     Eigen::VectorXd dx = x - x0;
     dx(2) = wrap_angle(dx(2));
@@ -284,7 +382,7 @@ TEST(JointGaussian, HeadingSplitTurnsRelativeLandmarksOnTheirArcs) {
     const JointGaussian& c = parts[k].state;
     const double delta = wrap_angle(c.mean(2) - g.mean(2));
     EXPECT_NEAR(parts[k].weight, parts[parts.size() - 1 - k].weight, 1e-12);
-    EXPECT_NEAR(std::sqrt(c.cov(2, 2)), 0.5 * spacing, 1e-9);
+    EXPECT_NEAR(std::sqrt(c.heading_variance()), 0.5 * spacing, 1e-9);
     EXPECT_NEAR((c.landmark_mean(ahead) - c.mean.head<2>()).norm(), 7.0, 1e-9) << delta;
     EXPECT_TRUE(c.landmark_mean(known).isApprox(known_position, 1e-12));
     const Eigen::Vector2d first_ahead = c.first[static_cast<std::size_t>(ahead)] - c.frame_pose.head<2>();
@@ -292,7 +390,7 @@ TEST(JointGaussian, HeadingSplitTurnsRelativeLandmarksOnTheirArcs) {
     EXPECT_TRUE(c.healthy());
     weight += parts[k].weight;
     mean += parts[k].weight * delta;
-    second += parts[k].weight * (delta * delta + c.cov(2, 2));
+    second += parts[k].weight * (delta * delta + c.heading_variance());
     largest = std::max(largest, std::abs(delta));
   }
   EXPECT_NEAR(weight, 1.0, 1e-12);

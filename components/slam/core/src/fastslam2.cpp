@@ -540,7 +540,7 @@ std::size_t FastSlam2::copies_end(std::size_t first) const {
   }
   // A heading split draws a random number in the middle of the update.
   const double spacing = options_.delayed_sampling.enter_heading_sigma_rad;
-  if (options_.delayed_sampling.split_heading && std::sqrt(p.joint->cov(2, 2)) > spacing) return first + 1;
+  if (options_.delayed_sampling.split_heading && std::sqrt(p.joint->heading_variance()) > spacing) return first + 1;
   std::size_t end = first + 1;
   for (; end < particles_.size(); ++end) {
     const Particle& q = particles_[end];
@@ -804,7 +804,7 @@ double FastSlam2::draw_heading_at_return(Particle& p, JointGaussian& g) {
   // Split only a heading too uncertain to sample from (the joint state's own
   // threshold), into components that narrow.
   const double spacing = options_.delayed_sampling.enter_heading_sigma_rad;
-  if (!(std::sqrt(g.cov(2, 2)) > spacing)) return 0.0;
+  if (!(std::sqrt(g.heading_variance()) > spacing)) return 0.0;
   // The frame's detections of landmarks mapped outside this state (absolute
   // references); the relative ones turn with the pose and cannot tell.
   known_.clear();

@@ -23,10 +23,10 @@ constexpr double kRelineariseDistance = 0.25;  // m
 int append_block(JointGaussian& g, std::uint32_t slot) {
   const Eigen::Index n = g.mean.size();
   g.mean.conservativeResize(n + 2);
-  g.cov.conservativeResize(n + 2, n + 2);
+  g.cov_lower.conservativeResize(n + 2, n + 2);
   g.mean.tail<2>().setZero();
-  g.cov.bottomRows<2>().setZero();
-  g.cov.rightCols<2>().setZero();
+  g.cov_lower.bottomRows<2>().setZero();
+  g.cov_lower.rightCols<2>().setZero();
   g.slots.push_back(slot);
   g.first.emplace_back(Eigen::Vector2d::Zero());
   g.relative.push_back(0);
@@ -40,9 +40,9 @@ bool JointGaussian::healthy() const {
   // A NaN or infinity in the mean or on the diagonal makes its sum non-finite.
   // Off the diagonal a covariance is bounded by its variances, and an update
   // that makes an entry non-finite makes its row's variance non-finite too.
-  if (!std::isfinite(mean.sum()) || !std::isfinite(cov.diagonal().sum())) return false;
-  for (Eigen::Index i = 0; i < cov.rows(); ++i) {
-    if (cov(i, i) < 0.0 || cov(i, i) > kMaxVariance) return false;
+  if (!std::isfinite(mean.sum()) || !std::isfinite(cov_lower.diagonal().sum())) return false;
+  for (Eigen::Index i = 0; i < cov_lower.rows(); ++i) {
+    if (cov_lower(i, i) < 0.0 || cov_lower(i, i) > kMaxVariance) return false;
   }
   return true;
 }
@@ -57,13 +57,13 @@ int JointGaussian::find(std::uint32_t slot) const {
 PoseGaussian JointGaussian::pose() const {
   PoseGaussian p;
   p.mean = mean.head<3>();
-  p.cov = cov.topLeftCorner<3, 3>();
+  p.cov = pose_cov();
   return p;
 }
 
 void JointGaussian::begin(const PoseGaussian& pose) {
   mean = pose.mean;
-  cov = pose.cov;
+  cov_lower = pose.cov;
   slots.clear();
   first.clear();
   relative.clear();
@@ -73,7 +73,7 @@ void JointGaussian::begin(const PoseGaussian& pose) {
 
 void JointGaussian::clear() {
   mean.resize(0);
-  cov.resize(0, 0);
+  cov_lower.resize(0, 0);
   slots.clear();
   first.clear();
   relative.clear();
@@ -96,23 +96,26 @@ void JointGaussian::end_frame() {
   // pose: inflating by a metre-sized correction would wreck the covariance.
   const Eigen::Vector2d c = mean.head<2>() - frame_pose.head<2>();
   if (c.norm() > kRelineariseDistance) return;
-  // Fc P Fc^T in place: rows 0 and 1 gain multiples of row 2, then the same
-  // for the columns.
-  cov.row(0) -= c.y() * cov.row(2);
-  cov.row(1) += c.x() * cov.row(2);
-  cov.col(0) -= c.y() * cov.col(2);
-  cov.col(1) += c.x() * cov.col(2);
+  // Fc P Fc^T = P + u P_2. + P_.2 u^T + P_22 u u^T with u = (-c_y, c_x, 0, ...):
+  // in the lower triangle only columns 0 and 1 change.
+  Eigen::MatrixXd& p = cov_lower;
+  const Eigen::Index n = p.rows();
+  const double u0 = -c.y();
+  const double u1 = c.x();
+  const double p20 = p(2, 0), p21 = p(2, 1), p22 = p(2, 2);
+  p(0, 0) += 2.0 * u0 * p20 + u0 * u0 * p22;
+  p(1, 0) += u1 * p20 + u0 * p21 + u0 * u1 * p22;
+  p(1, 1) += 2.0 * u1 * p21 + u1 * u1 * p22;
+  p.col(0).tail(n - 2) += u0 * p.col(2).tail(n - 2);
+  p.col(1).tail(n - 2) += u1 * p.col(2).tail(n - 2);
 }
 
 void JointGaussian::propagate(double v_mps, double w_radps, double dt_s, const MotionNoise& noise) {
   if (dt_s <= 0.0) return;
   const MotionStep step = motion_step(mean.head<3>(), v_mps, w_radps, dt_s, noise);
   const Eigen::Index m = mean.size() - 3;
-  cov.topLeftCorner<3, 3>() = step.f * cov.topLeftCorner<3, 3>() * step.f.transpose() + step.q;
-  if (m > 0) {
-    cov.topRightCorner(3, m) = step.f * cov.topRightCorner(3, m);
-    cov.bottomLeftCorner(m, 3) = cov.topRightCorner(3, m).transpose();
-  }
+  cov_lower.topLeftCorner<3, 3>() = step.f * pose_cov() * step.f.transpose() + step.q;
+  if (m > 0) cov_lower.bottomLeftCorner(m, 3) = (cov_lower.bottomLeftCorner(m, 3) * step.f.transpose()).eval();
   mean.head<3>() = step.mean;
 }
 
@@ -122,11 +125,9 @@ void JointGaussian::apply_motion(const ComposedMotion& motion) {
   const double s = std::sin(mean(2));
   const Eigen::Matrix3d f = motion.jacobian(c, s);
   const Eigen::Index m = mean.size() - 3;
-  cov.topLeftCorner<3, 3>() = f * cov.topLeftCorner<3, 3>() * f.transpose() + motion.noise(c, s);
-  if (m > 0) {
-    cov.topRightCorner(3, m) = (f * cov.topRightCorner(3, m)).eval();
-    cov.bottomLeftCorner(m, 3) = cov.topRightCorner(3, m).transpose();
-  }
+  cov_lower.topLeftCorner<3, 3>() = f * pose_cov() * f.transpose() + motion.noise(c, s);
+  // The landmarks' rows of the pose columns: P_lx <- P_lx F^T.
+  if (m > 0) cov_lower.bottomLeftCorner(m, 3) = (cov_lower.bottomLeftCorner(m, 3) * f.transpose()).eval();
   mean.head<3>() = motion.moved_mean(mean.head<3>(), c, s);
 }
 
@@ -134,7 +135,7 @@ int JointGaussian::add_known(std::uint32_t slot, const Eigen::Vector2d& landmark
                              const Eigen::Matrix2d& landmark_cov, LandmarkCounts landmark_counts) {
   const int i = append_block(*this, slot);
   mean.tail<2>() = landmark_mean;
-  cov.bottomRightCorner<2, 2>() = landmark_cov;
+  cov_lower.bottomRightCorner<2, 2>() = landmark_cov;
   first.back() = landmark_mean;
   counts.back() = landmark_counts;
   return i;
@@ -151,16 +152,18 @@ int JointGaussian::add_new(std::uint32_t slot, const Eigen::Vector2d& z, const E
   gz << c, -z.x() * s,
         s, z.x() * c;
   const Eigen::Vector2d landmark(frame_pose(0) + z.x() * c, frame_pose(1) + z.x() * s);
-  const Eigen::MatrixXd cross = gx * cov.topRows<3>();  // 2 x n, before the state grows
+  // Gx P_x., 2 x n, before the state grows.
+  const Eigen::Index n = mean.size();
+  const Eigen::Matrix3d pxx = pose_cov();
+  Eigen::Matrix<double, 2, Eigen::Dynamic> cross(2, n);
+  cross.leftCols<3>() = gx * pxx;
+  cross.rightCols(n - 3) = gx * cov_lower.bottomLeftCorner(n - 3, 3).transpose();
   const int i = append_block(*this, slot);
-  const Eigen::Index n = cross.cols();
   mean.tail<2>() = landmark;
   first.back() = landmark;
   relative.back() = 1;
-  cov.bottomLeftCorner(2, n) = cross;
-  cov.topRightCorner(n, 2) = cross.transpose();
-  cov.bottomRightCorner<2, 2>() =
-      gx * cov.topLeftCorner<3, 3>() * gx.transpose() + gz * r * gz.transpose();
+  cov_lower.bottomLeftCorner(2, n) = cross;
+  cov_lower.bottomRightCorner<2, 2>() = gx * pxx * gx.transpose() + gz * r * gz.transpose();
   return i;
 }
 
@@ -173,10 +176,10 @@ JointFit fit_observation(const JointGaussian& g, int index, const Eigen::Vector2
   fit.innovation = innovation(z, predict_observation(g.mean.head<3>(), g.mean.segment<2>(j)).z);
   fit.h_pose = p.h_pose;
   fit.h_landmark = p.h_landmark;
-  const Eigen::Matrix<double, 2, 3> pose_rows_x = p.h_pose * g.cov.block<3, 3>(0, 0);
-  const Eigen::Matrix2d cross = p.h_pose * g.cov.block<3, 2>(0, j) * p.h_landmark.transpose();
+  const Eigen::Matrix<double, 2, 3> pose_rows_x = p.h_pose * g.pose_cov();
+  const Eigen::Matrix2d cross = p.h_pose * g.pose_landmark_cov(index) * p.h_landmark.transpose();
   fit.s = pose_rows_x * p.h_pose.transpose() + cross + cross.transpose() +
-          p.h_landmark * g.cov.block<2, 2>(j, j) * p.h_landmark.transpose() + r;
+          p.h_landmark * g.landmark_cov(index) * p.h_landmark.transpose() + r;
   fit.mahalanobis2 = fit.innovation.dot(fit.s.inverse() * fit.innovation);
   fit.log_likelihood = -0.5 * fit.mahalanobis2 - std::log(2.0 * M_PI) - 0.5 * std::log(fit.s.determinant());
   return fit;
@@ -191,10 +194,10 @@ JointFit fit_observation_iterated(const JointGaussian& g, int index, const Eigen
   Vector5d x0;
   x0 << g.mean.head<3>(), g.mean.segment<2>(j);
   Matrix5d p;
-  p.topLeftCorner<3, 3>() = g.cov.block<3, 3>(0, 0);
-  p.topRightCorner<3, 2>() = g.cov.block<3, 2>(0, j);
-  p.bottomLeftCorner<2, 3>() = g.cov.block<2, 3>(j, 0);
-  p.bottomRightCorner<2, 2>() = g.cov.block<2, 2>(j, j);
+  p.topLeftCorner<3, 3>() = g.pose_cov();
+  p.topRightCorner<3, 2>() = g.pose_landmark_cov(index);
+  p.bottomLeftCorner<2, 3>() = g.pose_landmark_cov(index).transpose();
+  p.bottomRightCorner<2, 2>() = g.landmark_cov(index);
   JointFit fit;
   fit.index = index;
   Vector5d x = x0;
@@ -223,7 +226,8 @@ JointFit fit_observation_iterated(const JointGaussian& g, int index, const Eigen
 
 bool apply_observation(JointGaussian& g, const JointFit& fit) {
   const Eigen::Index j = 3 + 2 * fit.index;
-  const Eigen::Index n = g.cov.rows();
+  Eigen::MatrixXd& p = g.cov_lower;
+  const Eigen::Index n = p.rows();
   // Scratch without an allocation per update: P H^T, K, A and K nu.
   thread_local std::vector<double> scratch;
   scratch.resize(static_cast<std::size_t>(7 * n));
@@ -232,15 +236,19 @@ bool apply_observation(JointGaussian& g, const JointFit& fit) {
   Columns2 k(scratch.data() + 2 * n, n, 2);
   Columns2 a(scratch.data() + 4 * n, n, 2);
   Eigen::Map<Eigen::VectorXd> step(scratch.data() + 6 * n, n);
-  // P H^T touches only the pose and landmark columns of H.
-  pht.noalias() = g.cov.leftCols<3>() * fit.h_pose.transpose();
-  pht.noalias() += g.cov.middleCols<2>(j) * fit.h_landmark.transpose();
+  // P H^T touches only the pose and landmark columns of P, read from the lower
+  // triangle: the pose columns' rows below the pose block, the landmark's rows
+  // left of its block (within the columns the update writes anyway) and below.
+  pht.topRows<3>().noalias() = g.pose_cov() * fit.h_pose.transpose();
+  pht.bottomRows(n - 3).noalias() = p.bottomLeftCorner(n - 3, 3) * fit.h_pose.transpose();
+  pht.topRows(j).noalias() += p.block(j, 0, 2, j).transpose() * fit.h_landmark.transpose();
+  pht.middleRows<2>(j).noalias() += g.landmark_cov(fit.index) * fit.h_landmark.transpose();
+  pht.bottomRows(n - j - 2).noalias() += p.bottomRows(n - j - 2).middleCols<2>(j) * fit.h_landmark.transpose();
   const Eigen::Matrix2d s_inverse = fit.s.inverse();
   k.noalias() = pht * s_inverse;
   step.noalias() = k * fit.innovation;
-  // K S K^T = (P H^T) S^-1 (P H^T)^T = A A^T with A = P H^T L, S^-1 = L L^T:
-  // a sum of products that is the same for (r, c) and (c, r), so P stays
-  // exactly symmetric with a plain column-by-column update.
+  // K S K^T = (P H^T) S^-1 (P H^T)^T = A A^T with A = P H^T L, S^-1 = L L^T,
+  // subtracted column by column from the lower triangle.
   const Eigen::LLT<Eigen::Matrix2d> llt(s_inverse);
   if (llt.info() != Eigen::Success) return false;
   a.noalias() = pht * llt.matrixL().toDenseMatrix();
@@ -248,12 +256,14 @@ bool apply_observation(JointGaussian& g, const JointFit& fit) {
   // healthy() (finite, variances in [0, kMaxVariance]).
   if (!std::isfinite(step.sum()) || !std::isfinite(a.sum())) return false;
   for (Eigen::Index r = 0; r < n; ++r) {
-    const double v = g.cov(r, r) - (a(r, 0) * a(r, 0) + a(r, 1) * a(r, 1));
+    const double v = p(r, r) - (a(r, 0) * a(r, 0) + a(r, 1) * a(r, 1));
     if (!(v >= 0.0 && v <= kMaxVariance)) return false;
   }
   g.mean += step;
   g.mean(2) = wrap_angle(g.mean(2));
-  for (Eigen::Index c = 0; c < n; ++c) g.cov.col(c) -= a.col(0) * a(c, 0) + a.col(1) * a(c, 1);
+  for (Eigen::Index c = 0; c < n; ++c) {
+    p.col(c).tail(n - c) -= a.col(0).tail(n - c) * a(c, 0) + a.col(1).tail(n - c) * a(c, 1);
+  }
   return true;
 }
 
@@ -298,7 +308,7 @@ void to_robocentric(const JointGaussian& g, Eigen::VectorXd& mean, Eigen::Matrix
     j.block<2, 1>(b, 2) = drt * d;
     j.block<2, 2>(b, b) = rt;
   }
-  cov = j * g.cov * j.transpose();
+  cov = j * g.covariance() * j.transpose();
 }
 
 // Back to world coordinates, m = p + R(theta) m_R, into `out` (a copy of the
@@ -322,8 +332,7 @@ void from_robocentric(const JointGaussian& from, const Eigen::VectorXd& mean, co
     j.block<2, 1>(b, 2) = dr * m_r;
     j.block<2, 2>(b, b) = r;
   }
-  out.cov = j * cov * j.transpose();
-  out.cov = (0.5 * (out.cov + out.cov.transpose())).eval();
+  out.cov_lower = j * cov * j.transpose();
   const Eigen::Matrix2d turn = r * rotation(before(2)).transpose();
   const auto move = [&](const Eigen::Vector2d& q) -> Eigen::Vector2d {
     return after.head<2>() + turn * (q - before.head<2>());
@@ -340,7 +349,7 @@ void from_robocentric(const JointGaussian& from, const Eigen::VectorXd& mean, co
 
 std::vector<HeadingComponent> split_heading(const JointGaussian& g, double spacing_rad) {
   std::vector<HeadingComponent> out;
-  const double variance = g.cov(2, 2);
+  const double variance = g.heading_variance();
   const double component_variance = 0.25 * spacing_rad * spacing_rad;
   if (!(spacing_rad > 0.0) || !(variance > component_variance)) return out;
   Eigen::VectorXd y;
@@ -370,7 +379,7 @@ std::vector<HeadingComponent> split_heading(const JointGaussian& g, double spaci
 
 std::vector<ConditionedLandmark> condition_on_pose(const JointGaussian& g, const Pose2& pose) {
   // A tiny ridge keeps Pxx invertible when a direction has no uncertainty yet.
-  const Eigen::Matrix3d pxx = g.cov.topLeftCorner<3, 3>() + 1e-12 * Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d pxx = g.pose_cov() + 1e-12 * Eigen::Matrix3d::Identity();
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(pxx);
   Eigen::Vector3d dx = pose - g.mean.head<3>();
   dx(2) = wrap_angle(dx(2));
@@ -378,13 +387,13 @@ std::vector<ConditionedLandmark> condition_on_pose(const JointGaussian& g, const
   out.reserve(g.slots.size());
   for (int i = 0; i < g.landmark_count(); ++i) {
     const Eigen::Index j = 3 + 2 * i;
-    const Eigen::Matrix<double, 3, 2> pxi = g.cov.block<3, 2>(0, j);
+    const Eigen::Matrix<double, 3, 2> pxi = g.pose_landmark_cov(i);
     const Eigen::Matrix<double, 2, 3> a = ldlt.solve(pxi).transpose();  // P_ix Pxx^-1
     ConditionedLandmark c;
     c.slot = g.slots[static_cast<std::size_t>(i)];
     c.counts = g.counts[static_cast<std::size_t>(i)];
     c.mean = g.mean.segment<2>(j) + a * dx;
-    c.cov = g.cov.block<2, 2>(j, j) - a * pxi;
+    c.cov = g.landmark_cov(i) - a * pxi;
     c.cov = 0.5 * (c.cov + c.cov.transpose()).eval();
     // Rounding can leave a nearly singular block indefinite: floor its eigenvalues.
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(c.cov);

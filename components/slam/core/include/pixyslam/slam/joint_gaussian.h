@@ -35,7 +35,10 @@ struct LandmarkCounts {
 // Plain data; an empty JointGaussian (no state) is inactive.
 struct JointGaussian {
   Eigen::VectorXd mean;
-  Eigen::MatrixXd cov;
+  // The covariance's lower triangle (row >= column); the entries above the
+  // diagonal are not kept, so an update moves half the bytes. Read it through
+  // covariance() or the block accessors below.
+  Eigen::MatrixXd cov_lower;
   std::vector<std::uint32_t> slots;       // landmark slot of state block i (at 3 + 2i)
   std::vector<Eigen::Vector2d> first;     // first estimate of landmark i
   // Landmark i was first seen in this state (add_new): placed relative to the
@@ -55,7 +58,17 @@ struct JointGaussian {
   int find(std::uint32_t slot) const;
   PoseGaussian pose() const;
   Eigen::Vector2d landmark_mean(int i) const { return mean.segment<2>(3 + 2 * i); }
-  Eigen::Matrix2d landmark_cov(int i) const { return cov.block<2, 2>(3 + 2 * i, 3 + 2 * i); }
+  Eigen::Matrix3d pose_cov() const { return cov_lower.topLeftCorner<3, 3>().selfadjointView<Eigen::Lower>(); }
+  Eigen::Matrix2d landmark_cov(int i) const {
+    return cov_lower.block<2, 2>(3 + 2 * i, 3 + 2 * i).selfadjointView<Eigen::Lower>();
+  }
+  // Cov(pose, landmark i), 3 x 2.
+  Eigen::Matrix<double, 3, 2> pose_landmark_cov(int i) const {
+    return cov_lower.block<2, 3>(3 + 2 * i, 0).transpose();
+  }
+  double heading_variance() const { return cov_lower(2, 2); }
+  // The whole covariance, both triangles.
+  Eigen::MatrixXd covariance() const { return cov_lower.selfadjointView<Eigen::Lower>(); }
 
   // Starts from a pose Gaussian with no landmarks.
   void begin(const PoseGaussian& pose);
