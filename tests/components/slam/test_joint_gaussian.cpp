@@ -37,12 +37,44 @@ Eigen::Vector2d observe(const Pose2& pose, const Eigen::Vector2d& landmark) {
   return predict_observation(pose, landmark).z;
 }
 
-// JointGaussian keeps only the lower triangle of its covariance. A plain dense
+// PackedSymmetric: the lower triangle column after column; a round trip
+// through it gives the symmetric matrix back, a column segment is contiguous
+// in the packed array, and growing keeps every entry and adds zeros.
+TEST(PackedSymmetric, StoresTheLowerTriangleColumnByColumn) {
+  Eigen::MatrixXd m(4, 4);
+  m << 1, 2, 3, 4,
+       2, 5, 6, 7,
+       3, 6, 8, 9,
+       4, 7, 9, 10;
+  Eigen::MatrixXd upper_garbage = m;
+  upper_garbage(0, 3) = 99.0;  // only the lower triangle is read
+  PackedSymmetric p(upper_garbage);
+  EXPECT_EQ(p.size(), 4);
+  EXPECT_EQ(p.packed(), (std::vector<double>{1, 2, 3, 4, 5, 6, 7, 8, 9, 10}));
+  EXPECT_EQ(p.full(), m);
+  EXPECT_EQ(p(0, 3), 4.0);
+  EXPECT_EQ(p(3, 0), 4.0);
+  EXPECT_EQ(p.column(1, 2), Eigen::Vector2d(6, 7));
+  EXPECT_EQ(p.diagonal_block<2>(2), (Eigen::Matrix2d() << 8, 9, 9, 10).finished());
+  p.column(2, 2) *= 2.0;
+  EXPECT_EQ(p.lower(3, 2), 18.0);
+  p.grow(2);
+  EXPECT_EQ(p.size(), 6);
+  Eigen::MatrixXd grown = Eigen::MatrixXd::Zero(6, 6);
+  grown.topLeftCorner<4, 4>() = m;
+  grown(2, 2) = 16.0;
+  grown(3, 2) = grown(2, 3) = 18.0;
+  EXPECT_EQ(p.full(), grown);
+  p.clear();
+  EXPECT_EQ(p.size(), 0);
+}
+
+// JointGaussian keeps its covariance packed (PackedSymmetric). A plain dense
 // EKF over the same state, written out here with full matrices, must give the
 // same covariance through every operation: motion (one step and composed),
 // mapped and new landmarks, updates on pose and landmark blocks, and the
 // frame's re-linearisation.
-TEST(JointGaussian, LowerTriangleMatchesADenseEkf) {
+TEST(JointGaussian, PackedCovarianceMatchesADenseEkf) {
   std::mt19937_64 prng(7);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   MotionNoise mn;
@@ -50,7 +82,7 @@ TEST(JointGaussian, LowerTriangleMatchesADenseEkf) {
   mn.w_sigma_rad_per_sqrt_s = 0.1;
   JointGaussian g;
   g.begin(pose_gaussian(Pose2(0.5, -0.3, 0.4), Eigen::Vector3d(0.03, 0.02, 0.05)));
-  Eigen::MatrixXd p = g.covariance();
+  Eigen::MatrixXd p = g.cov.full();
   const auto grow = [&](const Eigen::MatrixXd& cross, const Eigen::Matrix2d& block) {
     const Eigen::Index n = p.rows();
     Eigen::MatrixXd q(n + 2, n + 2);
@@ -58,9 +90,9 @@ TEST(JointGaussian, LowerTriangleMatchesADenseEkf) {
     p = q;
   };
   const auto expect_same = [&](const char* step) {
-    ASSERT_EQ(g.cov_lower.rows(), p.rows()) << step;
+    ASSERT_EQ(g.cov.size(), p.rows()) << step;
     const double scale = p.cwiseAbs().maxCoeff();
-    EXPECT_LE((g.covariance() - p).cwiseAbs().maxCoeff(), 1e-12 * scale) << step;
+    EXPECT_LE((g.cov.full() - p).cwiseAbs().maxCoeff(), 1e-12 * scale) << step;
     EXPECT_TRUE(g.pose().cov.isApprox(p.topLeftCorner<3, 3>(), 1e-12)) << step;
   };
   for (int frame = 0; frame < 6; ++frame) {
@@ -271,7 +303,7 @@ TEST(JointGaussian, HealthRejectsNonFiniteAndNegativeVariances) {
   g.mean(0) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(g.healthy());
   g.mean(0) = 0.0;
-  g.cov_lower(2, 2) = -1e-3;
+  g.cov.lower(2, 2) = -1e-3;
   EXPECT_FALSE(g.healthy());
   g.clear();
   EXPECT_FALSE(g.active());
@@ -293,14 +325,14 @@ TEST(JointGaussian, AnUpdateThatWouldBreakTheStateIsRefusedAndChangesNothing) {
   fit.s = 1e-3 * fit.s;
   EXPECT_FALSE(apply_observation(g, fit));
   EXPECT_EQ(g.mean, before.mean);
-  EXPECT_EQ(g.cov_lower, before.cov_lower);
+  EXPECT_TRUE(g.cov == before.cov);
   fit.s = Eigen::Matrix2d::Zero();  // S^-1 not finite
   EXPECT_FALSE(apply_observation(g, fit));
-  EXPECT_EQ(g.cov_lower, before.cov_lower);
+  EXPECT_TRUE(g.cov == before.cov);
   fit = fit_observation(g, i, z, noise(0.1, 0.03));
   EXPECT_TRUE(apply_observation(g, fit));
   EXPECT_TRUE(g.healthy());
-  EXPECT_LT(g.cov_lower(0, 0), before.cov_lower(0, 0));
+  EXPECT_LT(g.cov.lower(0, 0), before.cov.lower(0, 0));
 }
 
 }  // namespace
@@ -323,7 +355,7 @@ TEST(JointGaussian, IteratedFitReachesTheMapOfALargeCorrection) {
   g.begin(pose_gaussian(Pose2(0.0, 0.0, 0.0), Eigen::Vector3d(0.25, 0.25, 0.25)));
   const int i = g.add_known(7, landmark, 1e-4 * Eigen::Matrix2d::Identity());
   const Eigen::VectorXd x0 = g.mean;
-  const Eigen::MatrixXd p_inverse = g.covariance().inverse();
+  const Eigen::MatrixXd p_inverse = g.cov.full().inverse();
   const auto cost = [&](const Eigen::VectorXd& x) {
     Eigen::VectorXd dx = x - x0;
     dx(2) = wrap_angle(dx(2));

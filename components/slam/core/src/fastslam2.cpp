@@ -668,12 +668,12 @@ void FastSlam2::update_particle_joint(Particle& p, const std::vector<RangeBearin
 }
 
 FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian& g, std::size_t n) {
-  // The map holds the state's landmarks only from its end on: kept for a breakdown.
-  marginals_before_.clear();
-  for (int i = 0; i < g.landmark_count(); ++i) {
-    const auto u = static_cast<std::size_t>(i);
-    marginals_before_.push_back({g.slots[u], g.landmark_mean(i), g.landmark_cov(i), g.counts[u]});
-  }
+  // The map holds the state's landmarks only from its end on: the state before
+  // the frame is kept for a breakdown. One sequential copy: reading just the
+  // landmarks' blocks would wait on a cache miss for each.
+  mean_before_ = g.mean;
+  cov_before_ = g.cov;
+  const int landmarks_before = g.landmark_count();
   g.begin_frame();
   decision_.assign(n, Decision::kNew);
   // First sightings join the state first, at the frame pose; they carry no weight.
@@ -740,6 +740,12 @@ FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian
     // the frame is dropped (this frame has not written to the map yet).
     ++counters_.joint_breakdowns;
     decision_.assign(n, Decision::kInvalid);
+    marginals_before_.clear();
+    for (int i = 0; i < landmarks_before; ++i) {
+      const auto u = static_cast<std::size_t>(i);
+      const Eigen::Index j = 3 + 2 * i;
+      marginals_before_.push_back({g.slots[u], mean_before_.segment<2>(j), cov_before_.diagonal_block<2>(j), g.counts[u]});
+    }
     return JointOutcome::kBrokeDown;
   }
   // The counters live in the state (JointGaussian::counts); the map gets an

@@ -23,10 +23,8 @@ constexpr double kRelineariseDistance = 0.25;  // m
 int append_block(JointGaussian& g, std::uint32_t slot) {
   const Eigen::Index n = g.mean.size();
   g.mean.conservativeResize(n + 2);
-  g.cov_lower.conservativeResize(n + 2, n + 2);
   g.mean.tail<2>().setZero();
-  g.cov_lower.bottomRows<2>().setZero();
-  g.cov_lower.rightCols<2>().setZero();
+  g.cov.grow(2);
   g.slots.push_back(slot);
   g.first.emplace_back(Eigen::Vector2d::Zero());
   g.relative.push_back(0);
@@ -40,11 +38,19 @@ bool JointGaussian::healthy() const {
   // A NaN or infinity in the mean or on the diagonal makes its sum non-finite.
   // Off the diagonal a covariance is bounded by its variances, and an update
   // that makes an entry non-finite makes its row's variance non-finite too.
-  if (!std::isfinite(mean.sum()) || !std::isfinite(cov_lower.diagonal().sum())) return false;
-  for (Eigen::Index i = 0; i < cov_lower.rows(); ++i) {
-    if (cov_lower(i, i) < 0.0 || cov_lower(i, i) > kMaxVariance) return false;
+  if (!std::isfinite(mean.sum())) return false;
+  for (Eigen::Index i = 0; i < cov.size(); ++i) {
+    const double v = cov.lower(i, i);
+    if (!(v >= 0.0 && v <= kMaxVariance)) return false;
   }
   return true;
+}
+
+Eigen::Matrix<double, 3, 2> JointGaussian::pose_landmark_cov(int i) const {
+  const Eigen::Index j = 3 + 2 * i;
+  Eigen::Matrix<double, 3, 2> b;
+  for (int c = 0; c < 3; ++c) b.row(c) << cov.lower(j, c), cov.lower(j + 1, c);
+  return b;
 }
 
 int JointGaussian::find(std::uint32_t slot) const {
@@ -63,7 +69,7 @@ PoseGaussian JointGaussian::pose() const {
 
 void JointGaussian::begin(const PoseGaussian& pose) {
   mean = pose.mean;
-  cov_lower = pose.cov;
+  cov.assign(pose.cov);
   slots.clear();
   first.clear();
   relative.clear();
@@ -73,7 +79,7 @@ void JointGaussian::begin(const PoseGaussian& pose) {
 
 void JointGaussian::clear() {
   mean.resize(0);
-  cov_lower.resize(0, 0);
+  cov.clear();
   slots.clear();
   first.clear();
   relative.clear();
@@ -98,24 +104,36 @@ void JointGaussian::end_frame() {
   if (c.norm() > kRelineariseDistance) return;
   // Fc P Fc^T = P + u P_2. + P_.2 u^T + P_22 u u^T with u = (-c_y, c_x, 0, ...):
   // in the lower triangle only columns 0 and 1 change.
-  Eigen::MatrixXd& p = cov_lower;
-  const Eigen::Index n = p.rows();
   const double u0 = -c.y();
   const double u1 = c.x();
-  const double p20 = p(2, 0), p21 = p(2, 1), p22 = p(2, 2);
-  p(0, 0) += 2.0 * u0 * p20 + u0 * u0 * p22;
-  p(1, 0) += u1 * p20 + u0 * p21 + u0 * u1 * p22;
-  p(1, 1) += 2.0 * u1 * p21 + u1 * u1 * p22;
-  p.col(0).tail(n - 2) += u0 * p.col(2).tail(n - 2);
-  p.col(1).tail(n - 2) += u1 * p.col(2).tail(n - 2);
+  const double p20 = cov.lower(2, 0), p21 = cov.lower(2, 1), p22 = cov.lower(2, 2);
+  cov.lower(0, 0) += 2.0 * u0 * p20 + u0 * u0 * p22;
+  cov.lower(1, 0) += u1 * p20 + u0 * p21 + u0 * u1 * p22;
+  cov.lower(1, 1) += 2.0 * u1 * p21 + u1 * u1 * p22;
+  cov.column(0, 2) += u0 * cov.column(2, 2);
+  cov.column(1, 2) += u1 * cov.column(2, 2);
+}
+
+void JointGaussian::move_pose(const Eigen::Matrix3d& f, const Eigen::Matrix3d& q) {
+  const Eigen::Matrix3d pxx = f * pose_cov() * f.transpose() + q;
+  for (int c = 0; c < 3; ++c) {
+    for (int r = c; r < 3; ++r) cov.lower(r, c) = pxx(r, c);
+  }
+  if (cov.size() == 3) return;
+  // The landmarks' rows of the pose columns: P_lx <- P_lx F^T.
+  PackedSymmetric::Segment c0 = cov.column(0, 3), c1 = cov.column(1, 3), c2 = cov.column(2, 3);
+  for (Eigen::Index r = 0; r < c0.size(); ++r) {
+    const Eigen::Vector3d x(c0(r), c1(r), c2(r));
+    c0(r) = f.row(0).dot(x);
+    c1(r) = f.row(1).dot(x);
+    c2(r) = f.row(2).dot(x);
+  }
 }
 
 void JointGaussian::propagate(double v_mps, double w_radps, double dt_s, const MotionNoise& noise) {
   if (dt_s <= 0.0) return;
   const MotionStep step = motion_step(mean.head<3>(), v_mps, w_radps, dt_s, noise);
-  const Eigen::Index m = mean.size() - 3;
-  cov_lower.topLeftCorner<3, 3>() = step.f * pose_cov() * step.f.transpose() + step.q;
-  if (m > 0) cov_lower.bottomLeftCorner(m, 3) = (cov_lower.bottomLeftCorner(m, 3) * step.f.transpose()).eval();
+  move_pose(step.f, step.q);
   mean.head<3>() = step.mean;
 }
 
@@ -123,11 +141,7 @@ void JointGaussian::apply_motion(const ComposedMotion& motion) {
   if (motion.empty()) return;
   const double c = std::cos(mean(2));
   const double s = std::sin(mean(2));
-  const Eigen::Matrix3d f = motion.jacobian(c, s);
-  const Eigen::Index m = mean.size() - 3;
-  cov_lower.topLeftCorner<3, 3>() = f * pose_cov() * f.transpose() + motion.noise(c, s);
-  // The landmarks' rows of the pose columns: P_lx <- P_lx F^T.
-  if (m > 0) cov_lower.bottomLeftCorner(m, 3) = (cov_lower.bottomLeftCorner(m, 3) * f.transpose()).eval();
+  move_pose(motion.jacobian(c, s), motion.noise(c, s));
   mean.head<3>() = motion.moved_mean(mean.head<3>(), c, s);
 }
 
@@ -135,7 +149,10 @@ int JointGaussian::add_known(std::uint32_t slot, const Eigen::Vector2d& landmark
                              const Eigen::Matrix2d& landmark_cov, LandmarkCounts landmark_counts) {
   const int i = append_block(*this, slot);
   mean.tail<2>() = landmark_mean;
-  cov_lower.bottomRightCorner<2, 2>() = landmark_cov;
+  const Eigen::Index j = 3 + 2 * i;
+  cov.lower(j, j) = landmark_cov(0, 0);
+  cov.lower(j + 1, j) = landmark_cov(1, 0);
+  cov.lower(j + 1, j + 1) = landmark_cov(1, 1);
   first.back() = landmark_mean;
   counts.back() = landmark_counts;
   return i;
@@ -157,13 +174,21 @@ int JointGaussian::add_new(std::uint32_t slot, const Eigen::Vector2d& z, const E
   const Eigen::Matrix3d pxx = pose_cov();
   Eigen::Matrix<double, 2, Eigen::Dynamic> cross(2, n);
   cross.leftCols<3>() = gx * pxx;
-  cross.rightCols(n - 3) = gx * cov_lower.bottomLeftCorner(n - 3, 3).transpose();
+  for (Eigen::Index c = 3; c < n; ++c) {
+    cross.col(c) = gx * Eigen::Vector3d(cov.lower(c, 0), cov.lower(c, 1), cov.lower(c, 2));
+  }
   const int i = append_block(*this, slot);
   mean.tail<2>() = landmark;
   first.back() = landmark;
   relative.back() = 1;
-  cov_lower.bottomLeftCorner(2, n) = cross;
-  cov_lower.bottomRightCorner<2, 2>() = gx * pxx * gx.transpose() + gz * r * gz.transpose();
+  for (Eigen::Index c = 0; c < n; ++c) {
+    cov.lower(n, c) = cross(0, c);
+    cov.lower(n + 1, c) = cross(1, c);
+  }
+  const Eigen::Matrix2d block = gx * pxx * gx.transpose() + gz * r * gz.transpose();
+  cov.lower(n, n) = block(0, 0);
+  cov.lower(n + 1, n) = block(1, 0);
+  cov.lower(n + 1, n + 1) = block(1, 1);
   return i;
 }
 
@@ -226,8 +251,8 @@ JointFit fit_observation_iterated(const JointGaussian& g, int index, const Eigen
 
 bool apply_observation(JointGaussian& g, const JointFit& fit) {
   const Eigen::Index j = 3 + 2 * fit.index;
-  Eigen::MatrixXd& p = g.cov_lower;
-  const Eigen::Index n = p.rows();
+  PackedSymmetric& p = g.cov;
+  const Eigen::Index n = p.size();
   // Scratch without an allocation per update: P H^T, K, A and K nu.
   thread_local std::vector<double> scratch;
   scratch.resize(static_cast<std::size_t>(7 * n));
@@ -237,13 +262,21 @@ bool apply_observation(JointGaussian& g, const JointFit& fit) {
   Columns2 a(scratch.data() + 4 * n, n, 2);
   Eigen::Map<Eigen::VectorXd> step(scratch.data() + 6 * n, n);
   // P H^T touches only the pose and landmark columns of P, read from the lower
-  // triangle: the pose columns' rows below the pose block, the landmark's rows
-  // left of its block (within the columns the update writes anyway) and below.
-  pht.topRows<3>().noalias() = g.pose_cov() * fit.h_pose.transpose();
-  pht.bottomRows(n - 3).noalias() = p.bottomLeftCorner(n - 3, 3) * fit.h_pose.transpose();
-  pht.topRows(j).noalias() += p.block(j, 0, 2, j).transpose() * fit.h_landmark.transpose();
-  pht.middleRows<2>(j).noalias() += g.landmark_cov(fit.index) * fit.h_landmark.transpose();
-  pht.bottomRows(n - j - 2).noalias() += p.bottomRows(n - j - 2).middleCols<2>(j) * fit.h_landmark.transpose();
+  // triangle: the pose columns below the pose block, the landmark's rows left
+  // of its block (in columns the update writes anyway) and its columns below.
+  const Eigen::Matrix<double, 3, 2> hp = fit.h_pose.transpose();
+  const Eigen::Matrix2d hl = fit.h_landmark.transpose();
+  pht.topRows<3>().noalias() = g.pose_cov() * hp;
+  for (int q = 0; q < 2; ++q) {
+    pht.col(q).tail(n - 3) = p.column(0, 3) * hp(0, q) + p.column(1, 3) * hp(1, q) + p.column(2, 3) * hp(2, q);
+  }
+  for (Eigen::Index r = 0; r < j; ++r) pht.row(r) += Eigen::RowVector2d(p.lower(j, r), p.lower(j + 1, r)) * hl;
+  pht.middleRows<2>(j).noalias() += g.landmark_cov(fit.index) * hl;
+  if (j + 2 < n) {
+    for (int q = 0; q < 2; ++q) {
+      pht.col(q).tail(n - j - 2) += p.column(j, j + 2) * hl(0, q) + p.column(j + 1, j + 2) * hl(1, q);
+    }
+  }
   const Eigen::Matrix2d s_inverse = fit.s.inverse();
   k.noalias() = pht * s_inverse;
   step.noalias() = k * fit.innovation;
@@ -256,13 +289,13 @@ bool apply_observation(JointGaussian& g, const JointFit& fit) {
   // healthy() (finite, variances in [0, kMaxVariance]).
   if (!std::isfinite(step.sum()) || !std::isfinite(a.sum())) return false;
   for (Eigen::Index r = 0; r < n; ++r) {
-    const double v = p(r, r) - (a(r, 0) * a(r, 0) + a(r, 1) * a(r, 1));
+    const double v = p.lower(r, r) - (a(r, 0) * a(r, 0) + a(r, 1) * a(r, 1));
     if (!(v >= 0.0 && v <= kMaxVariance)) return false;
   }
   g.mean += step;
   g.mean(2) = wrap_angle(g.mean(2));
   for (Eigen::Index c = 0; c < n; ++c) {
-    p.col(c).tail(n - c) -= a.col(0).tail(n - c) * a(c, 0) + a.col(1).tail(n - c) * a(c, 1);
+    p.column(c, c) -= a.col(0).tail(n - c) * a(c, 0) + a.col(1).tail(n - c) * a(c, 1);
   }
   return true;
 }
@@ -308,7 +341,7 @@ void to_robocentric(const JointGaussian& g, Eigen::VectorXd& mean, Eigen::Matrix
     j.block<2, 1>(b, 2) = drt * d;
     j.block<2, 2>(b, b) = rt;
   }
-  cov = j * g.covariance() * j.transpose();
+  cov = j * g.cov.full() * j.transpose();
 }
 
 // Back to world coordinates, m = p + R(theta) m_R, into `out` (a copy of the
@@ -332,7 +365,7 @@ void from_robocentric(const JointGaussian& from, const Eigen::VectorXd& mean, co
     j.block<2, 1>(b, 2) = dr * m_r;
     j.block<2, 2>(b, b) = r;
   }
-  out.cov_lower = j * cov * j.transpose();
+  out.cov.assign(j * cov * j.transpose());
   const Eigen::Matrix2d turn = r * rotation(before(2)).transpose();
   const auto move = [&](const Eigen::Vector2d& q) -> Eigen::Vector2d {
     return after.head<2>() + turn * (q - before.head<2>());

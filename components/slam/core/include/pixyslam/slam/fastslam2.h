@@ -292,7 +292,10 @@ class FastSlam2 {
   std::vector<int> gated_votes_;
   std::vector<char> any_new_;            // per detection: some particle started a landmark with it
   std::vector<Decision> copy_decisions_;  // update_copies: the decisions of the first copy
-  std::vector<ConditionedLandmark> marginals_before_;  // update_joint_state: the landmarks before the frame
+  // update_joint_state: the state before the frame, and on a breakdown its landmarks.
+  Eigen::VectorXd mean_before_;
+  PackedSymmetric cov_before_;
+  std::vector<ConditionedLandmark> marginals_before_;
   FilterCounters counters_;
 };
 

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include "pixyslam/slam/motion_model.h"
+#include "pixyslam/slam/packed_symmetric.h"
 #include "pixyslam/slam/types.h"
 
 namespace pixyslam::slam {
@@ -35,10 +36,9 @@ struct LandmarkCounts {
 // Plain data; an empty JointGaussian (no state) is inactive.
 struct JointGaussian {
   Eigen::VectorXd mean;
-  // The covariance's lower triangle (row >= column); the entries above the
-  // diagonal are not kept, so an update moves half the bytes. Read it through
-  // covariance() or the block accessors below.
-  Eigen::MatrixXd cov_lower;
+  // The covariance, packed: with thousands of particles the filter waits on
+  // memory, and an update streams half the bytes of dense storage.
+  PackedSymmetric cov;
   std::vector<std::uint32_t> slots;       // landmark slot of state block i (at 3 + 2i)
   std::vector<Eigen::Vector2d> first;     // first estimate of landmark i
   // Landmark i was first seen in this state (add_new): placed relative to the
@@ -58,17 +58,11 @@ struct JointGaussian {
   int find(std::uint32_t slot) const;
   PoseGaussian pose() const;
   Eigen::Vector2d landmark_mean(int i) const { return mean.segment<2>(3 + 2 * i); }
-  Eigen::Matrix3d pose_cov() const { return cov_lower.topLeftCorner<3, 3>().selfadjointView<Eigen::Lower>(); }
-  Eigen::Matrix2d landmark_cov(int i) const {
-    return cov_lower.block<2, 2>(3 + 2 * i, 3 + 2 * i).selfadjointView<Eigen::Lower>();
-  }
+  Eigen::Matrix3d pose_cov() const { return cov.diagonal_block<3>(0); }
+  Eigen::Matrix2d landmark_cov(int i) const { return cov.diagonal_block<2>(3 + 2 * i); }
   // Cov(pose, landmark i), 3 x 2.
-  Eigen::Matrix<double, 3, 2> pose_landmark_cov(int i) const {
-    return cov_lower.block<2, 3>(3 + 2 * i, 0).transpose();
-  }
-  double heading_variance() const { return cov_lower(2, 2); }
-  // The whole covariance, both triangles.
-  Eigen::MatrixXd covariance() const { return cov_lower.selfadjointView<Eigen::Lower>(); }
+  Eigen::Matrix<double, 3, 2> pose_landmark_cov(int i) const;
+  double heading_variance() const { return cov.lower(2, 2); }
 
   // Starts from a pose Gaussian with no landmarks.
   void begin(const PoseGaussian& pose);
@@ -77,6 +71,8 @@ struct JointGaussian {
   void propagate(double v_mps, double w_radps, double dt_s, const MotionNoise& noise);
   // The same for several steps at once (ComposedMotion): one 3 x n product.
   void apply_motion(const ComposedMotion& motion);
+  // P <- F P F^T + Q with F and Q on the pose block only.
+  void move_pose(const Eigen::Matrix3d& f, const Eigen::Matrix3d& q);
   // Brackets the observations of one frame. end_frame() re-linearises the motion
   // Jacobian at the predicted pose: with c the position correction of the frame,
   // P <- Fc P Fc^T, Fc = I + [0 0 -c_y; 0 0 c_x; 0 0 0] (the unicycle Jacobians
