@@ -35,9 +35,10 @@ int append_block(JointGaussian& g, std::uint32_t slot) {
 }  // namespace
 
 bool JointGaussian::healthy() const {
-  // A NaN or infinity in the mean or on the diagonal makes its sum non-finite.
-  // Off the diagonal a covariance is bounded by its variances, and an update
-  // that makes an entry non-finite makes its row's variance non-finite too.
+  // A NaN or infinity in the mean makes its sum non-finite; on the diagonal it
+  // fails the range check. Off the diagonal a covariance is bounded by its
+  // variances, and an update that makes an entry non-finite makes its row's
+  // variance non-finite too.
   if (!std::isfinite(mean.sum())) return false;
   for (Eigen::Index i = 0; i < cov.size(); ++i) {
     const double v = cov.lower(i, i);
