@@ -175,16 +175,16 @@ int JointGaussian::add_new(std::uint32_t slot, const Eigen::Vector2d& z, const E
   const Eigen::Matrix3d pxx = pose_cov();
   Eigen::Matrix<double, 2, Eigen::Dynamic> cross(2, n);
   cross.leftCols<3>() = gx * pxx;
-  for (Eigen::Index c = 3; c < n; ++c) {
-    cross.col(c) = gx * Eigen::Vector3d(cov.lower(c, 0), cov.lower(c, 1), cov.lower(c, 2));
+  for (Eigen::Index k = 3; k < n; ++k) {
+    cross.col(k) = gx * Eigen::Vector3d(cov.lower(k, 0), cov.lower(k, 1), cov.lower(k, 2));
   }
   const int i = append_block(*this, slot);
   mean.tail<2>() = landmark;
   first.back() = landmark;
   relative.back() = 1;
-  for (Eigen::Index c = 0; c < n; ++c) {
-    cov.lower(n, c) = cross(0, c);
-    cov.lower(n + 1, c) = cross(1, c);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    cov.lower(n, k) = cross(0, k);
+    cov.lower(n + 1, k) = cross(1, k);
   }
   const Eigen::Matrix2d block = gx * pxx * gx.transpose() + gz * r * gz.transpose();
   cov.lower(n, n) = block(0, 0);
