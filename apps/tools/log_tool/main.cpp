@@ -220,7 +220,7 @@ int main(int argc, char** argv) {
       .type("N");
   compare.flag("--until-unmatched", compare_request.until_unmatched,
                "with --match: pairs after the first message without a partner may differ (inputs taken in "
-               "another order from there); those before it must agree and be at least half");
+               "another order from there); those before it must agree, and at least half of all pairs must");
 
   log_tool::FoxgloveRequest foxglove_request;
   std::vector<std::string> foxglove_files;

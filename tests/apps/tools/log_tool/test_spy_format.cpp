@@ -304,6 +304,15 @@ TEST(PairMessages, ByKeyFieldsInOrderAndByPositionWithout) {
   EXPECT_EQ(by_position.only_first.size(), 5u);
   EXPECT_EQ(pairs_before_first_unmatched(by_position), 1u);
   EXPECT_EQ(pairs_before_first_unmatched(pair_messages(live, live, {"odometry_sequence"})), live.size());
+  // --until-unmatched: nothing before the first unmatched message may differ,
+  // and at least half of all pairs must agree, wherever that message is (a CI
+  // replay of 2026-11-27: 346 of 839 pairs before it, none after it differing).
+  EXPECT_TRUE(until_unmatched_passes(839, 0, 0));
+  EXPECT_TRUE(until_unmatched_passes(838, 0, 144));
+  EXPECT_TRUE(until_unmatched_passes(10, 0, 5));
+  EXPECT_FALSE(until_unmatched_passes(10, 0, 6));
+  EXPECT_FALSE(until_unmatched_passes(839, 1, 0));
+  EXPECT_TRUE(until_unmatched_passes(0, 0, 0));
 }
 
 TEST(SpyFormat, StringsAreEscapedAndNonFiniteNumbersStayValid) {

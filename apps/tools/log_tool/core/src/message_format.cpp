@@ -578,6 +578,11 @@ std::size_t pairs_before_first_unmatched(const MessagePairs& p) {
   return k;
 }
 
+bool until_unmatched_passes(std::size_t pairs, std::size_t differing_before, std::size_t differing_after) {
+  if (differing_before > 0 || differing_after > pairs) return false;
+  return 2 * (pairs - differing_after) >= pairs;
+}
+
 std::vector<std::string> compare_values(const Value& a, const Value& b, const std::vector<std::string>& ignored,
                                         double tolerance, std::size_t max_lines) {
   Comparison comparison{ignored, tolerance, max_lines, {}};

@@ -527,8 +527,9 @@ int run_compare(const CompareRequest& request, std::ostream& out) {
   if (request.until_unmatched) {
     out << before_unmatched << " of " << n << " pairs before the first message without a partner; "
         << differing_after << " after it differ (allowed: --until-unmatched)\n";
-    if (2 * before_unmatched < n) {
-      out << "too few pairs before the first message without a partner\n";
+    if (!until_unmatched_passes(n, differing, differing_after)) {
+      out << "too few identical pairs: " << n - differing - differing_after << " of " << n
+          << " (at least half must be)\n";
       same = false;
     }
   }

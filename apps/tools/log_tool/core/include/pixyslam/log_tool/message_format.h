@@ -101,6 +101,10 @@ MessagePairs pair_messages(const std::vector<Value>& first, const std::vector<Va
 // How many of p.pairs come before the first message of either file that has no
 // partner (all of them when every message has one). Pure.
 std::size_t pairs_before_first_unmatched(const MessagePairs& p);
+// compare --until-unmatched: the pairs before the first message without a
+// partner must all agree (differing_before 0), and at least half of all pairs
+// must agree; pairs after it may differ. Pure.
+bool until_unmatched_passes(std::size_t pairs, std::size_t differing_before, std::size_t differing_after);
 
 // Inter-arrival statistics of a stream (pixyslam_spy hz), times in seconds.
 struct GapStats {
