@@ -116,10 +116,7 @@ void JointGaussian::end_frame() {
 }
 
 void JointGaussian::move_pose(const Eigen::Matrix3d& f, const Eigen::Matrix3d& q) {
-  const Eigen::Matrix3d pxx = f * pose_cov() * f.transpose() + q;
-  for (int c = 0; c < 3; ++c) {
-    for (int r = c; r < 3; ++r) cov.lower(r, c) = pxx(r, c);
-  }
+  cov.set_diagonal_block<3>(0, f * pose_cov() * f.transpose() + q);
   if (cov.size() == 3) return;
   // The landmarks' rows of the pose columns: P_lx <- P_lx F^T.
   PackedSymmetric::Segment c0 = cov.column(0, 3), c1 = cov.column(1, 3), c2 = cov.column(2, 3);
@@ -150,10 +147,7 @@ int JointGaussian::add_known(std::uint32_t slot, const Eigen::Vector2d& landmark
                              const Eigen::Matrix2d& landmark_cov, LandmarkCounts landmark_counts) {
   const int i = append_block(*this, slot);
   mean.tail<2>() = landmark_mean;
-  const Eigen::Index j = 3 + 2 * i;
-  cov.lower(j, j) = landmark_cov(0, 0);
-  cov.lower(j + 1, j) = landmark_cov(1, 0);
-  cov.lower(j + 1, j + 1) = landmark_cov(1, 1);
+  cov.set_diagonal_block<2>(3 + 2 * i, landmark_cov);
   first.back() = landmark_mean;
   counts.back() = landmark_counts;
   return i;
@@ -186,10 +180,7 @@ int JointGaussian::add_new(std::uint32_t slot, const Eigen::Vector2d& z, const E
     cov.lower(n, k) = cross(0, k);
     cov.lower(n + 1, k) = cross(1, k);
   }
-  const Eigen::Matrix2d block = gx * pxx * gx.transpose() + gz * r * gz.transpose();
-  cov.lower(n, n) = block(0, 0);
-  cov.lower(n + 1, n) = block(1, 0);
-  cov.lower(n + 1, n + 1) = block(1, 1);
+  cov.set_diagonal_block<2>(n, gx * pxx * gx.transpose() + gz * r * gz.transpose());
   return i;
 }
 

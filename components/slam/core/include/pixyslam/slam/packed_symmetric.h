@@ -40,6 +40,13 @@ class PackedSymmetric {
     }
     return b;
   }
+  // Sets that block from the lower triangle of symmetric b.
+  template <int K>
+  void set_diagonal_block(Eigen::Index i, const Eigen::Matrix<double, K, K>& b) {
+    for (int c = 0; c < K; ++c) {
+      for (int r = c; r < K; ++r) lower(i + r, i + c) = b(r, c);
+    }
+  }
 
   void assign(const Eigen::MatrixXd& m);  // the lower triangle of square m
   Eigen::MatrixXd full() const;           // both triangles
