@@ -59,7 +59,7 @@ struct CompareRequest {
   // With match: pairs after the first message without a partner may differ
   // (a replayed estimator that took an odometry sample after a newer frame,
   // where the live one did not, applies it at another time from there on);
-  // every pair before it must agree, and they must be at least half.
+  // every pair before it must agree, and at least half of all pairs must.
   bool until_unmatched = false;
 };
 
