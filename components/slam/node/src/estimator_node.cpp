@@ -292,7 +292,8 @@ void EstimatorNode::log_status() const {
   const slam::FilterCounters f = filter_ ? filter_->counters() : slam::FilterCounters{};
   std::fprintf(stderr,
                "slam_estimator: odometry %llu (lost %llu), observations %llu (lost %llu), other robots' %llu, "
-               "steps %llu, late %llu, reordered %llu; detections used %llu, new %llu, gated %llu, "
+               "steps %llu, late %llu (frames at their stamp %llu; applied late: odometry %llu, frames %llu), "
+               "reordered %llu; detections used %llu, new %llu, gated %llu, "
                "invalid %llu; resamples %llu; landmarks %zu; checkpoints %llu (errors %llu)%s\n",
                static_cast<unsigned long long>(c.odometry_received),
                static_cast<unsigned long long>(c.odometry_lost),
@@ -300,6 +301,8 @@ void EstimatorNode::log_status() const {
                static_cast<unsigned long long>(c.observations_lost),
                static_cast<unsigned long long>(c.other_robot_samples),
                static_cast<unsigned long long>(c.steps), static_cast<unsigned long long>(c.samples_late),
+               static_cast<unsigned long long>(f.frames_late), static_cast<unsigned long long>(f.odometry_out_of_order),
+               static_cast<unsigned long long>(f.frames_out_of_order),
                static_cast<unsigned long long>(c.samples_reordered),
                static_cast<unsigned long long>(f.observations_used),
                static_cast<unsigned long long>(f.observations_new_landmark),
