@@ -305,6 +305,48 @@ TEST(EstimatorNode, ReportsRejectedInputOnTheDiagnosticsTopic) {
   EXPECT_EQ(counter(reports.back(), "odometry_invalid"), 1);
 }
 
+// Odometry that comes after a camera frame was released without it (the frame
+// waited out the odometry's max delay) is applied at the filter time, and the
+// estimator says so, naming the stamp and how late it was.
+TEST(EstimatorNode, OdometryAppliedLateIsNamedWithItsStamp) {
+  EstimatorOptions options = test_options();
+  EstimatorNode node(options);
+  node.start();
+  dds::Participant sensors(options.dds, "test_sensors");
+  dds::Writer<msg::Odometry> odometry_writer(sensors);
+  dds::Writer<msg::LandmarkObservation> observation_writer(sensors);
+  ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  testing::internal::CaptureStderr();
+  const std::uint64_t base_ns = dds::now_ns();
+  slam::OdometrySample s;
+  s.v_mps = 0.1;
+  for (int i = 0; i < 2; ++i) {
+    s.t_s = 0.1 * i;
+    msg::Odometry m = test_support::odometry_msg(s, 0.1, to_stamp_ns(s.t_s, base_ns));
+    ASSERT_TRUE(odometry_writer.publish(m));
+  }
+  slam::ObservationFrame frame;
+  frame.t_s = 0.55;
+  msg::LandmarkObservation observation = test_support::observation_msg(frame, to_stamp_ns(frame.t_s, base_ns));
+  ASSERT_TRUE(observation_writer.publish(observation));
+  // The frame goes to the filter once the odometry has been silent for its max delay (with
+  // time to spare for a recovery wait, should the first samples arrive late on a busy host).
+  const auto released_by = std::chrono::duration<double>(frame.t_s + options.queue.odometry_max_delay_s + 1.5);
+  std::this_thread::sleep_until(std::chrono::steady_clock::now() + released_by);
+  s.t_s = 0.2;
+  msg::Odometry late = test_support::odometry_msg(s, 0.1, to_stamp_ns(s.t_s, base_ns));
+  ASSERT_TRUE(odometry_writer.publish(late));
+  ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  node.stop();
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("odometry stamped 0.200 s came after the filter had reached 0.550 s (0.350 s late"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(node.counters().samples_late, 1u);
+}
+
 // Two robots on one domain: each estimator takes its own robot's sensors only
 // (header.robot_id = its dds.robot_id) and counts the other's as ignored.
 TEST(EstimatorNode, TwoRobotsOnOneDomainEachEstimatorReadsItsOwn) {

@@ -188,6 +188,8 @@ void EstimatorNode::step(const slam::SensorInput& input) {
   std::lock_guard<std::mutex> lock(state_mutex_);
   const auto begin = std::chrono::steady_clock::now();
   if (!filter_) create_filter(slam::input_time(input));
+  const double filter_time_s = filter_->time_s();
+  const slam::FilterCounters before = filter_->counters();
   if (const auto* odometry = std::get_if<slam::OdometryInput>(&input)) {
     filter_->add_odometry(odometry->sample);
     last_odometry_seq_ = odometry->seq;
@@ -196,6 +198,7 @@ void EstimatorNode::step(const slam::SensorInput& input) {
     filter_->add_observations(observation.frame);
     last_observation_seq_ = observation.seq;
   }
+  warn_if_applied_late(input, filter_time_s, before);
   StepInfo info;
   info.epoch_ns = inbox_.epoch_ns();
   info.odometry_seq = last_odometry_seq_;
@@ -219,6 +222,21 @@ void EstimatorNode::step(const slam::SensorInput& input) {
        stamp >= last_checkpoint_ns_ + static_cast<std::uint64_t>(options_.checkpoint.period_s * 1e9))) {
     write_checkpoint(false);
   }
+}
+
+void EstimatorNode::warn_if_applied_late(const slam::SensorInput& input, double filter_time_s,
+                                         const slam::FilterCounters& before) {
+  const slam::FilterCounters& after = filter_->counters();
+  const bool odometry = after.odometry_out_of_order > before.odometry_out_of_order;
+  if (!odometry && after.frames_out_of_order == before.frames_out_of_order) return;
+  // The first ten, then every hundredth: a clock step could make every sample late.
+  const std::uint64_t n = after.odometry_out_of_order + after.frames_out_of_order;
+  if (n > 10 && n % 100 != 0) return;
+  std::fprintf(stderr,
+               "slam_estimator: %s stamped %.3f s came after the filter had reached %.3f s (%.3f s late; a "
+               "sample of the other stream was released without it): applied at the filter time (%llu so far)\n",
+               odometry ? "odometry" : "a camera frame", slam::input_time(input), filter_time_s,
+               filter_time_s - slam::input_time(input), static_cast<unsigned long long>(n));
 }
 
 void EstimatorNode::publish_map_state() {
