@@ -233,10 +233,12 @@ void EstimatorNode::warn_if_applied_late(const slam::SensorInput& input, double 
   const std::uint64_t n = after.odometry_out_of_order + after.frames_out_of_order;
   if (n > 10 && n % 100 != 0) return;
   std::fprintf(stderr,
-               "slam_estimator: %s stamped %.3f s came after the filter had reached %.3f s (%.3f s late; a "
-               "sample of the other stream was released without it): applied at the filter time (%llu so far)\n",
+               "slam_estimator: %s stamped %.3f s came after the filter had reached %.3f s (%.3f s late; %s): "
+               "applied at the filter time (%llu so far)\n",
                odometry ? "odometry" : "a camera frame", slam::input_time(input), filter_time_s,
-               filter_time_s - slam::input_time(input), static_cast<unsigned long long>(n));
+               filter_time_s - slam::input_time(input),
+               odometry ? "a camera frame was released without it" : "older than the last frame",
+               static_cast<unsigned long long>(n));
 }
 
 void EstimatorNode::publish_map_state() {
