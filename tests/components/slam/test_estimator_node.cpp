@@ -76,6 +76,20 @@ sim::WorldOptions test_world(double duration_s) {
   return world;
 }
 
+// The sensors' side of a test: one participant with an odometry and a camera writer.
+struct SensorWriters {
+  explicit SensorWriters(const dds::DdsOptions& options)
+      : participant(options, "test_sensors"), odometry(participant), observations(participant) {}
+  // Both writers matched with the estimator's readers (within 10 s each).
+  bool matched() {
+    return odometry.wait_for_readers(1, std::chrono::seconds(10)) &&
+           observations.wait_for_readers(1, std::chrono::seconds(10));
+  }
+  dds::Participant participant;
+  dds::Writer<msg::Odometry> odometry;
+  dds::Writer<msg::LandmarkObservation> observations;
+};
+
 TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
   const sim::WorldOptions world = test_world(60.0);
   const sim::WorldRun run = sim::simulate(world);
@@ -88,24 +102,21 @@ TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
   EstimatorNode node(options);
   node.start();
 
-  dds::Participant sensors(options.dds, "test_sensors");
-  dds::Writer<msg::Odometry> odometry_writer(sensors);
-  dds::Writer<msg::LandmarkObservation> observation_writer(sensors);
+  SensorWriters sensors(options.dds);
   std::mutex mutex;
   std::vector<msg::MapState> states;
-  dds::Reader<msg::MapState> map_reader(sensors, [&](const msg::MapState& m) {
+  dds::Reader<msg::MapState> map_reader(sensors.participant, [&](const msg::MapState& m) {
     std::lock_guard<std::mutex> lock(mutex);
     states.push_back(m);
   });
-  ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
-  ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(sensors.matched());
 
   // About 700 messages a second: a MapState reader starved for a while (a busy
   // host) is still within the 1024 states both sides keep. Unpaced, the estimator
   // answered at ~1600 states a second and a loaded CI run lost 68 of 1138.
-  feed(run, 0.0, world.duration_s, base_ns, odometry_writer, observation_writer, std::chrono::microseconds(1500));
-  ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
-  ASSERT_TRUE(observation_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+  feed(run, 0.0, world.duration_s, base_ns, sensors.odometry, sensors.observations, std::chrono::microseconds(1500));
+  ASSERT_TRUE(sensors.odometry.wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(sensors.observations.wait_for_acknowledgments(std::chrono::seconds(10)));
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   node.stop();
 
@@ -159,14 +170,11 @@ TEST(EstimatorNode, ResumesFromItsCheckpointAfterARestart) {
   auto run_node = [&](double from_s, double to_s, std::vector<eval::TimedPose>& estimate, bool& resumed) {
     EstimatorNode node(options);
     node.start();
-    dds::Participant sensors(options.dds, "test_sensors");
-    dds::Writer<msg::Odometry> odometry_writer(sensors);
-    dds::Writer<msg::LandmarkObservation> observation_writer(sensors);
-    ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
-    ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
-    feed(run, from_s, to_s, base_ns, odometry_writer, observation_writer);
-    ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
-    ASSERT_TRUE(observation_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+    SensorWriters sensors(options.dds);
+    ASSERT_TRUE(sensors.matched());
+    feed(run, from_s, to_s, base_ns, sensors.odometry, sensors.observations);
+    ASSERT_TRUE(sensors.odometry.wait_for_acknowledgments(std::chrono::seconds(10)));
+    ASSERT_TRUE(sensors.observations.wait_for_acknowledgments(std::chrono::seconds(10)));
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
     node.stop();
     EXPECT_GT(node.counters().checkpoints_written, 10u);
@@ -312,11 +320,8 @@ TEST(EstimatorNode, OdometryAppliedLateIsNamedWithItsStamp) {
   EstimatorOptions options = test_options();
   EstimatorNode node(options);
   node.start();
-  dds::Participant sensors(options.dds, "test_sensors");
-  dds::Writer<msg::Odometry> odometry_writer(sensors);
-  dds::Writer<msg::LandmarkObservation> observation_writer(sensors);
-  ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
-  ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  SensorWriters sensors(options.dds);
+  ASSERT_TRUE(sensors.matched());
   testing::internal::CaptureStderr();
   const std::uint64_t base_ns = dds::now_ns();
   slam::OdometrySample s;
@@ -324,20 +329,20 @@ TEST(EstimatorNode, OdometryAppliedLateIsNamedWithItsStamp) {
   for (int i = 0; i < 2; ++i) {
     s.t_s = 0.1 * i;
     msg::Odometry m = test_support::odometry_msg(s, 0.1, to_stamp_ns(s.t_s, base_ns));
-    ASSERT_TRUE(odometry_writer.publish(m));
+    ASSERT_TRUE(sensors.odometry.publish(m));
   }
   slam::ObservationFrame frame;
   frame.t_s = 0.55;
   msg::LandmarkObservation observation = test_support::observation_msg(frame, to_stamp_ns(frame.t_s, base_ns));
-  ASSERT_TRUE(observation_writer.publish(observation));
+  ASSERT_TRUE(sensors.observations.publish(observation));
   // The frame goes to the filter once the odometry has been silent for its max delay (with
   // time to spare for a recovery wait, should the first samples arrive late on a busy host).
   const auto released_by = std::chrono::duration<double>(frame.t_s + options.queue.odometry_max_delay_s + 1.5);
   std::this_thread::sleep_until(std::chrono::steady_clock::now() + released_by);
   s.t_s = 0.2;
   msg::Odometry late = test_support::odometry_msg(s, 0.1, to_stamp_ns(s.t_s, base_ns));
-  ASSERT_TRUE(odometry_writer.publish(late));
-  ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(sensors.odometry.publish(late));
+  ASSERT_TRUE(sensors.odometry.wait_for_acknowledgments(std::chrono::seconds(10)));
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   node.stop();
   const std::string err = testing::internal::GetCapturedStderr();
