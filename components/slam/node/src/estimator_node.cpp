@@ -160,6 +160,11 @@ std::vector<std::pair<std::uint64_t, slam::Pose2>> EstimatorNode::trajectory() c
   return trajectory_;
 }
 
+namespace {
+// Samples the filter applied at its own time instead of their stamp.
+std::uint64_t applied_late(const slam::FilterCounters& f) { return f.odometry_out_of_order + f.frames_out_of_order; }
+}  // namespace
+
 void EstimatorNode::filter_loop() {
   using Clock = std::chrono::steady_clock;
   auto next_status = Clock::now() + std::chrono::duration<double>(options_.status_period_s);
@@ -189,7 +194,7 @@ void EstimatorNode::step(const slam::SensorInput& input) {
   const auto begin = std::chrono::steady_clock::now();
   if (!filter_) create_filter(slam::input_time(input));
   const double filter_time_s = filter_->time_s();
-  const slam::FilterCounters before = filter_->counters();
+  const std::uint64_t applied_late_before = applied_late(filter_->counters());
   if (const auto* odometry = std::get_if<slam::OdometryInput>(&input)) {
     filter_->add_odometry(odometry->sample);
     last_odometry_seq_ = odometry->seq;
@@ -198,7 +203,7 @@ void EstimatorNode::step(const slam::SensorInput& input) {
     filter_->add_observations(observation.frame);
     last_observation_seq_ = observation.seq;
   }
-  warn_if_applied_late(input, filter_time_s, before);
+  warn_if_applied_late(input, filter_time_s, applied_late_before);
   StepInfo info;
   info.epoch_ns = inbox_.epoch_ns();
   info.odometry_seq = last_odometry_seq_;
@@ -225,13 +230,12 @@ void EstimatorNode::step(const slam::SensorInput& input) {
 }
 
 void EstimatorNode::warn_if_applied_late(const slam::SensorInput& input, double filter_time_s,
-                                         const slam::FilterCounters& before) {
-  const slam::FilterCounters& after = filter_->counters();
-  const bool odometry = after.odometry_out_of_order > before.odometry_out_of_order;
-  if (!odometry && after.frames_out_of_order == before.frames_out_of_order) return;
+                                         std::uint64_t applied_late_before) {
+  const std::uint64_t n = applied_late(filter_->counters());
+  if (n == applied_late_before) return;
   // The first ten, then every hundredth: a clock step could make every sample late.
-  const std::uint64_t n = after.odometry_out_of_order + after.frames_out_of_order;
   if (n > 10 && n % 100 != 0) return;
+  const bool odometry = std::holds_alternative<slam::OdometryInput>(input);
   std::fprintf(stderr,
                "slam_estimator: %s stamped %.3f s came after the filter had reached %.3f s (%.3f s late; %s): "
                "applied at the filter time (%llu so far)\n",
