@@ -5,10 +5,20 @@
 # scripts/run_tests.sh -L unit.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-"$root/scripts/install_deps.sh"
-"$root/scripts/build.sh"
+# Each phase's wall time, on one line at the end (and when a phase fails).
+phases=""
+phase() {
+  local name=$1 start=$SECONDS rc=0
+  shift
+  "$@" || rc=$?
+  phases+=" $name $((SECONDS - start)) s,"
+  ((rc == 0)) || echo "run_tests: $name failed (exit status $rc) after $((SECONDS - start)) s"
+  return "$rc"
+}
+phase install "$root/scripts/install_deps.sh"
+phase build "$root/scripts/build.sh"
 if [[ ${PIXYSLAM_ARMHF:-1} != 0 ]]; then
-  "$root/scripts/cross_build_armhf.sh" --no-tests --build-dir "$root/build-armhf"
+  phase armhf_build "$root/scripts/cross_build_armhf.sh" --no-tests --build-dir "$root/build-armhf"
 fi
 build_dir=${BUILD_DIR:-$root/build}
 # Two tests more than cores: the DDS tests (one at a time, RESOURCE_LOCK dds)
@@ -20,8 +30,10 @@ build_dir=${BUILD_DIR:-$root/build}
 # early and they do not load the cores beside the timing-sensitive DDS runs).
 status=0
 if (($# == 0)); then
-  ctest --test-dir "$build_dir" --output-on-failure --parallel "$(nproc)" --timeout 600 -L '^unit$' || status=$?
+  phase unit_tests ctest --test-dir "$build_dir" --output-on-failure --parallel "$(nproc)" --timeout 600 -L '^unit$' ||
+    status=$?
   set -- -LE '^unit$'
 fi
-ctest --test-dir "$build_dir" --output-on-failure --parallel "$(($(nproc) + 2))" --timeout 600 "$@" || status=$?
+phase tests ctest --test-dir "$build_dir" --output-on-failure --parallel "$(($(nproc) + 2))" --timeout 600 "$@" || status=$?
+echo "run_tests: ${phases%,} (total $SECONDS s)"
 exit "$status"
