@@ -313,10 +313,11 @@ TEST(EstimatorNode, ReportsRejectedInputOnTheDiagnosticsTopic) {
   EXPECT_EQ(counter(reports.back(), "odometry_invalid"), 1);
 }
 
+// A sample older than the filter time, named with its stamp and how it was applied.
 // Odometry that comes after a camera frame was released without it (the frame
-// waited out the odometry's max delay) is applied at the filter time, and the
-// estimator says so, naming the stamp and how late it was.
-TEST(EstimatorNode, OdometryAppliedLateIsNamedWithItsStamp) {
+// waited out the odometry's max delay) is applied at the filter time; a camera
+// frame that comes after newer odometry was released is applied at its stamp.
+TEST(EstimatorNode, LateSamplesAreNamedWithTheirStamps) {
   EstimatorOptions options = test_options();
   EstimatorNode node(options);
   node.start();
@@ -326,30 +327,47 @@ TEST(EstimatorNode, OdometryAppliedLateIsNamedWithItsStamp) {
   const std::uint64_t base_ns = dds::now_ns();
   slam::OdometrySample s;
   s.v_mps = 0.1;
-  for (int i = 0; i < 2; ++i) {
-    s.t_s = 0.1 * i;
-    msg::Odometry m = test_support::odometry_msg(s, 0.1, to_stamp_ns(s.t_s, base_ns));
+  auto send_odometry = [&](double t_s) {
+    s.t_s = t_s;
+    msg::Odometry m = test_support::odometry_msg(s, 0.1, to_stamp_ns(t_s, base_ns));
     ASSERT_TRUE(sensors.odometry.publish(m));
-  }
-  slam::ObservationFrame frame;
-  frame.t_s = 0.55;
-  msg::LandmarkObservation observation = test_support::observation_msg(frame, to_stamp_ns(frame.t_s, base_ns));
-  ASSERT_TRUE(sensors.observations.publish(observation));
+    // Taken before anything sent after it. The stamps printed count from the first sample the
+    // estimator takes: the odometry at 0.0, not the frame (on a busy host the frame once
+    // overtook it: "stamped -0.350 s").
+    ASSERT_TRUE(sensors.odometry.wait_for_acknowledgments(std::chrono::seconds(10)));
+  };
+  auto send_frame = [&](double t_s) {
+    slam::ObservationFrame frame;
+    frame.t_s = t_s;
+    msg::LandmarkObservation m = test_support::observation_msg(frame, to_stamp_ns(t_s, base_ns));
+    ASSERT_TRUE(sensors.observations.publish(m));
+    ASSERT_TRUE(sensors.observations.wait_for_acknowledgments(std::chrono::seconds(10)));
+  };
+  send_odometry(0.0);
+  send_odometry(0.1);
+  send_frame(0.55);
   // The frame goes to the filter once the odometry has been silent for its max delay (with
   // time to spare for a recovery wait, should the first samples arrive late on a busy host).
-  const auto released_by = std::chrono::duration<double>(frame.t_s + options.queue.odometry_max_delay_s + 1.5);
-  std::this_thread::sleep_until(std::chrono::steady_clock::now() + released_by);
-  s.t_s = 0.2;
-  msg::Odometry late = test_support::odometry_msg(s, 0.1, to_stamp_ns(s.t_s, base_ns));
-  ASSERT_TRUE(sensors.odometry.publish(late));
-  ASSERT_TRUE(sensors.odometry.wait_for_acknowledgments(std::chrono::seconds(10)));
+  std::this_thread::sleep_for(std::chrono::duration<double>(0.55 + options.queue.odometry_max_delay_s + 1.5));
+  send_odometry(0.2);
+  // Odometry past the camera's last frame goes to the filter once the camera has been silent
+  // for its max delay.
+  send_odometry(0.6);
+  send_odometry(0.8);
+  std::this_thread::sleep_for(std::chrono::duration<double>(options.queue.observation_max_delay_s + 1.0));
+  send_frame(0.65);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   node.stop();
   const std::string err = testing::internal::GetCapturedStderr();
-  EXPECT_NE(err.find("odometry stamped 0.200 s came after the filter had reached 0.550 s (0.350 s late"),
+  EXPECT_NE(err.find("odometry stamped 0.200 s came after the filter had reached 0.550 s (0.350 s late; a camera "
+                     "frame was released without it): applied at the filter time (1 so far)"),
             std::string::npos)
       << err;
-  EXPECT_EQ(node.counters().samples_late, 1u);
+  EXPECT_NE(err.find("a camera frame stamped 0.650 s came after the filter had reached 0.800 s (0.150 s late; newer "
+                     "odometry was released without it): applied at its stamp (2 so far)"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(node.counters().samples_late, 2u);
 }
 
 // Two robots on one domain: each estimator takes its own robot's sensors only

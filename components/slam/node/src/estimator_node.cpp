@@ -161,8 +161,10 @@ std::vector<std::pair<std::uint64_t, slam::Pose2>> EstimatorNode::trajectory() c
 }
 
 namespace {
-// Samples the filter applied at its own time instead of their stamp.
-std::uint64_t applied_late(const slam::FilterCounters& f) { return f.odometry_out_of_order + f.frames_out_of_order; }
+// Samples older than the filter time when they came (the status line's "late").
+std::uint64_t late_samples(const slam::FilterCounters& f) {
+  return f.odometry_out_of_order + f.frames_late + f.frames_out_of_order;
+}
 }  // namespace
 
 void EstimatorNode::filter_loop() {
@@ -194,7 +196,7 @@ void EstimatorNode::step(const slam::SensorInput& input) {
   const auto begin = std::chrono::steady_clock::now();
   if (!filter_) create_filter(slam::input_time(input));
   const double filter_time_s = filter_->time_s();
-  const std::uint64_t applied_late_before = applied_late(filter_->counters());
+  const slam::FilterCounters late_before = filter_->counters();
   if (const auto* odometry = std::get_if<slam::OdometryInput>(&input)) {
     filter_->add_odometry(odometry->sample);
     last_odometry_seq_ = odometry->seq;
@@ -203,7 +205,7 @@ void EstimatorNode::step(const slam::SensorInput& input) {
     filter_->add_observations(observation.frame);
     last_observation_seq_ = observation.seq;
   }
-  warn_if_applied_late(input, filter_time_s, applied_late_before);
+  warn_if_late(input, filter_time_s, late_before);
   StepInfo info;
   info.epoch_ns = inbox_.epoch_ns();
   info.odometry_seq = last_odometry_seq_;
@@ -229,19 +231,23 @@ void EstimatorNode::step(const slam::SensorInput& input) {
   }
 }
 
-void EstimatorNode::warn_if_applied_late(const slam::SensorInput& input, double filter_time_s,
-                                         std::uint64_t applied_late_before) {
-  const std::uint64_t n = applied_late(filter_->counters());
-  if (n == applied_late_before) return;
+void EstimatorNode::warn_if_late(const slam::SensorInput& input, double filter_time_s,
+                                 const slam::FilterCounters& late_before) {
+  const slam::FilterCounters& f = filter_->counters();
+  const std::uint64_t n = late_samples(f);
+  if (n == late_samples(late_before)) return;
   // The first ten, then every hundredth: a clock step could make every sample late.
   if (n > 10 && n % 100 != 0) return;
-  const bool odometry = std::holds_alternative<slam::OdometryInput>(input);
-  std::fprintf(stderr,
-               "slam_estimator: %s stamped %.3f s came after the filter had reached %.3f s (%.3f s late; %s): "
-               "applied at the filter time (%llu so far)\n",
-               odometry ? "odometry" : "a camera frame", slam::input_time(input), filter_time_s,
-               filter_time_s - slam::input_time(input),
-               odometry ? "a camera frame was released without it" : "older than the last frame",
+  const char* what = "odometry";
+  const char* how = "a camera frame was released without it): applied at the filter time";
+  if (std::holds_alternative<slam::ObservationInput>(input)) {
+    what = "a camera frame";
+    how = f.frames_late != late_before.frames_late
+              ? "newer odometry was released without it): applied at its stamp"
+              : "older than the last frame): applied at the filter time";
+  }
+  std::fprintf(stderr, "slam_estimator: %s stamped %.3f s came after the filter had reached %.3f s (%.3f s late; %s (%llu so far)\n",
+               what, slam::input_time(input), filter_time_s, filter_time_s - slam::input_time(input), how,
                static_cast<unsigned long long>(n));
 }
 

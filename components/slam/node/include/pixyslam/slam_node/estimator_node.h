@@ -67,9 +67,10 @@ class EstimatorNode {
  private:
   void filter_loop();
   void step(const slam::SensorInput& input);
-  // Names a sample the filter could not apply at its stamp (FilterCounters::odometry_out_of_order,
-  // frames_out_of_order, whose sum was applied_late_before): the first ten, then every hundredth.
-  void warn_if_applied_late(const slam::SensorInput& input, double filter_time_s, std::uint64_t applied_late_before);
+  // Names a sample older than the filter time (FilterCounters::odometry_out_of_order,
+  // frames_late, frames_out_of_order; their counts before the step in late_before) and how it
+  // was applied: the first ten, then every hundredth.
+  void warn_if_late(const slam::SensorInput& input, double filter_time_s, const slam::FilterCounters& late_before);
   // The filter, from the checkpoint when there is a fresh one (state_mutex_ held).
   void create_filter(double first_t_s);
   // The configured start pose, or the robot's first ground truth (estimator.initial_pose.source).
