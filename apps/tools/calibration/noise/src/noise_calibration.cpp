@@ -139,6 +139,10 @@ std::vector<Row> collect_rows(const offline::RunInput& in, const std::vector<sla
   std::vector<Row> rows;
   Predictor base(odometry, 0.0, true), shifted(odometry, kDelayStep, false);
   const std::size_t n = in.frames.size();
+  // About one row per detection and lag: grown once, not by doubling (a pass's page faults).
+  std::size_t detections = 0;
+  for (const slam::ObservationFrame& f : in.frames) detections += f.detections.size();
+  rows.reserve(detections * static_cast<std::size_t>(std::max(o.max_lags_per_frame, 1)));
   *start_frames = 0;
   std::size_t window_begin = 0;
   for (std::size_t j = 0; j < n; ++j) {
