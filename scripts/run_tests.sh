@@ -21,13 +21,11 @@ if [[ ${PIXYSLAM_ARMHF:-1} != 0 ]]; then
   phase armhf_build "$root/scripts/cross_build_armhf.sh" --no-tests --build-dir "$root/build-armhf"
 fi
 build_dir=${BUILD_DIR:-$root/build}
-# Three tests more than cores: the DDS tests (one at a time, RESOURCE_LOCK dds)
-# and the namespace tests (RESOURCE_LOCK netns) mostly wait on simulated real
-# time, the container image build mostly on apt, while the fuzz build and the
-# armhf unit tests under qemu (all three niced) keep the cores busy beside them
-# from the start. With two more than cores, the fuzz build (one core) waited
-# ~245 s for a slot behind the DDS and namespace tests and ended last, alone,
-# ~100 s after the rest (CI 2026-11-28: tests 741 s); with one more, ~150 s.
+# Two tests more than cores: the DDS tests (one at a time, RESOURCE_LOCK dds)
+# mostly wait on simulated real time, the container image build mostly on apt,
+# while the armhf unit tests under qemu and the fuzz build (both niced) keep
+# the cores busy beside them from the start (with one more than cores, the fuzz
+# build waited ~150 s for the images and was the last test to end).
 # The pure unit tests first, on their own (under a minute; a failure shows
 # early and they do not load the cores beside the timing-sensitive DDS runs).
 status=0
@@ -36,6 +34,6 @@ if (($# == 0)); then
     status=$?
   set -- -LE '^unit$'
 fi
-phase tests ctest --test-dir "$build_dir" --output-on-failure --parallel "$(($(nproc) + 3))" --timeout 600 "$@" || status=$?
+phase tests ctest --test-dir "$build_dir" --output-on-failure --parallel "$(($(nproc) + 2))" --timeout 600 "$@" || status=$?
 echo "run_tests: ${phases%,} (total $SECONDS s)"
 exit "$status"

@@ -5,7 +5,8 @@
 # cleanly, the evaluator's ATE is under MAX_ATE (so MapState arrived and the
 # map is near the truth), and the log holds every message each publisher sent
 # (seq 1..N per topic, N = the publisher's own count).
-# The log is kept as KEEP_LOG when given (for the replay test). LAUNCH names
+# The log is kept as KEEP_LOG when given (for the replay test; the estimator
+# then waits up to 1 s for either stream, as the replayed one does). LAUNCH names
 # another launch file of CONFIG_DIR (launch_sim_camera.yaml: the camera backend
 # on robot_sim's rendered images); with it 3/4 of the poles must be mapped, none
 # under a wrong id. LAUNCH_ARGS are launch arguments (e.g. "particles:=150
@@ -22,6 +23,16 @@ domain=$((120 + $$ % 100))
 sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/config/*.yaml
 sed -i "s/^  duration_s: [0-9.]* /  duration_s: $duration /" "$work/config/robot_sim.yaml"
 sed -i -E "s/--max-ate, '[0-9.]+'/--max-ate, '$max_ate'/" "$work/config/$launch"
+if [[ -n "$keep_log" ]]; then
+  # The recording the replay test must reproduce: the estimator waits up to 1 s
+  # for either stream (0.3 and 0.05 s live), as the replayed one does. A busy
+  # host otherwise makes it take a sample late (CI 2026-11-28: two at 21 s of 44),
+  # and a replay in stamp order cannot reproduce the states after that.
+  for key in odometry_max_delay_s observation_max_delay_s; do
+    sed -i -E "s/^  $key: [0-9.]+ /  $key: 1.0 /" "$work/config/slam_estimator.yaml"
+    grep -q "^  $key: 1.0 " "$work/config/slam_estimator.yaml" || { echo "FAIL: $key not set"; exit 1; }
+  done
+fi
 
 status=0
 "$bin/pixyslam_launch" "$work/config/$launch" "${launch_args[@]}" --run-dir "$work/run" > "$work/out.log" 2>&1 &
