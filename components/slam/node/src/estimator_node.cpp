@@ -246,7 +246,9 @@ void EstimatorNode::warn_if_late(const slam::SensorInput& input, double filter_t
               ? "newer odometry was released without it): applied at its stamp"
               : "older than the last frame): applied at the filter time";
   }
-  std::fprintf(stderr, "slam_estimator: %s stamped %.3f s came after the filter had reached %.3f s (%.3f s late; %s (%llu so far)\n",
+  std::fprintf(stderr,
+               "slam_estimator: %s stamped %.3f s came after the filter had reached %.3f s (%.3f s late; %s "
+               "(%llu so far)\n",
                what, slam::input_time(input), filter_time_s, filter_time_s - slam::input_time(input), how,
                static_cast<unsigned long long>(n));
 }
