@@ -14,15 +14,10 @@ cp -r "$config" "$work/config"
 domain=$((20 + $$ % 100))
 sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/config/*.yaml
 # The player, delayed on a busy host, can hold a sample back longer than the
-# live bridges did: a camera frame after a newer odometry sample, or odometry
-# after a newer frame, and every later state differs (CI: odometry 0.054 s late
-# at 13.7 s; in a later run a frame late beyond the camera's 0.05 s wait, between 10 and 20 s).
-# Waiting up to 1 s for either stream changes nothing else: the filter still
-# takes every sample in stamp order.
-for key in odometry_max_delay_s observation_max_delay_s; do
-  sed -i -E "s/^  $key: [0-9.]+ /  $key: 1.0 /" "$work/config/slam_estimator.yaml"
-  grep -q "^  $key: 1.0 " "$work/config/slam_estimator.yaml" || { echo "FAIL: $key not set"; exit 1; }
-done
+# live bridges did (CI: odometry 0.054 s late at 13.7 s; in a later run a frame
+# late beyond the camera's 0.05 s wait, between 10 and 20 s).
+source "$(dirname "${BASH_SOURCE[0]}")/support/estimator_waits.sh"
+estimator_waits_for_both_streams "$work/config"
 
 status=0
 read -r -a launch_args <<< "${LAUNCH_ARGS:-}"  # as the recorded run had them

@@ -24,14 +24,10 @@ sed -i "s/^  domain_id: 0/  domain_id: $domain/" "$work"/config/*.yaml
 sed -i "s/^  duration_s: [0-9.]* /  duration_s: $duration /" "$work/config/robot_sim.yaml"
 sed -i -E "s/--max-ate, '[0-9.]+'/--max-ate, '$max_ate'/" "$work/config/$launch"
 if [[ -n "$keep_log" ]]; then
-  # The recording the replay test must reproduce: the estimator waits up to 1 s
-  # for either stream (0.3 and 0.05 s live), as the replayed one does. A busy
-  # host otherwise makes it take a sample late (CI 2026-11-28: two at 21 s of 44),
-  # and a replay in stamp order cannot reproduce the states after that.
-  for key in odometry_max_delay_s observation_max_delay_s; do
-    sed -i -E "s/^  $key: [0-9.]+ /  $key: 1.0 /" "$work/config/slam_estimator.yaml"
-    grep -q "^  $key: 1.0 " "$work/config/slam_estimator.yaml" || { echo "FAIL: $key not set"; exit 1; }
-  done
+  # The recording the replay test must reproduce, made with the waits the
+  # replayed estimator has (CI 2026-11-28: two samples late at 21 s of 44).
+  source "$(dirname "${BASH_SOURCE[0]}")/support/estimator_waits.sh"
+  estimator_waits_for_both_streams "$work/config"
 fi
 
 status=0
