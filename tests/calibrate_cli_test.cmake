@@ -32,3 +32,23 @@ execute_process(COMMAND ${CALIBRATE} camera --samples ${WORK_DIR}/bad.csv --conf
 if(NOT rc EQUAL 2 OR NOT err MATCHES "bad.csv:3: height_px 'twenty' is not a number")
   message(FATAL_ERROR "a bad row should exit 2 naming bad.csv:3, got ${rc}:\n${err}")
 endif()
+# expect(CODE REGEX args...): exit status CODE, stderr matching REGEX.
+function(expect code pattern)
+  execute_process(COMMAND ${CALIBRATE} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc STREQUAL "${code}" OR NOT err MATCHES "${pattern}")
+    message(FATAL_ERROR "pixyslam_calibrate ${ARGN}: exit ${rc}, expected ${code} and '${pattern}':\n${err}")
+  endif()
+endfunction()
+set(pixy ${CONFIG}/pixy_bridge.yaml)
+expect(2 "give one of --samples and --images" camera --config ${pixy})
+expect(2 "give one of --samples and --images" camera --config ${pixy} --samples ${WORK_DIR}/poles.csv
+       --images ${WORK_DIR}/poles.csv)
+expect(2 "--config: At Most 1" camera --config ${pixy} --config ${pixy} --samples ${WORK_DIR}/poles.csv)
+expect(2 "unknown option --confg" camera --confg ${pixy} --samples ${WORK_DIR}/poles.csv)
+# A measurement file is input, not configuration: 1, with the OS reason.
+expect(1 "nope.csv: cannot open: No such file or directory" camera --config ${pixy} --samples ${WORK_DIR}/nope.csv)
+# noise: --dataset, and --mrclam, its old name, still accepted.
+foreach(flag --dataset --mrclam)
+  expect(1 "data set folder not found: ${WORK_DIR}/no_data" noise ${flag} ${WORK_DIR}/no_data --robot 1
+         --config ${CONFIG}/slam_new_robot.yaml --out ${WORK_DIR}/noise.yaml)
+endforeach()

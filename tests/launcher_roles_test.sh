@@ -3,7 +3,8 @@
 # restarted with back-off while the essential ones go on; an essential one that
 # fails stops the run; an optional one exiting 2 (configuration error) is not
 # restarted; with several processes marked ends_run (a for_each over robots),
-# the run ends with the last of them.
+# the run ends with the last of them. A file that uses ${input}: --show-args
+# works without --input, a run without it exits 2 saying so.
 #   launcher_roles_test.sh LAUNCHER
 set -euo pipefail
 launcher=$1
@@ -76,4 +77,26 @@ grep -q "\[robot3\] robot 3 done" "$work/ends.log" || fail "the run ended before
 grep -qF "robot1 finished; the run goes on until 1 more process(es) marked ends_run finish" "$work/ends.log" ||
   fail "the first ends_run process's end not reported"
 [[ $elapsed -ge 3 && $elapsed -lt 10 && $status -eq 0 ]] || fail "ends_run: exit $status after $elapsed s"
+
+cat > "$work/input.yaml" <<'YAML'
+launch:
+  arguments:
+    rate: {default: '1', help: "the rate"}
+  processes:
+    - name: reader
+      command: [/bin/echo, 'reading ${input}']
+      ends_run: true
+YAML
+"$launcher" "$work/input.yaml" --show-args > "$work/show.log" 2>&1 || fail "--show-args without --input: $(cat "$work/show.log")"
+grep -q "rate" "$work/show.log" || fail "--show-args printed no arguments: $(cat "$work/show.log")"
+for shipped in launch_replay.yaml launch_mrclam.yaml; do
+  "$launcher" "$(dirname "$0")/../config/$shipped" --show-args > /dev/null || fail "$shipped --show-args without --input"
+done
+run_launch input
+grep -qF "this launch file needs --input FILE" "$work/input.log" && [[ $status -eq 2 ]] ||
+  fail "a run using \${input} without --input: exit $status"
+[[ ! -d $work/run_input ]] || fail "the run folder was made for a run that did not start"
+"$launcher" "$work/input.yaml" --input "$work/data.txt" --run-dir "$work/run_input" > "$work/input.log" 2>&1 ||
+  fail "with --input: $(cat "$work/input.log")"
+grep -qF "reading $work/data.txt" "$work/input.log" || fail "\${input} not the file given: $(cat "$work/input.log")"
 echo PASS

@@ -2,7 +2,8 @@
 # complete, a not closed and two damaged MCAP files written by
 # mcap_damage_fixture. Complete and not closed exit 0 (check: 1 for not closed
 # unless --allow-recovered); damaged exits 1 and names the byte offset of the
-# damage on stderr; print prints every message that could be read.
+# damage on stderr; print prints every message that could be read. A file that
+# does not exist exits 1.
 #   cmake -DFIXTURE=... -DLOG_TOOL=... -DWORK_DIR=... -P log_tool_damage_cli_test.cmake
 cmake_minimum_required(VERSION 3.22)
 
@@ -108,5 +109,13 @@ run(print_chunk 1 print ${dir}/damaged_chunk.mcap --json)
 expect_count("print damaged chunk" "${print_chunk_out}" "${odometry}" ${survivors})
 run(check_chunk 1 check ${dir}/damaged_chunk.mcap --allow-recovered)
 expect_match("check damaged chunk" "${check_chunk_out}" "seq not exactly 1..N")
+
+# A file that does not exist: 1 (input, not usage), naming it and the reason.
+foreach(command info check print)
+  run(missing_${command} 1 ${command} ${dir}/no_such.mcap)
+  expect_match("${command} missing file" "${missing_${command}_err}" "no_such.mcap: cannot open: No such file or directory")
+endforeach()
+run(missing_compare 1 compare ${dir}/closed.mcap ${dir}/no_such.mcap --topic pixyslam/odometry)
+expect_match("compare missing file" "${missing_compare_err}" "no_such.mcap: cannot open: No such file or directory")
 
 message(STATUS "log_tool_damage_cli: all steps passed")

@@ -21,7 +21,7 @@ mean_ate() {  # the ATE column of mrclam_eval's per-run rows
 }
 calibrated_rows=""
 for robot in 1 2 3 4 5; do
-  "$bin/pixyslam_calibrate" noise --mrclam "$dataset" --robot "$robot" --config "$config/slam_new_robot.yaml" \
+  "$bin/pixyslam_calibrate" noise --dataset "$dataset" --robot "$robot" --config "$config/slam_new_robot.yaml" \
     --out "$work/robot$robot.yaml" --keys w_sigma,odometry_delay,range_exponent > "$work/calibrate$robot.log"
   grep "^calibrated" "$work/calibrate$robot.log"
   calibrated_rows+=$("$bin/mrclam_eval" --dataset "$dataset" --config "$work/robot$robot.yaml" --robots "$robot" \

@@ -15,7 +15,7 @@ trap 'rm -rf "$work"' EXIT
 trap 'exit 130' INT TERM
 
 "$bin/slam_offline" sim --config "$config/sim_fast_camera.yaml" --out-dir "$work/sim" --write-dataset "$work/data" > /dev/null
-"$bin/pixyslam_calibrate" noise --mrclam "$work/data" --robot 1 --config "$config/slam_new_robot.yaml" \
+"$bin/pixyslam_calibrate" noise --dataset "$work/data" --robot 1 --config "$config/slam_new_robot.yaml" \
   --out "$work/calibrated.yaml" > "$work/calibrate.log"
 grep "^calibrated" "$work/calibrate.log"
 

@@ -74,9 +74,22 @@ bool has_camera_section(const std::string& config_path) {
 }  // namespace
 #endif
 
+#ifdef PIXYSLAM_HAS_CAMERA
+// pixy_bridge_camera, or pixy_bridge when that ran it in its place (same argv).
+const char* program_name(const char* argv0) {
+  const std::string_view invoked = argv0 == nullptr ? "" : argv0;
+  const std::size_t slash = invoked.rfind('/');
+  return invoked.substr(slash == std::string_view::npos ? 0 : slash + 1) == "pixy_bridge" ? "pixy_bridge"
+                                                                                         : "pixy_bridge_camera";
+}
+#else
+const char* program_name(const char*) { return "pixy_bridge"; }
+#endif
+
 int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();  // first: every thread inherits the blocked signals
+  const char* const name = program_name(argv[0]);
 #ifdef PIXYSLAM_CAMERA_PROGRAM
   const bool help = any_argument(argc, argv, is_help);
   if (help || any_argument(argc, argv, is_camera)) {
@@ -86,7 +99,7 @@ int main(int argc, char** argv) {
 #endif
   bridge::BridgeCommandLine args;
   std::string camera_input;
-  app::Cli cli{"pixy_bridge", "The Pixy's UART block stream (or a camera) -> one LandmarkObservation per frame over DDS, until "
+  app::Cli cli{name, "The Pixy's UART block stream (or a camera) -> one LandmarkObservation per frame over DDS, until "
                "SIGINT/SIGTERM."};
   bridge::add_bridge_flags(cli, args, "config/pixy_bridge.yaml: node:, pixy:, camera: (optional), dds:",
                            "pixy.frame_rate_hz=30");
@@ -115,7 +128,7 @@ int main(int argc, char** argv) {
                                                         so_far.pixy.camera.image_height_px);
   };
 #endif
-  const std::optional<int> bad = app::configure("pixy_bridge", [&] {
+  const std::optional<int> bad = app::configure(name, [&] {
     options = pixy_node::read_pixy_node_options_file(args.config, read_camera);
     pixy_node::apply_overrides(options, args.overrides);
 #ifdef PIXYSLAM_HAS_CAMERA
@@ -148,20 +161,20 @@ int main(int argc, char** argv) {
 #ifdef PIXYSLAM_HAS_CAMERA
   if (camera_options) effective += camera::to_yaml(*camera_options);
 #endif
-  if (args.verbose) app::print_effective_configuration("pixy_bridge", effective);
+  if (args.verbose) app::print_effective_configuration(name, effective);
 
-  return app::run_main("pixy_bridge", [&] {
+  return app::run_main(name, [&] {
     std::unique_ptr<bridge::ByteSource> source;
 #ifdef PIXYSLAM_HAS_CAMERA
-    if (camera_options) source = std::make_unique<camera::CameraByteSource>(*camera_options, bridge::stderr_log("pixy_bridge"));
+    if (camera_options) source = std::make_unique<camera::CameraByteSource>(*camera_options, bridge::stderr_log(name));
 #endif
     if (!source) source = std::make_unique<bridge::SerialByteSource>(options.serial_device, options.baud);
-    pixy_node::PixyNode node(options, std::move(source), bridge::stderr_log("pixy_bridge"));
+    pixy_node::PixyNode node(options, std::move(source), bridge::stderr_log(name));
     node.start();
     while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
     }
     node.stop();
-    std::fprintf(stderr, "pixy_bridge: stopped (signal %d)\n", app::StopSignal::signal_number());
+    std::fprintf(stderr, "%s: stopped (signal %d)\n", name, app::StopSignal::signal_number());
     return 0;
   });
 }

@@ -11,7 +11,7 @@
 // (METRES driven, measured) or one turn in place (DEGREES turned, > 0
 // counter-clockwise). --out: the config with the fitted keys replaced
 // (comments kept), checked by the bridge's own option reader.
-//   pixyslam_calibrate noise --mrclam DIR --robot N --config BASE.yaml --out FILE.yaml [--ground-truth]
+//   pixyslam_calibrate noise --dataset DIR --robot N --config BASE.yaml --out FILE.yaml [--ground-truth]
 //                            [--fit-range-scale] [--keys LIST]
 // noise: the odometry noise densities, range and bearing sigmas, range scale,
 // the range's cos-bearing exponent and command lag of a robot from the filter's own innovations over a recording
@@ -61,9 +61,11 @@ struct Flags {
   }
 };
 
+// A measurement file (not a config): unreadable exits 1 naming the OS reason.
 std::string read_file(const std::string& path) {
+  app::check_input_file(path);
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw config::ConfigError(path + ": cannot open");
+  if (!in) throw std::runtime_error(path + ": cannot open");
   std::ostringstream text;
   text << in.rdbuf();
   return text.str();
@@ -91,7 +93,7 @@ std::vector<calibration::OdometryRun> read_runs(const std::string& flag, const s
     }
     if (eq == std::string::npos || eq == 0 || used == 0 || used != item.size() - eq - 1 || !std::isfinite(truth) ||
         truth == 0.0) {
-      throw std::invalid_argument("--" + flag + " '" + item + "': want RECORDING=NUMBER (non-zero)");
+      throw app::UsageError("--" + flag + " '" + item + "': want RECORDING=NUMBER (non-zero)");
     }
     const std::string path = item.substr(0, eq);
     runs.push_back({calibration::net_ticks(read_file(path), path), truth * scale, path});
@@ -102,7 +104,7 @@ std::vector<calibration::OdometryRun> read_runs(const std::string& flag, const s
 // The pole samples of --samples, or measured in the photos of --images.
 std::vector<calibration::PoleSample> camera_samples(const Flags& args, config::YamlReader& root,
                                                     const pixy::PixyOptions& pixy, std::string& source) {
-  if (args.has("samples") == args.has("images")) throw std::invalid_argument("give one of --samples and --images");
+  if (args.has("samples") == args.has("images")) throw app::UsageError("give one of --samples and --images");
   if (args.has("samples")) {
     source = args.get("samples");
     return calibration::parse_pole_samples(read_file(source), source);
@@ -120,7 +122,7 @@ std::vector<calibration::PoleSample> camera_samples(const Flags& args, config::Y
 #else
   (void)root;
   (void)pixy;
-  throw std::invalid_argument("--images: this pixyslam_calibrate was built without the camera backend");
+  throw app::UsageError("--images: this pixyslam_calibrate was built without the camera backend");
 #endif
 }
 
@@ -232,14 +234,14 @@ int noise(const Flags& args, int robot, bool with_ground_truth, bool fit_range_s
     for (const std::string& key : parameters::split_list(args.get("keys"))) {
       if (key != "v_sigma" && key != "w_sigma" && key != "range_sigma" && key != "bearing_sigma" &&
           key != "range_scale" && key != "range_exponent" && key != "odometry_delay" && key != "error_correlation") {
-        throw std::invalid_argument("--keys: unknown value '" + key +
+        throw app::UsageError("--keys: unknown value '" + key +
                                     "' (v_sigma, w_sigma, range_sigma, bearing_sigma, range_scale, range_exponent, "
                                     "odometry_delay, error_correlation)");
       }
       keys.insert(key);
     }
   }
-  const std::string base_text = read_file(config_path);
+  const std::string base_text = config::read_config_text(config_path);
   config::YamlReader root = config::YamlReader::from_string(base_text, config_path);
   config::YamlReader filter_yaml = root.child("filter");
   const slam::FilterOptions base = slam::read_filter_options(filter_yaml);
@@ -258,7 +260,7 @@ int noise(const Flags& args, int robot, bool with_ground_truth, bool fit_range_s
   model.range_cos_bearing_exponent = 0.0;
   model.odometry_delay_s = 0.0;
 
-  const mrclam::RobotData data = mrclam::load_robot(args.get("mrclam"), robot);
+  const mrclam::RobotData data = mrclam::load_robot(args.get("dataset"), robot);
   mrclam::RobotData blind_data = data;
   blind_data.groundtruth.clear();  // a new robot has none: start at the origin
   blind_data.landmarks.clear();
@@ -359,7 +361,7 @@ int main(int argc, char** argv) {
   // --NAME VALUE into flags.values["NAME"] when given.
   const auto value = [&](app::Cli& command, const std::string& name, const std::string& help, const char* type) {
     return &command
-                .option_each(
+                .option_call(
                     "--" + name, [&flags, name](const std::string& v) { flags.values[name] = v; }, help)
                 .type(type);
   };
@@ -384,7 +386,13 @@ int main(int argc, char** argv) {
       "noise",
       "odometry noise densities, range and bearing sigmas, the range's cos-bearing exponent and command lag from "
       "the filter's own innovations (never the ground truth); the errors' correlation time from pairs of sightings");
-  value(noise_command, "mrclam", "the MRCLAM data set folder of the recording", "DIR")->required();
+  // --mrclam: the old name of --dataset, still accepted.
+  noise_command
+      .option_call(
+          "--dataset,--mrclam", [&flags](const std::string& v) { flags.values["dataset"] = v; },
+          "the MRCLAM data set folder of the recording (--mrclam: its old name, deprecated)")
+      .type("DIR")
+      .required();
   noise_command.option("--robot", robot, "the robot, 1-5").required().range(mrclam::kFirstRobot, mrclam::kLastRobot).type("N");
   value(noise_command, "config", "the base YAML (filter: and mrclam:)", "BASE.yaml")->required();
   value(noise_command, "out", "write BASE with the calibrated keys replaced", "FILE.yaml")->required();

@@ -221,6 +221,21 @@ struct LaunchCommandLine {
   bool show_args = false;
 };
 
+// Whether a command or environment value of the plan contains `text`.
+bool uses_word(const launcher::LaunchPlan& plan, const std::string& text) {
+  for (const auto* specs : {&plan.processes, &plan.after_run}) {
+    for (const launcher::ProcessSpec& spec : *specs) {
+      for (const std::string& word : spec.command) {
+        if (word.find(text) != std::string::npos) return true;
+      }
+      for (const auto& variable : spec.environment) {
+        if (variable.second.find(text) != std::string::npos) return true;
+      }
+    }
+  }
+  return false;
+}
+
 int run(const LaunchCommandLine& args, const std::map<std::string, std::string>& given) {
   const std::string& launch_file = args.launch_file;
   const bool show_args = args.show_args;
@@ -230,12 +245,17 @@ int run(const LaunchCommandLine& args, const std::map<std::string, std::string>&
       {"config_dir", std::filesystem::absolute(config::folder_of(launch_file)).string()},
       {"bin_dir", bin_dir},
       {"run_dir", std::filesystem::absolute(run_dir).string()}};
-  if (!args.input.empty()) variables["input"] = std::filesystem::absolute(args.input).string();
+  // Without --input, ${input} is this placeholder: --show-args needs no file, a run does.
+  const std::string no_input = "<--input FILE>";
+  variables["input"] = args.input.empty() ? no_input : std::filesystem::absolute(args.input).string();
   launcher::LaunchPlan plan = launcher::read_launch_plan(launch_file, variables, given);
   std::unique_ptr<launcher::HealthMonitor> health;
   if (show_args) {
     std::fputs(launcher::arguments_text(plan).c_str(), stdout);
     return 0;
+  }
+  if (args.input.empty() && uses_word(plan, no_input)) {
+    throw std::invalid_argument("this launch file needs --input FILE (" + launch_file + " uses ${input})");
   }
   if (!args.deployment.empty()) {
     const launcher::Deployment deployment = launcher::read_deployment(args.deployment);

@@ -181,12 +181,12 @@ int main(int argc, char** argv) {
 
   std::string info_file;
   app::Cli& info = cli.subcommand("info", "a recording's topics, counts, rates and times");
-  info.option("file", info_file, "the MCAP file").required().existing_file().type("FILE.mcap");
+  info.option("file", info_file, "the MCAP file").required().input_file().type("FILE.mcap");
   info.flag("--json", json, "one JSON object instead of the text");
 
   log_tool::CheckRequest check_request;
   app::Cli& check = cli.subcommand("check", "a recording is whole: every sequence 1..N, no damage");
-  check.option("file", check_request.path, "the MCAP file").required().existing_file().type("FILE.mcap");
+  check.option("file", check_request.path, "the MCAP file").required().input_file().type("FILE.mcap");
   check
       .option_each(
           "--expect", [&](const std::string& e) { add_expectation(e, check_request); },
@@ -196,7 +196,7 @@ int main(int argc, char** argv) {
 
   log_tool::PrintRequest print_request;
   app::Cli& print = cli.subcommand("print", "a recording's messages, decoded");
-  print.option("file", print_request.path, "the MCAP file").required().existing_file().type("FILE.mcap");
+  print.option("file", print_request.path, "the MCAP file").required().input_file().type("FILE.mcap");
   print.option("--topic", print_request.topic, "only this topic").type("TOPIC");
   print.flag("--json", print_request.json, "one JSON object per line");
 
@@ -204,7 +204,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> compare_files;
   std::string ignored;
   app::Cli& compare = cli.subcommand("compare", "two recordings' messages of one topic, field by field");
-  compare.option("files", compare_files, "the two MCAP files").required().existing_file().type("A.mcap B.mcap");
+  compare.option("files", compare_files, "the two MCAP files").required().input_file().type("A.mcap B.mcap");
   compare.option("--topic", compare_request.topic, "the topic").required().type("TOPIC");
   compare.option("--ignore", ignored, "fields not compared").type("FIELD,...");
   compare.option("--tolerance", compare_request.tolerance, "largest difference of a number taken as equal")

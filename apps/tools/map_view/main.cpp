@@ -93,14 +93,14 @@ int main(int argc, char** argv) {
   ViewArguments render_view;
   RenderRequest render_request;
   app::Cli& render = cli.subcommand("render", "the final map of a log as a PNG");
-  render.option("log", render_request.log, "the logger's MCAP file").required().existing_file().type("LOG.mcap");
+  render.option("log", render_request.log, "the logger's MCAP file").required().input_file().type("LOG.mcap");
   render.option("--out", render_request.out, "the PNG to write").required().type("FILE.png");
   render_view.add_to(render, true);
 
   ViewArguments video_view;
   VideoRequest video_request;
   app::Cli& video = cli.subcommand("video", "the map along the log's time under one fixed view");
-  video.option("log", video_request.log, "the logger's MCAP file").required().existing_file().type("LOG.mcap");
+  video.option("log", video_request.log, "the logger's MCAP file").required().input_file().type("LOG.mcap");
   std::string video_out_dir;
   app::Cli::Option& video_out = video.option("--out", video_request.out, "the MJPG video to write").type("FILE.avi");
   app::Cli::Option& video_frames =

@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   app::Cli cli{"pixyslam_play", "Replays MCAP logs written by the logger onto DDS, with the recorded timing."};
   cli.option("logs", o.files, "the MCAP files, played in the order given (a rotated log: LOG_000.mcap LOG_001.mcap ...)")
       .required()
-      .existing_file()
+      .input_file()
       .type("LOG.mcap");
   cli.option("--rate", o.playback.rate, "playback speed factor (1: the recorded timing)").type("R");
   cli.option("--start", o.playback.start_offset_s, "skip the first S seconds of the log").type("S");

@@ -120,6 +120,15 @@ TEST(PixyNodeOptions, ShippedConfigLoadsWithNodeAndDds) {
   EXPECT_EQ(o.serial_device, "/dev/serial0");
   EXPECT_EQ(o.baud, 19200);
   EXPECT_DOUBLE_EQ(o.camera_latency_s, 0.0);
+  // The file's node: values are the defaults, as it says.
+  const PixyNodeOptions defaults;
+  EXPECT_DOUBLE_EQ(o.frame_timeout_s, 0.01);
+  EXPECT_DOUBLE_EQ(o.frame_timeout_s, defaults.frame_timeout_s);
+  EXPECT_EQ(o.serial_device, defaults.serial_device);
+  EXPECT_EQ(o.baud, defaults.baud);
+  EXPECT_DOUBLE_EQ(o.camera_latency_s, defaults.camera_latency_s);
+  EXPECT_DOUBLE_EQ(o.process.reopen_period_s, defaults.process.reopen_period_s);
+  EXPECT_DOUBLE_EQ(o.process.status_period_s, defaults.process.status_period_s);
   EXPECT_EQ(o.pixy.signatures.size(), 20u);
   EXPECT_EQ(o.dds.profiles_file, std::string(PIXYSLAM_CONFIG_DIR) + "/dds/profiles.xml");
 }

@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "pixyslam/app/process_main.h"
 #include "pixyslam/dds/dds_options.h"
 #include "pixyslam/parameters/parameters.h"
 
@@ -22,6 +23,11 @@ Cli::Option& Cli::Option::required() {
 Cli::Option& Cli::Option::existing_file() {
   CLI::Validator exists = CLI::ExistingFile;
   option_->check(exists.description(""));  // "--config FILE", not "FILE:FILE"
+  return *this;
+}
+
+Cli::Option& Cli::Option::input_file() {
+  input_ = true;
   return *this;
 }
 
@@ -144,11 +150,35 @@ Cli::Option& Cli::option_each(const std::string& name, std::function<void(const 
                   ->allow_extra_args(false));
 }
 
+Cli::Option& Cli::option_call(const std::string& name, std::function<void(const std::string&)> set,
+                              const std::string& help) {
+  return keep(app_->add_option_function<std::string>(name, std::move(set), help));
+}
+
 void Cli::flag(const std::string& name, bool& value, const std::string& help) { app_->add_flag(name, value, help); }
 
 void Cli::footer(const std::string& text) { app_->footer(text); }
 
 bool Cli::given(const std::string& name) const { return app_->count(name) != 0; }
+
+std::optional<int> Cli::check_inputs(const std::string& program) const {
+  for (const auto& option : options_) {
+    if (!option->input_ || option->option_->count() == 0) continue;
+    for (const std::string& path : option->option_->results()) {
+      try {
+        check_input_file(path);
+      } catch (const std::runtime_error& e) {
+        std::fprintf(stderr, "%s: %s\n", program.c_str(), e.what());
+        return 1;
+      }
+    }
+  }
+  for (const auto& sub : subcommands_) {
+    if (!sub->chosen()) continue;
+    if (const auto failed = sub->check_inputs(program)) return failed;
+  }
+  return std::nullopt;
+}
 
 std::optional<int> Cli::parse(int argc, char** argv) {
   try {
@@ -168,10 +198,20 @@ std::optional<int> Cli::parse(int argc, char** argv) {
                    names.c_str());
       return 2;
     }
+    // CLI11 checks required options before unknown words: a misspelt
+    // "--confg" would otherwise read "--config is required".
+    std::string unknown;
+    for (const std::string& word : app_->remaining(true)) {
+      if (word.size() > 1 && word[0] == '-') unknown += (unknown.empty() ? "" : ", ") + word;
+    }
+    if (!unknown.empty() && dynamic_cast<const CLI::ExtrasError*>(&e) == nullptr) {
+      std::fprintf(stderr, "%s: unknown option %s (see --help)\n", app_->get_name().c_str(), unknown.c_str());
+      return 2;
+    }
     std::fprintf(stderr, "%s: %s (see --help)\n", app_->get_name().c_str(), e.what());
     return 2;
   }
-  return std::nullopt;
+  return check_inputs(app_->get_name());
 }
 
 Cli::Option& add_config(Cli& cli, std::string& path, const std::string& help) {
@@ -210,7 +250,7 @@ Cli::Option& add_set(Cli& cli, std::vector<std::string>& assignments, const std:
 
 Cli::Option& add_domain(Cli& cli, std::vector<std::string>& dds_overrides) {
   return cli
-      .option_each(
+      .option_call(
           "--domain", [&dds_overrides](const std::string& d) { dds_overrides.push_back(dds::domain_override(d)); },
           "DDS domain (overrides the config's and PIXYSLAM_DDS_DOMAIN)")
       .type("N");

@@ -46,7 +46,10 @@ class Cli {
    public:
     explicit Option(CLI::Option* option) : option_(option) {}
     Option& required();
-    Option& existing_file();
+    Option& existing_file();  // a config: missing or unreadable exits 2
+    // A data file the program reads: one that does not exist or cannot be
+    // read exits 1 from parse() ("<name>: PATH: cannot open: REASON").
+    Option& input_file();
     Option& range(double min, double max);  // INT in [min - max] in --help for an int option
     Option& seed();                         // an integer in [0, parameters::kMaxSeed]
     Option& non_negative();
@@ -60,6 +63,7 @@ class Cli {
     friend class Cli;
     CLI::Option* option_;
     bool integer_ = false;  // declared on an int (or uint64) member
+    bool input_ = false;    // input_file()
   };
 
   Cli(const std::string& name, const std::string& description);
@@ -75,6 +79,8 @@ class Cli {
   Option& option(const std::string& name, std::vector<std::string>& values, const std::string& help);
   // Calls `each` with every value given (repeatable).
   Option& option_each(const std::string& name, std::function<void(const std::string&)> each, const std::string& help);
+  // Calls `set` with the value (given at most once).
+  Option& option_call(const std::string& name, std::function<void(const std::string&)> set, const std::string& help);
   void flag(const std::string& name, bool& value, const std::string& help);
   void footer(const std::string& text);
   bool given(const std::string& name) const;
@@ -86,12 +92,14 @@ class Cli {
 
   // Returns the exit status when the process is to end here: 0 after --help
   // (the help on stdout), 2 for a usage error ("<name>: <what> (see --help)"
-  // on stderr); nothing when it is to go on.
+  // on stderr; unknown options are named before a missing required one), 1
+  // for an input_file() that cannot be read; nothing when it is to go on.
   std::optional<int> parse(int argc, char** argv);
 
  private:
   explicit Cli(CLI::App* subcommand);
   Option& keep(CLI::Option* option);
+  std::optional<int> check_inputs(const std::string& program) const;
   std::unique_ptr<CLI::App> owned_;  // the top level owns the CLI11 app; a subcommand does not
   CLI::App* app_;
   std::vector<std::unique_ptr<Option>> options_;
@@ -106,7 +114,7 @@ Cli::Option& add_config(Cli& cli, std::string& path, const std::string& help);
 // `example` shows a key, e.g. "filter.particles=300".
 Cli::Option& add_set(Cli& cli, std::vector<std::string>& assignments, const std::string& example);
 
-// --domain N, repeatable (the last wins): "dds.domain_id=N" appended to
+// --domain N, at most once: "dds.domain_id=N" appended to
 // `dds_overrides` for dds::resolve_settings (the range is checked there, once).
 Cli::Option& add_domain(Cli& cli, std::vector<std::string>& dds_overrides);
 

@@ -52,6 +52,11 @@ std::optional<int> configure(const char* name, const Body& body) {
   return std::nullopt;
 }
 
+// A data file (not a config) the process reads: throws std::runtime_error
+// "PATH: cannot open: REASON" (exit 1 in run_main) unless it is a readable
+// regular file.
+void check_input_file(const std::string& path);
+
 // Prints "# <name>: effective configuration" and `yaml` to stdout, flushed.
 void print_effective_configuration(const char* name, const std::string& yaml);
 
