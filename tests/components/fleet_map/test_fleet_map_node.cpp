@@ -35,6 +35,41 @@ msg::MapState map_state(std::uint64_t stamp_ns, double dx) {
   return m;
 }
 
+// A FleetMapNode on the loopback domain and a reader of what it publishes.
+struct FleetBench {
+  explicit FleetBench(int max_robots = 64) : node(options(max_robots)), robots(loopback_options(), "test_estimators") {
+    node.start();
+  }
+  static FleetMapOptions options(int max_robots) {
+    FleetMapOptions o;
+    o.period_s = 0.1;
+    o.max_robots = max_robots;
+    o.dds = loopback_options();
+    o.dds.robot_id = "fleet";
+    return o;
+  }
+  // Waits up to 6 s for a fleet map of `robots_in_map` robots stamped `stamp_ns`.
+  void wait_for(std::size_t robots_in_map, std::uint64_t stamp_ns) {
+    for (int i = 0; i < 300; ++i) {
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!got.empty() && got.back().robots().size() == robots_in_map && got.back().header().stamp_ns() == stamp_ns) {
+          return;
+        }
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+  FleetMapNode node;
+  dds::Participant robots;
+  std::mutex mutex;
+  std::vector<msg::FleetMap> got;
+  dds::Reader<msg::FleetMap> fleet{robots, [this](const msg::FleetMap& m) {
+                                     std::lock_guard<std::mutex> lock(mutex);
+                                     got.push_back(m);
+                                   }};
+};
+
 TEST(FleetMapOptions, ShippedConfigLoadsAndBadKeysAreNamed) {
   const FleetMapOptions o = read_fleet_map_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/fleet_map.yaml");
   EXPECT_DOUBLE_EQ(o.period_s, 1.0);
@@ -77,20 +112,9 @@ TEST(FleetMapConversions, MessageCarriesLandmarksAndVerdicts) {
 
 TEST(FleetMapNode, FusesEveryRobotsMapFromDds) {
   // Given the node and two robots' estimators on one domain,
-  FleetMapOptions options;
-  options.period_s = 0.1;
-  options.dds = loopback_options();
-  options.dds.robot_id = "fleet";
-  FleetMapNode node(options);
-  node.start();
-  dds::Participant robots(loopback_options(), "test_estimators");
-  dds::Writer<msg::MapState> robot1(robots, "robot1"), robot2(robots, "robot2");
-  std::mutex mutex;
-  std::vector<msg::FleetMap> got;
-  dds::Reader<msg::FleetMap> fleet(robots, [&](const msg::FleetMap& m) {
-    std::lock_guard<std::mutex> lock(mutex);
-    got.push_back(m);
-  });
+  FleetBench bench;
+  FleetMapNode& node = bench.node;
+  dds::Writer<msg::MapState> robot1(bench.robots, "robot1"), robot2(bench.robots, "robot2");
   ASSERT_TRUE(robot1.wait_for_readers(1, std::chrono::seconds(10)));
   ASSERT_TRUE(robot2.wait_for_readers(1, std::chrono::seconds(10)));
   // when both publish their maps (robot2's twice, the newest 2 cm to the right),
@@ -99,17 +123,11 @@ TEST(FleetMapNode, FusesEveryRobotsMapFromDds) {
   ASSERT_TRUE(robot2.publish(two));
   ASSERT_TRUE(robot2.publish(newer));
   // then a fleet map arrives with both robots' landmarks fused.
-  for (int i = 0; i < 300; ++i) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (!got.empty() && got.back().robots().size() == 2 && got.back().header().stamp_ns() == 2000) break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  bench.wait_for(2, 2000);
   node.stop();
-  std::lock_guard<std::mutex> lock(mutex);
-  ASSERT_FALSE(got.empty());
-  const msg::FleetMap& last = got.back();
+  std::lock_guard<std::mutex> lock(bench.mutex);
+  ASSERT_FALSE(bench.got.empty());
+  const msg::FleetMap& last = bench.got.back();
   EXPECT_EQ(last.header().robot_id(), "fleet");
   ASSERT_EQ(last.robots().size(), 2u);
   EXPECT_EQ(last.robots()[0].robot_id(), "robot1");
@@ -121,6 +139,41 @@ TEST(FleetMapNode, FusesEveryRobotsMapFromDds) {
   EXPECT_EQ(c.map_states, 3u);
   EXPECT_EQ(c.robots, 2u);
   EXPECT_GE(c.fleet_maps, 1u);
+}
+
+// Hostile but well-formed MapStates: one stamped 2^64 - 1 does not freeze the
+// robot's map (the next real one, far older, is a restart and is taken), and
+// robot ids beyond max_robots are dropped and counted.
+TEST(FleetMapNode, AFarFutureStampAndInventedRobotsAreBounded) {
+  FleetBench bench(2);
+  FleetMapNode& node = bench.node;
+  dds::Writer<msg::MapState> robot1(bench.robots, "robot1"), robot2(bench.robots, "robot2"),
+      robot3(bench.robots, "robot3");
+  ASSERT_TRUE(robot1.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(robot2.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(robot3.wait_for_readers(1, std::chrono::seconds(10)));
+  const std::uint64_t t = 1'000'000'000'000ull;
+  msg::MapState hostile = map_state(~0ull, 5.0), real = map_state(t, 0.0), two = map_state(t, 0.0),
+                three = map_state(t, 0.0);
+  ASSERT_TRUE(robot1.publish(hostile));
+  ASSERT_TRUE(robot1.wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(robot1.publish(real));
+  ASSERT_TRUE(robot2.publish(two));
+  ASSERT_TRUE(robot1.wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(robot2.wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(robot3.publish(three));
+  ASSERT_TRUE(robot3.wait_for_acknowledgments(std::chrono::seconds(10)));
+  bench.wait_for(2, t);
+  node.stop();
+  const FleetMapCounters c = node.counters();
+  EXPECT_EQ(c.restarts, 1u);
+  EXPECT_EQ(c.robots_over_limit, 1u);
+  EXPECT_EQ(c.robots, 2u);
+  std::lock_guard<std::mutex> lock(bench.mutex);
+  ASSERT_FALSE(bench.got.empty());
+  EXPECT_EQ(bench.got.back().header().stamp_ns(), t);
+  ASSERT_EQ(bench.got.back().landmarks().size(), 6u);
+  EXPECT_NEAR(bench.got.back().landmarks()[0].x_m(), 0.0, 1e-9);  // the real map, not the hostile one
 }
 
 }  // namespace

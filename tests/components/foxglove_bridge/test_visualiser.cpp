@@ -1,5 +1,6 @@
 // Foxglove scene messages from MapState/GroundTruth (pixyslam/foxglove/visualiser.h).
 #include <cmath>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -105,6 +106,40 @@ TEST(Visualiser, PathIsBoundedAndKeepsItsEnds) {
   EXPECT_EQ(path.poses()[0].position().x(), 0.045);
 }
 
+// Several robots (or a hostile writer) on the domain: the visuals follow one
+// robot, the first seen unless robot_id names one; the others' states are
+// counted and make no visuals, so one path never zigzags between robots.
+TEST(Visualiser, OneRobotIsDrawnAndOthersAreCounted) {
+  for (const std::string& chosen : {std::string(), std::string("robot8")}) {
+    VisualOptions o;
+    o.robot_id = chosen;
+    Visualiser v(o);
+    const std::string drawn = chosen.empty() ? "robot7" : chosen;
+    std::size_t paths = 0;
+    for (int i = 0; i < 6; ++i) {
+      msg::MapState s = state_with_landmarks(i + 1, 0.1 * i);
+      s.header().robot_id(i % 2 == 0 ? "robot7" : "robot8");
+      const std::vector<VisualMessage> out = v.on_map_state(s);
+      if (s.header().robot_id() != drawn) {
+        EXPECT_TRUE(out.empty());
+        continue;
+      }
+      ASSERT_EQ(out.size(), 4u);
+      ::foxglove::PosesInFramePubSubType type;
+      ::foxglove::PosesInFrame path;
+      std::string error;
+      ASSERT_TRUE(dds::deserialize_payload(type, out[2].cdr.data(), out[2].cdr.size(), &path, error)) << error;
+      EXPECT_EQ(path.poses().size(), ++paths);
+      for (const auto& p : path.poses()) EXPECT_EQ(std::lround(p.position().x() * 10) % 2, drawn == "robot7" ? 0 : 1);
+    }
+    EXPECT_EQ(v.other_robot(), 3u);
+    msg::GroundTruth other;
+    other.header().robot_id("robot9");
+    EXPECT_TRUE(v.on_ground_truth(other).empty());
+    EXPECT_EQ(v.other_robot(), 4u);
+  }
+}
+
 TEST(Visualiser, OnlyWantedChannelsAreBuiltAndThePathGrowsMeanwhile) {
   Visualiser v;
   const auto none = [](VisualChannel) { return false; };
@@ -119,6 +154,7 @@ TEST(Visualiser, OnlyWantedChannelsAreBuiltAndThePathGrowsMeanwhile) {
   ASSERT_TRUE(dds::deserialize_payload(type, out[0].cdr.data(), out[0].cdr.size(), &path, error)) << error;
   EXPECT_EQ(path.poses().size(), 6u);  // the five unwanted states' poses too
   msg::GroundTruth truth;
+  truth.header().robot_id("robot7");
   truth.landmarks().resize(3);
   const std::vector<VisualMessage> true_out =
       v.on_ground_truth(truth, [](VisualChannel c) { return c == VisualChannel::kTrueLandmarks; });

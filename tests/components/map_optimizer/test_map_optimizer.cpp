@@ -231,6 +231,49 @@ TEST(MapOptimizer, BadInputIsCountedAndDropped) {
   EXPECT_NO_THROW(opt.solve());
 }
 
+// What decodes fine but no sensor sends: a stamp a year on (one stretch of
+// unknown motion, not a keyframe a second), sigmas of 1e-200 (weights that
+// would swamp every other factor), ids beyond max_landmarks, guesses at 1e300.
+TEST(MapOptimizer, HostileButWellFormedInputIsBoundedAndCounted) {
+  const ExactRun run = exact_circle(50);
+  MapOptimizerOptions options = exact_options();
+  options.max_landmarks = 4;
+  MapOptimizer opt(options, run.truth.front(), 50.0);
+  opt.add_odometry(run.odometry[0]);
+  const double year_s = 365.0 * 86400.0;
+  slam::ObservationFrame later;
+  later.t_s = 50.0 + year_s;
+  later.detections = {{1, 1.0, 0.1}};
+  opt.add_frame(later);
+  // A keyframe a second while the held command lasts, then one for the rest.
+  EXPECT_LE(opt.keyframes().size(), 3u + static_cast<std::size_t>(options.control_timeout_s / options.keyframe_interval_s));
+  EXPECT_EQ(opt.counters().observations, 1u);
+
+  slam::ObservationFrame tiny;
+  tiny.t_s = later.t_s + 1.0;
+  tiny.detections = {{1, 1.0, 0.1, 1e-200, 0.0}, {1, 1.0, 0.1, 0.0, 1e-200}, {1, 1.0, 0.1, 1e300, 0.0}};
+  opt.add_frame(tiny);
+  EXPECT_EQ(opt.counters().observations_invalid, 3u);
+
+  slam::ObservationFrame many;
+  many.t_s = tiny.t_s + 1.0;
+  for (int id = 1; id <= 8; ++id) many.detections.push_back({id, 1.0 + 0.1 * id, 0.1});
+  opt.add_frame(many);
+  EXPECT_EQ(opt.counters().observations_over_map_limit, 4u);
+  EXPECT_EQ(opt.landmarks().size(), 4u);
+
+  for (int id = 100; id < 200; ++id) opt.set_landmark_guess(id, Eigen::Vector2d(1.0, 1.0));
+  opt.set_landmark_guess(2, Eigen::Vector2d(1e300, 0.0));
+  slam::ObservationFrame guessed;
+  guessed.t_s = many.t_s + 1.0;
+  guessed.detections = {{2, 1.0, 0.1}};
+  opt.add_odometry({guessed.t_s - 0.5, 0.1, 0.0});
+  opt.add_frame(guessed, slam::Pose2(1e300, 0.0, 0.0));
+  for (const Keyframe& k : opt.keyframes()) EXPECT_LT(k.pose.head<2>().norm(), 1e3);
+  EXPECT_NO_THROW(opt.solve());
+  for (const LandmarkSolution& l : opt.landmarks()) EXPECT_TRUE(l.mean.allFinite());
+}
+
 TEST(MapOptimizer, OptionsAreValidatedByName) {
   MapOptimizerOptions o;
   o.bearing_sigma_rad = 0.0;

@@ -264,7 +264,10 @@ TEST(PixyNode, PublishesOneObservationPerFrameAndSkipsBadBytes) {
   // The camera then sends nothing: the last frame completes by frame_timeout_s.
   script->add_idle(arrival_ns(kFrames - 1) + 1000000000ull);
 
-  const PixyNodeOptions options = shipped_options();
+  // A timeout longer than the frame period: every frame but the last is
+  // completed by the next frame's first word.
+  PixyNodeOptions options = shipped_options();
+  options.frame_timeout_s = 0.05;
   LogLines log;
   ObservationInbox& inbox = observation_inbox();
   inbox.clear();

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "ground_truth.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/eval/trajectory_metrics.h"
 #include "pixyslam/sim/sim_world.h"
@@ -65,6 +66,14 @@ void feed(const sim::WorldRun& run, double from_s, double to_s, std::uint64_t ba
     } else if ((o + f) % 50 == 0) {
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
+  }
+}
+
+// Waits up to 10 s for the node's filter to have taken `steps` steps.
+void wait_for_steps(const EstimatorNode& node, std::uint64_t steps) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (node.counters().steps < steps && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
 }
 
@@ -444,16 +453,91 @@ TEST(EstimatorNode, MalformedSamplesAreCountedAndTheFilterGoesOn) {
     ASSERT_TRUE(odometry_writer.publish(m));
   }
   ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
-  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (node.counters().steps < 5 && std::chrono::steady_clock::now() < end) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  wait_for_steps(node, 5);
   const EstimatorCounters c = node.counters();
   node.stop();
   EXPECT_EQ(c.odometry_received, 5u);
   EXPECT_EQ(c.odometry_malformed, bad_o.size());
   EXPECT_EQ(c.observations_malformed, bad_f.size());
   EXPECT_GE(c.steps, 5u);
+}
+
+// Samples that decode fine but are stamped years ahead (a hostile sender, a
+// clock set wrong), the first two before any real one: dropped and counted,
+// and neither the filter's clock nor its time are taken from them.
+TEST(EstimatorNode, SamplesStampedYearsAheadAreDroppedAndTheFilterGoesOn) {
+  EstimatorOptions options = test_options();
+  EstimatorNode node(options);
+  node.start();
+  SensorWriters sensors(options.dds);
+  ASSERT_TRUE(sensors.matched());
+  const std::uint64_t base_ns = dds::now_ns();
+  const std::uint64_t year_ns = 365ull * 86400ull * 1000000000ull;
+  slam::OdometrySample s;
+  s.v_mps = 0.1;
+  msg::Odometry ahead_odometry = test_support::odometry_msg(s, 0.1, base_ns + year_ns);
+  msg::LandmarkObservation ahead_frame = test_support::observation_msg({}, base_ns + year_ns);
+  ASSERT_TRUE(sensors.odometry.publish(ahead_odometry));
+  ASSERT_TRUE(sensors.observations.publish(ahead_frame));
+  ASSERT_TRUE(sensors.odometry.wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(sensors.observations.wait_for_acknowledgments(std::chrono::seconds(10)));
+  for (int i = 0; i < 10; ++i) {
+    s.t_s = 0.1 * i;
+    msg::Odometry m = test_support::odometry_msg(s, 0.1, to_stamp_ns(s.t_s, base_ns));
+    ASSERT_TRUE(sensors.odometry.publish(m));
+    if (i == 5) {  // and one more in the middle of the run
+      msg::LandmarkObservation later_frame = test_support::observation_msg({}, base_ns + 2 * year_ns);
+      ASSERT_TRUE(sensors.observations.publish(later_frame));
+    }
+  }
+  ASSERT_TRUE(sensors.odometry.wait_for_acknowledgments(std::chrono::seconds(10)));
+  wait_for_steps(node, 10);
+  node.stop();
+  const EstimatorCounters c = node.counters();
+  EXPECT_EQ(c.samples_ahead, 3u);
+  EXPECT_EQ(c.steps, 10u);
+  const std::uint64_t last = node.latest_map_state().header().stamp_ns();
+  EXPECT_GE(last, base_ns);
+  EXPECT_LE(last, base_ns + 2'000'000'000ull);
+}
+
+// The start pose from the ground truth: a GroundTruth that is not a pose (NaN)
+// is counted and ignored, the next one is taken.
+TEST(EstimatorNode, AGroundTruthThatIsNotAPoseIsNotTakenAsTheStartPose) {
+  EstimatorOptions options = test_options();
+  options.initial_pose_source = "ground_truth";
+  options.initial_pose_wait_s = 5.0;
+  EstimatorNode node(options);
+  node.start();
+  SensorWriters sensors(options.dds);
+  dds::Writer<msg::GroundTruth> truth(sensors.participant);
+  ASSERT_TRUE(sensors.matched());
+  ASSERT_TRUE(truth.wait_for_readers(1, std::chrono::seconds(10)));
+  msg::GroundTruth bad;
+  bad.pose().x_m(std::nan(""));
+  ASSERT_TRUE(truth.publish(bad));
+  msg::GroundTruth far;
+  far.pose().y_m(1e300);
+  ASSERT_TRUE(truth.publish(far));
+  msg::GroundTruth good;
+  good.pose().x_m(1.5);
+  good.pose().y_m(-0.5);
+  good.pose().theta_rad(0.25);
+  ASSERT_TRUE(truth.publish(good));
+  ASSERT_TRUE(truth.wait_for_acknowledgments(std::chrono::seconds(10)));
+  const std::uint64_t base_ns = dds::now_ns();
+  for (int i = 0; i < 2; ++i) {  // the second confirms the first one's time
+    msg::Odometry still = test_support::odometry_msg(slam::OdometrySample{}, 0.1, base_ns + i * 100'000'000ull);
+    ASSERT_TRUE(sensors.odometry.publish(still));
+  }
+  ASSERT_TRUE(sensors.odometry.wait_for_acknowledgments(std::chrono::seconds(10)));
+  wait_for_steps(node, 1);
+  node.stop();
+  EXPECT_EQ(node.counters().truth_invalid, 2u);
+  const msg::Pose2D& pose = node.latest_map_state().mean_pose();
+  EXPECT_NEAR(pose.x_m(), 1.5, 1e-6);
+  EXPECT_NEAR(pose.y_m(), -0.5, 1e-6);
+  EXPECT_NEAR(pose.theta_rad(), 0.25, 1e-6);
 }
 
 TEST(EstimatorOptions, ShippedConfigIsValid) {

@@ -723,6 +723,34 @@ TEST(FastSlam2, InvalidObservationsAreCountedAndIgnored) {
   expect_finite(f.pose_estimate());
 }
 
+// A sender inventing landmark ids cannot grow the map (and every MapState)
+// without bound: ids beyond max_map_landmarks are dropped and counted, the
+// landmarks already mapped keep being used.
+TEST(FastSlam2, NewLandmarkIdsBeyondTheMapLimitAreDroppedAndCounted) {
+  for (const Association association : {Association::kKnownId, Association::kMaximumLikelihood}) {
+    FilterOptions o;
+    o.particles = 20;
+    o.max_map_landmarks = 3;
+    o.association = association;
+    FastSlam2 f(o, Pose2(0.0, 0.0, 0.0));
+    f.add_odometry({0.0, 0.0, 0.0});
+    f.add_observations({1.0, {{10, 2.0, -0.5}, {11, 2.0, 0.0}, {12, 2.0, 0.5}}});
+    ASSERT_EQ(f.landmarks_of_best().size(), 3u);
+    // Three more ids, far from the mapped ones, then the first three again.
+    f.add_observations({2.0, {{20, 5.0, -2.0}, {21, 5.0, 2.5}, {22, 6.0, 3.0}}});
+    f.add_observations({3.0, {{10, 2.0, -0.5}, {11, 2.0, 0.0}, {12, 2.0, 0.5}}});
+    EXPECT_EQ(f.landmarks_of_best().size(), 3u);
+    if (association == Association::kKnownId) {
+      EXPECT_EQ(f.counters().observations_over_map_limit, 3u);
+      EXPECT_EQ(f.counters().observations_used, 3u);
+    } else {
+      // Any detection may start a landmark: a frame that could pass the limit is dropped whole.
+      EXPECT_EQ(f.counters().observations_over_map_limit, 6u);
+    }
+    expect_finite(f.pose_estimate());
+  }
+}
+
 // Property: whatever arrives (NaN, inf, negative or huge ranges, bearings out
 // of range, time going backwards or jumping by days, absurd speeds, bursts of
 // one landmark, unknown ids), the estimate and the map stay finite. Random

@@ -45,6 +45,64 @@ TEST(SensorQueue, FrameWaitsForTheOdometryThatCoversIt) {
   EXPECT_DOUBLE_EQ(stamp_of(out[1]), 10.15);
 }
 
+// One stamp a year ahead (a hostile sender, a clock set wrong) is held and
+// dropped when its stream goes on at the old time; a jump its stream's next
+// sample confirms (a restart, a clock step) goes on; the first samples wait
+// for their stream's second.
+TEST(StampGate, AJumpGoesOnOnlyWhenItsStreamsNextSampleConfirmsIt) {
+  const std::uint64_t s = 1'000'000'000ull;
+  const std::uint64_t year = 365ull * 86400ull * s;
+  StampGate<int> gate(2, 10.0, 1.0);
+  EXPECT_TRUE(gate.offer(1, 0, 100 * s, 0).empty());  // the first one waits
+  EXPECT_TRUE(gate.offer(2, 1, 100 * s, 1).empty());  // another stream does not confirm it
+  EXPECT_EQ(gate.offer(3, 0, 100 * s + s / 10, 2), (std::vector<int>{1, 3, 2}));
+  EXPECT_TRUE(gate.offer(4, 0, 100 * s + year, 3).empty());
+  EXPECT_TRUE(gate.offer(5, 1, 100 * s + year, 4).empty());  // nor does it confirm another's jump
+  EXPECT_EQ(gate.offer(6, 0, 100 * s + 2 * s / 10, 5), (std::vector<int>{6}));  // the old time goes on
+  EXPECT_EQ(gate.dropped(), 1u);
+  EXPECT_EQ(gate.offer(7, 1, 100 * s + 3 * s / 10, 6), (std::vector<int>{7}));
+  EXPECT_EQ(gate.dropped(), 2u);
+  // A held jump also goes after max_hold.
+  EXPECT_TRUE(gate.offer(8, 1, 100 * s + year, 7).empty());
+  EXPECT_EQ(gate.offer(9, 0, 100 * s + 4 * s / 10, 2 * s), (std::vector<int>{9}));
+  EXPECT_EQ(gate.dropped(), 3u);
+  // A restart 5 min on, confirmed by the next sample: the time moves, the other stream follows.
+  EXPECT_TRUE(gate.offer(10, 0, 400 * s, 3 * s).empty());
+  EXPECT_EQ(gate.offer(11, 0, 400 * s + s / 10, 3 * s + 1), (std::vector<int>{10, 11}));
+  EXPECT_EQ(gate.offer(12, 1, 400 * s + s / 20, 3 * s + 2), (std::vector<int>{12}));
+  // At the end a held jump is dropped.
+  EXPECT_TRUE(gate.offer(13, 1, 400 * s + year, 3 * s + 3).empty());
+  EXPECT_TRUE(gate.flush().empty());
+  EXPECT_EQ(gate.dropped(), 4u);
+}
+
+TEST(StampGate, AFirstSampleFromAWrongClockDoesNotSetTheTime) {
+  const std::uint64_t s = 1'000'000'000ull;
+  StampGate<int> gate(2, 10.0);
+  EXPECT_TRUE(gate.offer(1, 0, 1'000'000 * s, 0).empty());
+  EXPECT_TRUE(gate.offer(2, 1, 1'000'000 * s, 1).empty());
+  EXPECT_TRUE(gate.offer(3, 0, 100 * s, 2).empty());  // no agreement: the first is dropped, this one waits
+  EXPECT_EQ(gate.offer(4, 0, 100 * s + s / 10, 3), (std::vector<int>{3, 4}));
+  EXPECT_EQ(gate.offer(5, 1, 100 * s + s / 10, 4), (std::vector<int>{5}));
+  EXPECT_EQ(gate.dropped(), 2u);  // the other stream's far one: its stream went on at the real time
+  StampGate<int> lone(2, 10.0);
+  EXPECT_TRUE(lone.offer(1, 0, 5 * s, 0).empty());
+  EXPECT_EQ(lone.flush(), (std::vector<int>{1}));  // a lone first sample goes at the end
+}
+
+TEST(SensorQueue, AFloodBeyondMaxHeldIsDroppedAndCounted) {
+  SensorQueueOptions options;
+  options.max_held = 4;
+  SensorQueue queue(options);
+  queue.push(frame(9.0), 9.0);
+  for (int i = 0; i < 10; ++i) queue.push(frame(10.0 + 0.01 * i), 10.0);
+  EXPECT_EQ(queue.size(), 4u);
+  EXPECT_EQ(queue.counters().overflow, 7u);
+  EXPECT_EQ(queue.counters().observations_in, 4u);
+  EXPECT_EQ(queue.pop_all().size(), 4u);
+  EXPECT_TRUE(queue.push(frame(11.0), 11.0));  // room again
+}
+
 TEST(SensorQueue, OdometryIsReleasedWithoutWaitingForASlowCamera) {
   SensorQueue queue(SensorQueueOptions{});
   queue.push(frame(9.95));

@@ -8,8 +8,13 @@
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/dds/participant.h"
+#include "pixyslam/diagnostics/diagnostics_publisher.h"
 
 namespace pixyslam::fleet_map_node {
+namespace {
+// A MapState this much older than its robot's newest is a restarted estimator.
+constexpr double kRestartGapS = 10.0;
+}  // namespace
 
 const parameters::Table<FleetMapOptions>& fleet_map_parameters() {
   using O = FleetMapOptions;
@@ -18,6 +23,8 @@ const parameters::Table<FleetMapOptions>& fleet_map_parameters() {
   static const P::Table<O> table = {
       P::real<O>("period_s", 0.05, 3600.0, "s", "a fleet map this often while some robot's map changed",
                  [](O& o) -> double& { return o.period_s; }),
+      P::integer<O, int>("max_robots", 1, 4096, "", "robots fused at most; MapStates of further robot ids are dropped",
+                         [](O& o) -> int& { return o.max_robots; }),
       P::integer<O, int>("min_common_landmarks", 3, 100000, "",
                          "landmarks a robot must share with the others for its frame to be checked (and aligned)",
                          [](O& o) -> int& { return o.fusion.min_common_landmarks; }),
@@ -112,9 +119,29 @@ FleetMapNode::FleetMapNode(const FleetMapOptions& options) : options_(options) {
   // Every robot's map: no robot filter.
   reader_ = std::make_unique<dds::Reader<msg::MapState>>(*participant_,
                                                          [this](const msg::MapState& m) { on_map_state(m); }, "");
+  diagnostics_ = std::make_unique<diagnostics::DiagnosticsPublisher>(
+      *participant_, "fleet_map", options_.dds.diagnostics_period_s, [this] { return diagnostics_snapshot(); });
 }
 
-FleetMapNode::~FleetMapNode() { stop(); }
+FleetMapNode::~FleetMapNode() {
+  stop();
+  diagnostics_.reset();
+}
+
+diagnostics::Snapshot FleetMapNode::diagnostics_snapshot() const {
+  const FleetMapCounters c = counters();
+  diagnostics::Snapshot s;
+  s.counters = {{"map_states", c.map_states, false},
+                {"robots", c.robots, false},
+                {"stale", c.stale, false},
+                {"restarts", c.restarts, true},
+                {"robots_over_limit", c.robots_over_limit, true},
+                {"malformed", c.malformed, true},
+                {"seq_jumps", c.seq_jumps, true},
+                {"fleet_maps", c.fleet_maps, false},
+                {"publish_failures", c.publish_failures, true}};
+  return s;
+}
 
 void FleetMapNode::start() {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -129,6 +156,12 @@ void FleetMapNode::stop() {
   }
   cv_.notify_all();
   if (thread_.joinable()) thread_.join();
+  if (diagnostics_) diagnostics_->stop();
+  if (!reader_) return;
+  const FleetMapCounters last = counters();
+  std::lock_guard<std::mutex> lock(mutex_);
+  counters_.malformed = last.malformed;
+  counters_.seq_jumps = last.seq_jumps;
   reader_.reset();  // no callback after this
 }
 
@@ -136,19 +169,30 @@ FleetMapCounters FleetMapNode::counters() const {
   std::lock_guard<std::mutex> lock(mutex_);
   FleetMapCounters c = counters_;
   c.robots = maps_.size();
+  if (reader_) {  // reset only by stop(), on the thread that calls counters() after it
+    c.malformed = reader_->malformed() + reader_->callback_errors();
+    c.seq_jumps = reader_->seq_jumps();
+  }
   return c;
 }
 
 void FleetMapNode::on_map_state(const msg::MapState& state) {
   std::lock_guard<std::mutex> lock(mutex_);
   ++counters_.map_states;
+  const std::uint64_t stamp = state.header().stamp_ns();
   const auto it = maps_.find(state.header().robot_id());
-  if (it != maps_.end() && state.header().stamp_ns() < it->second.stamp_ns) {
-    ++counters_.stale;
+  if (it == maps_.end() && maps_.size() >= static_cast<std::size_t>(options_.max_robots)) {
+    ++counters_.robots_over_limit;
     return;
   }
+  if (it != maps_.end() && stamp < it->second.stamp_ns) {
+    if (static_cast<double>(it->second.stamp_ns - stamp) * 1e-9 <= kRestartGapS) {
+      ++counters_.stale;
+      return;
+    }
+    ++counters_.restarts;
+  }
   maps_[state.header().robot_id()] = to_robot_map(state);
-  newest_stamp_ns_ = std::max(newest_stamp_ns_, state.header().stamp_ns());
   changed_ = true;
 }
 
@@ -173,8 +217,10 @@ void FleetMapNode::fuse_and_publish() {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!changed_) return;
     changed_ = false;
-    for (const auto& entry : maps_) maps.push_back(entry.second);
-    stamp = newest_stamp_ns_;
+    for (const auto& entry : maps_) {
+      maps.push_back(entry.second);
+      stamp = std::max(stamp, entry.second.stamp_ns);
+    }
   }
   const fleet_map::FleetMap fleet = fleet_map::fuse_maps(maps, options_.fusion);
   msg::FleetMap message = to_fleet_map_msg(fleet, maps, stamp);

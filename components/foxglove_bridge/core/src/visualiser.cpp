@@ -199,7 +199,15 @@ fg::PosesInFrame Visualiser::path_message(const std::deque<msg::Pose2D>& path, s
   return out;
 }
 
+bool Visualiser::drawn(const std::string& robot_id) {
+  if (options_.robot_id.empty()) options_.robot_id = robot_id;
+  if (robot_id == options_.robot_id) return true;
+  ++other_robot_;
+  return false;
+}
+
 std::vector<VisualMessage> Visualiser::on_map_state(const msg::MapState& state, const ChannelFilter& wanted) {
+  if (!drawn(state.header().robot_id())) return {};
   const std::uint64_t stamp = state.header().stamp_ns();
   const auto want = [&](VisualChannel c) { return !wanted || wanted(c); };
   extend_path(path_, state.mean_pose());
@@ -227,6 +235,7 @@ std::vector<VisualMessage> Visualiser::on_map_state(const msg::MapState& state, 
 }
 
 std::vector<VisualMessage> Visualiser::on_ground_truth(const msg::GroundTruth& truth, const ChannelFilter& wanted) {
+  if (!drawn(truth.header().robot_id())) return {};
   const std::uint64_t stamp = truth.header().stamp_ns();
   const auto want = [&](VisualChannel c) { return !wanted || wanted(c); };
   extend_path(true_path_, truth.pose());

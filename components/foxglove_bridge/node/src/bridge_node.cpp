@@ -132,6 +132,8 @@ BridgeCounters BridgeNode::counters() const {
     c.seq_gaps += s->lost();
   }
   c.visual_messages = visual_messages_.load();
+  std::lock_guard<std::mutex> visual_lock(visual_mutex_);
+  c.visual_other_robot = visualiser_.other_robot();
   return c;
 }
 
@@ -148,6 +150,7 @@ diagnostics::Snapshot BridgeNode::diagnostics_snapshot() const {
   s.counters.push_back({"samples_received", c.samples_received, false});
   s.counters.push_back({"samples_malformed", c.samples_malformed, true});
   s.counters.push_back({"seq_gaps", c.seq_gaps, true});
+  s.counters.push_back({"visual_other_robot", c.visual_other_robot, false});
   return s;
 }
 

@@ -44,6 +44,8 @@ const parameters::Table<BridgeOptions>& bridge_parameters() {
                  [](O& o) -> std::string& { return o.visual.map_frame; }, check_frame),
       P::text<O>("robot_frame", "frame of the robot, placed at the mean pose",
                  [](O& o) -> std::string& { return o.visual.robot_frame; }, check_frame),
+      P::text<O>("visual_robot_id", "the robot drawn in pixyslam/viz/* ('': the first whose MapState arrives)",
+                 [](O& o) -> std::string& { return o.visual.robot_id; }),
   };
   return table;
 }

@@ -212,6 +212,7 @@ MapOptimizerOptions MapOptimizerOptions::from_filter(const slam::FilterOptions& 
   o.bearing_sigma_rad = filter.bearing_sigma_rad;
   o.min_range_m = filter.min_range_m;
   o.max_range_m = filter.max_range_m;
+  o.max_landmarks = filter.max_map_landmarks;
   return o;
 }
 
@@ -245,6 +246,7 @@ void validate(const MapOptimizerOptions& o) {
   require(std::isfinite(o.bearing_sigma_rad) && o.bearing_sigma_rad > 0.0, "bearing_sigma_rad", "must be > 0");
   require(std::isfinite(o.min_range_m) && o.min_range_m >= 0.0, "min_range_m", "must be >= 0");
   require(std::isfinite(o.max_range_m) && o.max_range_m > o.min_range_m, "max_range_m", "must be > min_range_m");
+  require(o.max_landmarks >= 1, "max_landmarks", "must be >= 1");
   require(std::isfinite(o.function_tolerance) && o.function_tolerance > 0.0, "function_tolerance", "must be > 0");
 }
 
@@ -282,9 +284,12 @@ void MapOptimizer::integrate_to(double t_s) {
     double w = held_w_;
     bool measured = true;
     if (last_time_s_ >= timeout_at) {
+      // Unknown motion: one stretch up to t_s, whatever its length (a gap of
+      // days, or a hostile stamp, must not add a keyframe every interval).
       v = 0.0;
       w = 0.0;
       measured = false;
+      next = t_s;
     } else {
       next = std::min(next, timeout_at);
     }
@@ -308,7 +313,8 @@ void MapOptimizer::close_keyframe(double t_s, const std::optional<slam::Pose2>& 
   const double c = std::cos(from.z());
   const double s = std::sin(from.z());
   slam::Pose2 initial = open_motion_.moved_mean(from, c, s);
-  if (guess && finite(*guess)) initial = *guess;
+  // A guess from another process: finite and on a map, else dead reckoning.
+  if (guess && finite(*guess) && guess->head<2>().cwiseAbs().maxCoeff() <= 1e6) initial = *guess;
   initial.z() = slam::wrap_angle(initial.z());
 
   const Eigen::Vector3d delta(open_motion_.displacement().x(), open_motion_.displacement().y(),
@@ -366,14 +372,20 @@ void MapOptimizer::add_frame(const slam::ObservationFrame& frame, const std::opt
   ++counters_.frames;
   integrate_to(frame.t_s);
   std::vector<const slam::RangeBearing*> valid;
+  std::vector<int> new_ids;  // ids this frame adds
   for (const slam::RangeBearing& d : frame.detections) {
     const bool ok = std::isfinite(d.range_m) && std::isfinite(d.bearing_rad) && d.range_m >= options_.min_range_m &&
-                    d.range_m <= options_.max_range_m && std::isfinite(d.range_sigma_m) &&
-                    std::isfinite(d.bearing_sigma_rad);
-    if (ok) {
-      valid.push_back(&d);
-    } else {
+                    d.range_m <= options_.max_range_m && slam::plausible_sigma(d.range_sigma_m) &&
+                    slam::plausible_sigma(d.bearing_sigma_rad);
+    const bool known = ok && (landmarks_.count(d.landmark_id) != 0 ||
+                              std::find(new_ids.begin(), new_ids.end(), d.landmark_id) != new_ids.end());
+    if (!ok) {
       ++counters_.observations_invalid;
+    } else if (!known && landmarks_.size() + new_ids.size() >= static_cast<std::size_t>(options_.max_landmarks)) {
+      ++counters_.observations_over_map_limit;
+    } else {
+      if (!known) new_ids.push_back(d.landmark_id);
+      valid.push_back(&d);
     }
   }
   if (valid.empty()) return;
@@ -415,7 +427,13 @@ void MapOptimizer::add_frame(const slam::ObservationFrame& frame, const std::opt
 }
 
 void MapOptimizer::set_landmark_guess(int id, const Eigen::Vector2d& position) {
-  if (position.allFinite()) landmark_guesses_[id] = position;
+  // A guess is a first estimate: finite, on a map, and for at most max_landmarks ids.
+  if (!position.allFinite() || position.cwiseAbs().maxCoeff() > 1e6) return;
+  if (landmark_guesses_.count(id) == 0 &&
+      landmark_guesses_.size() >= static_cast<std::size_t>(options_.max_landmarks)) {
+    return;
+  }
+  landmark_guesses_[id] = position;
 }
 
 SolveSummary MapOptimizer::solve(std::optional<std::size_t> window_keyframes) {

@@ -98,6 +98,7 @@ msg::OptimisedMap OptimizerNode::latest_map() const {
 
 diagnostics::Snapshot OptimizerNode::diagnostics_snapshot() const {
   const OptimizerNodeCounters c = counters();
+  const slam::SensorQueueCounters queue = inbox_.queue_counters();
   std::lock_guard<std::mutex> lock(state_mutex_);
   const map_optimizer::OptimizerCounters o =
       optimizer_ ? optimizer_->counters() : map_optimizer::OptimizerCounters{};
@@ -107,10 +108,14 @@ diagnostics::Snapshot OptimizerNode::diagnostics_snapshot() const {
                 {"map_states_received", c.map_states_received, false},
                 {"malformed", c.malformed, true},
                 {"seq_jumps", c.seq_jumps, true},
-                {"samples_late", inbox_.queue_counters().late, true},
+                {"samples_late", queue.late, true},
+                {"samples_ahead", queue.ahead, true},
+                {"samples_flood_dropped", queue.overflow, true},
+                {"step_errors", c.step_errors, true},
                 {"odometry_dropped", o.odometry_dropped, true},
                 {"frames_dropped", o.frames_dropped, true},
                 {"observations_invalid", o.observations_invalid, true},
+                {"observations_over_map_limit", o.observations_over_map_limit, true},
                 {"keyframes", o.keyframes, false},
                 {"observations", o.observations, false},
                 {"window_solves", c.window_solves, false},
@@ -126,7 +131,8 @@ void OptimizerNode::loop() {
   for (;;) {
     const slam_node::SensorInbox::Ready ready = inbox_.wait_ready();
     const bool stopping = ready.stopping;
-    for (const slam::SensorInput& input : ready.inputs) step(input);
+    slam_node::step_each(ready.inputs, [this](const slam::SensorInput& input) { step(input); }, "map_optimizer",
+                         state_mutex_, counters_.step_errors);
     if (stopping) {
       std::lock_guard<std::mutex> state_lock(state_mutex_);
       collect_whole(true);

@@ -44,12 +44,6 @@ Pose2 sample_pose(const PoseGaussian& g, std::mt19937_64& rng) {
   return x;
 }
 
-// A detection's own sigma: 0 (or less) = use the configured noise; otherwise it
-// must be a usable number (1 um .. 1 km, or rad).
-bool plausible_sigma(double sigma) {
-  return std::isfinite(sigma) && (sigma <= 0.0 || (sigma >= 1e-6 && sigma <= 1e3));
-}
-
 // Landmarks at most considered as anchors (the first ones seen).
 constexpr std::size_t kMaxAnchors = 16;
 // Odometry steps kept for late frames (2 MB): a longer time without frames
@@ -347,6 +341,11 @@ void FastSlam2::update_with_frame(const ObservationFrame& frame) {
       ++counters_.observations_invalid;
       continue;
     }
+    if (options_.association == Association::kKnownId && slot_of_id_.count(d.landmark_id) == 0 &&
+        id_of_slot_.size() >= static_cast<std::size_t>(options_.max_map_landmarks)) {
+      ++counters_.observations_over_map_limit;
+      continue;
+    }
     const std::size_t k = valid.size();
     valid.push_back(d);
     z_[k] = Eigen::Vector2d(d.range_m, d.bearing_rad);
@@ -357,6 +356,12 @@ void FastSlam2::update_with_frame(const ObservationFrame& frame) {
     if (options_.association == Association::kKnownId) slots_[k] = slot_for(d.landmark_id);
     if (options_.error_correlation_s > 0.0) r_[k] *= correlated_error_factor(slots_[k], frame.t_s);
     new_log_likelihood_[k] = 0.0;  // associate() sets it per particle
+  }
+  // With maximum likelihood every detection of the frame may start a landmark.
+  if (options_.association == Association::kMaximumLikelihood &&
+      id_of_slot_.size() + valid.size() > static_cast<std::size_t>(options_.max_map_landmarks)) {
+    counters_.observations_over_map_limit += valid.size();
+    valid.clear();
   }
   if (valid.empty()) {
     if (joint_motion_.empty()) return;

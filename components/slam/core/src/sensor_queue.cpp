@@ -27,7 +27,16 @@ bool insert_sorted(std::deque<T>& queue, const T& item) {
 
 SensorQueue::SensorQueue(const SensorQueueOptions& options) : options_(options) {}
 
-void SensorQueue::push(const OdometryInput& odometry, double arrival_s) {
+bool SensorQueue::admit() {
+  if (size() >= options_.max_held) {
+    ++counters_.overflow;
+    return false;
+  }
+  return true;
+}
+
+bool SensorQueue::push(const OdometryInput& odometry, double arrival_s) {
+  if (!admit()) return false;
   ++counters_.odometry_in;
   odometry_arrival_s_ = std::max(odometry_arrival_s_, arrival_s);
   const double end = stamp(odometry) + std::max(0.0, odometry.period_s);
@@ -36,17 +45,20 @@ void SensorQueue::push(const OdometryInput& odometry, double arrival_s) {
   has_odometry_ = true;
   if (is_late(stamp(odometry))) ++counters_.late;
   if (insert_sorted(odometry_, odometry)) ++counters_.reordered;
+  return true;
 }
 
-void SensorQueue::push(const ObservationInput& observation, double arrival_s) {
+bool SensorQueue::push(const ObservationInput& observation, double arrival_s) {
+  const double t = stamp(observation);
+  if (!admit()) return false;
   ++counters_.observations_in;
   observation_arrival_s_ = std::max(observation_arrival_s_, arrival_s);
-  const double t = stamp(observation);
   note_arrival(t, arrival_s, options_.observation_max_delay_s);
   observation_known_until_s_ = has_observation_ ? std::max(observation_known_until_s_, t) : t;
   has_observation_ = true;
   if (is_late(t)) ++counters_.late;
   if (insert_sorted(observations_, observation)) ++counters_.reordered;
+  return true;
 }
 
 namespace {

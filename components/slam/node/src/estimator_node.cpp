@@ -35,9 +35,15 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options)
     truth_reader_ = std::make_unique<dds::Reader<msg::GroundTruth>>(
         *participant_,
         [this](const msg::GroundTruth& m) {
+          const slam::Pose2 pose(m.pose().x_m(), m.pose().y_m(), m.pose().theta_rad());
+          // Any participant can send one: a start pose must be finite and on a map.
+          if (!pose.allFinite() || pose.head<2>().cwiseAbs().maxCoeff() > 1e6) {
+            ++truth_invalid_;
+            return;
+          }
           std::lock_guard<std::mutex> lock(truth_mutex_);
           if (first_truth_) return;
-          first_truth_ = slam::Pose2(m.pose().x_m(), m.pose().y_m(), m.pose().theta_rad());
+          first_truth_ = pose;
           truth_cv_.notify_all();
         },
         options_.dds.robot_id);
@@ -114,6 +120,10 @@ diagnostics::Snapshot EstimatorNode::diagnostics_snapshot() const {
                 // warns as odometry_out_of_order / frames_out_of_order.
                 {"samples_late", c.samples_late, false},
                 {"samples_reordered", c.samples_reordered, false},
+                {"samples_ahead", c.samples_ahead, true},
+                {"samples_flood_dropped", c.samples_flood_dropped, true},
+                {"truth_invalid", c.truth_invalid, true},
+                {"step_errors", c.step_errors, true},
                 {"odometry_invalid", f.odometry_invalid, true},
                 {"odometry_out_of_order", f.odometry_out_of_order, true},
                 {"odometry_no_data", f.odometry_no_data, true},
@@ -125,6 +135,7 @@ diagnostics::Snapshot EstimatorNode::diagnostics_snapshot() const {
                 {"observations_new_landmark", f.observations_new_landmark, false},
                 {"observations_gated", f.observations_gated, true},
                 {"observations_invalid", f.observations_invalid, true},
+                {"observations_over_map_limit", f.observations_over_map_limit, true},
                 {"resamples", f.resamples, false},
                 {"landmarks", map_state_.landmarks().size(), false},
                 {"checkpoints_written", c.checkpoints_written, false},
@@ -147,6 +158,9 @@ EstimatorCounters EstimatorNode::counters() const {
   const slam::SensorQueueCounters q = inbox_.queue_counters();
   c.samples_late = q.late;
   c.samples_reordered = q.reordered;
+  c.samples_ahead = q.ahead;
+  c.truth_invalid = truth_invalid_.load();
+  c.samples_flood_dropped = q.overflow;
   return c;
 }
 
@@ -173,7 +187,8 @@ void EstimatorNode::filter_loop() {
   for (;;) {
     const SensorInbox::Ready ready = inbox_.wait_ready();
     const bool stopping = ready.stopping;
-    for (const slam::SensorInput& input : ready.inputs) step(input);
+    step_each(ready.inputs, [this](const slam::SensorInput& input) { step(input); }, "slam_estimator", state_mutex_,
+              counters_.step_errors);
 
     if (options_.status_period_s > 0.0 && Clock::now() >= next_status) {
       log_status();

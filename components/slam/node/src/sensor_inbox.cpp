@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <exception>
 
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/slam_node/map_state_conversions.h"
@@ -9,7 +11,8 @@
 namespace pixyslam::slam_node {
 
 SensorInbox::SensorInbox(const slam::SensorQueueOptions& queue, bool use_detection_sigmas)
-    : use_detection_sigmas_(use_detection_sigmas), queue_(queue) {}
+    : use_detection_sigmas_(use_detection_sigmas), max_pending_(queue.max_held), gate_(2, queue.max_stamp_jump_s),
+      queue_(queue) {}
 
 void SensorInbox::push(const msg::Odometry& m) { enqueue(m); }
 void SensorInbox::push(const msg::LandmarkObservation& m) { enqueue(m); }
@@ -17,6 +20,11 @@ void SensorInbox::push(const msg::LandmarkObservation& m) { enqueue(m); }
 void SensorInbox::enqueue(Message&& m) {
   {
     std::lock_guard<std::mutex> lock(inbox_mutex_);
+    // The consumer is behind by max_pending_ samples: a flood.
+    if (inbox_.size() >= max_pending_) {
+      ++overflow_;
+      return;
+    }
     inbox_.push_back(std::move(m));
   }
   inbox_cv_.notify_one();
@@ -36,9 +44,23 @@ std::uint64_t SensorInbox::epoch_ns() const {
 }
 
 slam::SensorQueueCounters SensorInbox::queue_counters() const {
-  std::lock_guard<std::mutex> lock(queue_mutex_);
-  return queue_.counters();
+  slam::SensorQueueCounters c;
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    c = queue_.counters();
+    c.ahead += gate_.dropped();
+  }
+  std::lock_guard<std::mutex> lock(inbox_mutex_);
+  c.overflow += overflow_;
+  return c;
 }
+
+namespace {
+std::uint64_t steady_ns() {
+  return static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count());
+}
+}  // namespace
 
 double SensorInbox::now_s() const {
   return static_cast<double>(static_cast<std::int64_t>(dds::now_ns() - epoch_ns_)) * 1e-9;
@@ -60,10 +82,21 @@ SensorInbox::Ready SensorInbox::wait_ready() {
     out.stopping = stopping_;
   }
   std::lock_guard<std::mutex> queue_lock(queue_mutex_);
-  for (const Message& m : batch) {
-    const std::uint64_t stamp = std::visit([](const auto& x) { return x.header().stamp_ns(); }, m);
+  const auto stamp_of = [](const Message& m) {
+    return std::visit([](const auto& x) { return x.header().stamp_ns(); }, m);
+  };
+  std::vector<Message> passed;
+  for (Message& m : batch) {
+    const std::uint64_t stamp = stamp_of(m);
+    const std::size_t stream = m.index();
+    for (Message& p : gate_.offer(std::move(m), stream, stamp, steady_ns())) passed.push_back(std::move(p));
+  }
+  if (out.stopping) {
+    for (Message& p : gate_.flush()) passed.push_back(std::move(p));
+  }
+  for (const Message& m : passed) {
     if (!has_epoch_) {
-      epoch_ns_ = stamp;
+      epoch_ns_ = stamp_of(m);
       has_epoch_ = true;
     }
     const double arrival_s = now_s();
@@ -76,6 +109,22 @@ SensorInbox::Ready SensorInbox::wait_ready() {
   }
   if (has_epoch_) out.inputs = out.stopping ? queue_.pop_all() : queue_.pop_ready(now_s());
   return out;
+}
+
+void step_each(const std::vector<slam::SensorInput>& inputs,
+               const std::function<void(const slam::SensorInput&)>& step, const char* process, std::mutex& mutex,
+               std::uint64_t& errors) {
+  for (const slam::SensorInput& input : inputs) {
+    try {
+      step(input);
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (errors++ % 100 == 0) {
+        std::fprintf(stderr, "%s: input stamped %.3f s dropped: %s (%llu so far)\n", process, slam::input_time(input),
+                     e.what(), static_cast<unsigned long long>(errors));
+      }
+    }
+  }
 }
 
 }  // namespace pixyslam::slam_node

@@ -196,6 +196,19 @@ TEST(ViewTransform, FitCentresTheBoxWithTheMargin) {
   EXPECT_NEAR(empty.pixels_per_metre(), 200.0, 1e-9);
 }
 
+// A MapState with particles at +-1e308 (well-formed, hostile or broken) would
+// make the box infinitely wide and the scale 0: such points are not a map.
+TEST(ViewTransform, PointsFarBeyondAnyMapDoNotShrinkTheView) {
+  WorldBox b = box(0.0, 0.0, 4.0, 2.0);
+  b.extend(1e308, 0.0);
+  b.extend(-1e308, -1e308);
+  b.extend(2e6, 0.0);
+  EXPECT_DOUBLE_EQ(b.width_m(), 4.0);
+  EXPECT_DOUBLE_EQ(b.height_m(), 2.0);
+  const ViewTransform t = ViewTransform::fit(b, cv::Rect2d(0.0, 0.0, 800.0, 600.0), 50.0, 1.0);
+  EXPECT_NEAR(t.pixels_per_metre(), 175.0, 1e-9);
+}
+
 TEST(ViewTransform, ContentBoundsCoverEverythingDrawn) {
   MapViewState s;
   s.particles = {{-1.0, 0.0, 0.0}, {0.5, 3.0, 0.0}};

@@ -166,8 +166,11 @@ TEST(SeqTracker, CountsGapsTheWriterCouldHaveMadeAndJumpsItCouldNot) {
   const SeqTracker::Result outage = t.update(base + 20001, 2.0);  // 20,000 in 2 s: plausible
   EXPECT_FALSE(outage.jump);
   EXPECT_EQ(outage.lost, 20000u);
-  EXPECT_EQ(t.update(3, 0.1).lost, 0u);           // restarted writer: nothing lost
-  EXPECT_EQ(t.update(4, 0.1).lost, 0u);
+  const SeqTracker::Result back = t.update(3, 0.1);  // one writer going back: hostile, or broken
+  EXPECT_TRUE(back.jump);
+  EXPECT_EQ(back.lost, 0u);
+  EXPECT_EQ(t.update(4, 0.1).lost, 0u);           // and on from there
+  EXPECT_FALSE(t.update(5, 0.1).jump);
   EXPECT_TRUE(t.update(~0ull, 0.1).jump);         // the top of the range
   EXPECT_EQ(t.update(~0ull, 0.1).lost, 0u);       // a repeat
 }

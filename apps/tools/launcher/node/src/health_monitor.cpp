@@ -33,9 +33,11 @@ class HealthMonitor::Listener : public fdds::DomainParticipantListener {
         break;
       case ParticipantDiscoveryInfo::REMOVED_PARTICIPANT:
         events_.push_back(who + ": left");
+        names_.erase(info.info.m_guid.guidPrefix);  // participants that come and go are not kept
         break;
       case ParticipantDiscoveryInfo::DROPPED_PARTICIPANT:
         events_.push_back(who + ": LOST (no liveliness within its lease: crashed, hung or unreachable)");
+        names_.erase(info.info.m_guid.guidPrefix);
         ++lost_;
         break;
       default:

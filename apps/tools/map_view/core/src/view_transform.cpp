@@ -6,8 +6,14 @@
 
 namespace pixyslam::map_view {
 
+namespace {
+// Coordinates beyond this are no robot's map (a hostile or broken sample):
+// they would shrink the view to nothing.
+constexpr double kMaxWorldM = 1e6;
+}  // namespace
+
 void WorldBox::extend(double x_m, double y_m) {
-  if (!std::isfinite(x_m) || !std::isfinite(y_m)) return;
+  if (!(std::abs(x_m) <= kMaxWorldM) || !(std::abs(y_m) <= kMaxWorldM)) return;
   if (empty) {
     min_x_m = max_x_m = x_m;
     min_y_m = max_y_m = y_m;

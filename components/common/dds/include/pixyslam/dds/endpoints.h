@@ -37,9 +37,10 @@ eprosima::fastdds::dds::TypeSupport type_support() {
 
 // Per-writer sequence accounting that no writer can poison: a gap larger than
 // the writer could have published since its previous sample (at most
-// kMaxRateHz, plus kSlack) is a jump (a restarted, replayed or hostile writer),
-// counted once, not as millions of lost messages; a seq that goes back is a
-// restart. Not thread-safe (one per reader listener).
+// kMaxRateHz, plus kSlack) is a jump (a replayed or hostile writer), counted
+// once, not as millions of lost messages; so is a seq that goes back (one
+// writer numbers 1, 2, ...; a restarted process is a new writer). Not
+// thread-safe (one per reader listener).
 class SeqTracker {
  public:
   static constexpr double kMaxRateHz = 10000.0;
@@ -51,6 +52,7 @@ class SeqTracker {
   };
   Result update(std::uint64_t seq, double elapsed_s) {
     Result r;
+    if (seq < last_) r.jump = true;
     if (seq > last_ && seq - last_ > 1) {
       const std::uint64_t gap = seq - last_ - 1;
       const double plausible = kMaxRateHz * std::max(0.0, elapsed_s) + static_cast<double>(kSlack);
@@ -218,6 +220,9 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
         continue;
       }
       const auto now = std::chrono::steady_clock::now();
+      // Writers that come and go are not forgotten one by one: past a bound
+      // the accounting starts again (a few seq gaps go uncounted).
+      if (writers_.size() >= kMaxWriters && writers_.count(info.publication_handle) == 0) writers_.clear();
       WriterSeq& writer = writers_[info.publication_handle];
       if (!writer.seen) {
         writer.seen = true;
@@ -237,6 +242,7 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
     }
   }
 
+  static constexpr std::size_t kMaxWriters = 1024;
   struct WriterSeq {
     bool seen = false;
     std::chrono::steady_clock::time_point last;

@@ -23,12 +23,17 @@ class Reader;
 template <class Message>
 class Writer;
 }  // namespace pixyslam::dds
+namespace pixyslam::diagnostics {
+class DiagnosticsPublisher;
+struct Snapshot;
+}  // namespace pixyslam::diagnostics
 
 namespace pixyslam::fleet_map_node {
 
 // config/fleet_map.yaml.
 struct FleetMapOptions {
   double period_s = 1.0;  // `fleet_map.period_s`: a fleet map this often while some robot's map changed
+  int max_robots = 64;    // `fleet_map.max_robots`: MapStates of further robot ids are dropped (counted)
   fleet_map::FusionOptions fusion;  // `fleet_map.min_common_landmarks`, `agreement_probability`, `disagreement`
   dds::DdsOptions dds;    // dds.robot_id names the fleet map's writer (e.g. "fleet")
 };
@@ -48,15 +53,22 @@ msg::FleetMap to_fleet_map_msg(const fleet_map::FleetMap& fleet, const std::vect
 struct FleetMapCounters {
   std::uint64_t map_states = 0;       // received, every robot
   std::uint64_t stale = 0;            // older than the robot's newest: ignored
+  std::uint64_t restarts = 0;         // more than 10 s older than the robot's newest: a restart, taken
+  std::uint64_t robots_over_limit = 0;  // MapStates of robots beyond max_robots: dropped
+  std::uint64_t malformed = 0;        // did not decode, or the callback threw
+  std::uint64_t seq_jumps = 0;
   std::uint64_t fleet_maps = 0;       // published
   std::uint64_t publish_failures = 0;
   std::size_t robots = 0;
 };
 
-// Reads every robot's MapState (whatever its robot_id), keeps each robot's
-// newest, and every period_s in which one changed fuses them
-// (fleet_map::fuse_maps) and publishes a FleetMap stamped with the newest
-// MapState's stamp. A robot's frame verdict that changes is logged.
+// Reads every robot's MapState (whatever its robot_id, up to max_robots),
+// keeps each robot's newest, and every period_s in which one changed fuses
+// them (fleet_map::fuse_maps) and publishes a FleetMap stamped with the newest
+// kept MapState's stamp. A MapState more than 10 s older than its
+// robot's newest is taken as a restart (a new clock), not as stale, so that
+// one stamp from the far future cannot freeze a robot's map. A robot's frame
+// verdict that changes is logged; counters go out on pixyslam/diagnostics.
 class FleetMapNode {
  public:
   explicit FleetMapNode(const FleetMapOptions& options);
@@ -72,6 +84,7 @@ class FleetMapNode {
   void on_map_state(const msg::MapState& state);
   void loop();
   void fuse_and_publish();
+  diagnostics::Snapshot diagnostics_snapshot() const;
 
   const FleetMapOptions options_;
   mutable std::mutex mutex_;
@@ -80,13 +93,13 @@ class FleetMapNode {
   std::map<std::string, std::string> verdicts_;      // last logged per robot
   bool changed_ = false;
   bool stopping_ = false;
-  std::uint64_t newest_stamp_ns_ = 0;
   FleetMapCounters counters_;
   std::thread thread_;
 
   std::unique_ptr<dds::Participant> participant_;
   std::unique_ptr<dds::Writer<msg::FleetMap>> writer_;
-  std::unique_ptr<dds::Reader<msg::MapState>> reader_;  // last: its callback uses the above
+  std::unique_ptr<dds::Reader<msg::MapState>> reader_;  // its callback uses the above
+  std::unique_ptr<diagnostics::DiagnosticsPublisher> diagnostics_;  // last: reads the reader
 };
 
 }  // namespace pixyslam::fleet_map_node

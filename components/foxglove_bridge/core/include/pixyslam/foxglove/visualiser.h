@@ -45,6 +45,9 @@ struct VisualOptions {
   double ellipse_sigma = 2.0;        // ellipses drawn at this many standard deviations
   std::size_t path_max_poses = 1000; // a longer path keeps every other pose (whole extent, bounded size)
   double path_min_step_m = 0.02;     // a pose joins the path once this far from the last one
+  // The robot drawn (header.robot_id of MapState and GroundTruth); empty: the
+  // first robot seen. Other robots' samples make no visuals (other_robot()).
+  std::string robot_id;
 };
 
 // One output message: CDR payload (encapsulation header first) of the channel's schema.
@@ -76,20 +79,26 @@ class Visualiser {
   // way, so a channel wanted later starts with the whole path.
   using ChannelFilter = std::function<bool(VisualChannel)>;
 
-  // Landmarks, particles and pose ellipse, path, transform.
+  // Landmarks, particles and pose ellipse, path, transform (nothing for
+  // another robot's state).
   std::vector<VisualMessage> on_map_state(const msg::MapState& state, const ChannelFilter& wanted = {});
-  // True path and true landmarks.
+  // True path and true landmarks (nothing for another robot's).
   std::vector<VisualMessage> on_ground_truth(const msg::GroundTruth& truth, const ChannelFilter& wanted = {});
   // Decodes a CDR payload of `type_name` and calls the above; other types give
   // nothing. Returns false with `error` set when the payload does not decode.
   bool on_payload(std::string_view type_name, const std::vector<std::uint8_t>& payload,
                   std::vector<VisualMessage>& out, std::string& error);
 
+  // Samples of robots other than the one drawn.
+  std::uint64_t other_robot() const { return other_robot_; }
+
   // The typed messages (what on_* serialize), for tests.
   ::foxglove::SceneUpdate landmark_scene(const msg::MapState& state) const;
   ::foxglove::SceneUpdate estimate_scene(const msg::MapState& state) const;
 
  private:
+  // True for the robot drawn (the first seen when options_.robot_id is empty).
+  bool drawn(const std::string& robot_id);
   // Adds `pose` to `path` (decimating).
   void extend_path(std::deque<msg::Pose2D>& path, const msg::Pose2D& pose) const;
   ::foxglove::PosesInFrame path_message(const std::deque<msg::Pose2D>& path, std::uint64_t stamp_ns) const;
@@ -101,6 +110,7 @@ class Visualiser {
   VisualOptions options_;
   std::deque<msg::Pose2D> path_;
   std::deque<msg::Pose2D> true_path_;
+  std::uint64_t other_robot_ = 0;
 };
 
 }  // namespace pixyslam::foxglove

@@ -27,6 +27,7 @@ struct BridgeCounters {
   std::uint64_t samples_malformed = 0;  // did not decode (dropped by the readers)
   std::uint64_t seq_gaps = 0;           // header seq numbers skipped, per writer
   std::uint64_t visual_messages = 0;    // pixyslam/viz/* messages made (for subscribed channels only)
+  std::uint64_t visual_other_robot = 0; // MapState/GroundTruth of robots other than the one drawn
 };
 
 // The foxglove_bridge process: every selected DDS topic as a Foxglove channel
@@ -61,7 +62,7 @@ class BridgeNode {
 
   BridgeOptions options_;
   std::unique_ptr<WsServer> server_;
-  std::mutex visual_mutex_;
+  mutable std::mutex visual_mutex_;
   foxglove::Visualiser visualiser_;
   std::atomic<std::uint64_t> visual_messages_{0};
   mutable std::mutex counters_mutex_;

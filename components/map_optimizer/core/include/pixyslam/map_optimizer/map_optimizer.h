@@ -62,6 +62,7 @@ struct MapOptimizerOptions {
   double bearing_sigma_rad = 0.027;
   double min_range_m = 0.05;
   double max_range_m = 50.0;
+  int max_landmarks = 4096;  // the filter's max_map_landmarks: detections of more ids are dropped
   double keyframe_interval_s = 1.0;
   // Huber threshold on the whitened residual norm: sqrt(chi2_2(0.95)).
   double huber_threshold = 2.4477;
@@ -116,6 +117,7 @@ struct OptimizerCounters {
   std::size_t frames_dropped = 0;     // non-finite time or before the last time
   std::size_t observations = 0;       // range/bearing factors added
   std::size_t observations_invalid = 0;  // non-finite or outside the range limits
+  std::size_t observations_over_map_limit = 0;  // a new id beyond max_landmarks: dropped
   std::size_t keyframes = 0;
   std::size_t solves = 0;
 };

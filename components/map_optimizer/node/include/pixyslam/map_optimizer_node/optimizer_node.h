@@ -61,6 +61,7 @@ struct OptimizerNodeCounters {
   std::uint64_t whole_solves = 0;
   std::uint64_t maps_published = 0;
   std::uint64_t guesses_from_filter = 0;  // keyframes started from the filter's pose
+  std::uint64_t step_errors = 0;          // inputs the optimiser threw on: dropped
   double cpu_time_s = 0.0;                // the optimiser thread's CPU time
   double solve_time_s = 0.0;              // Ceres' time over all solves
 };

@@ -61,6 +61,7 @@ struct FilterCounters {
   std::uint64_t observations_new_landmark = 0;
   std::uint64_t observations_gated = 0;
   std::uint64_t observations_invalid = 0;
+  std::uint64_t observations_over_map_limit = 0;  // would start a landmark beyond max_map_landmarks: dropped
   std::uint64_t resamples = 0;
   std::uint64_t delayed_sampling_starts = 0;  // particle-frames that began a joint state
   std::uint64_t joint_breakdowns = 0;  // joint-state updates refused as numerically broken

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <deque>
 #include <limits>
@@ -45,6 +48,12 @@ struct SensorQueueOptions {
   // that held their first messages until every reader matched release their
   // backlogs at slightly different times).
   double recovery_wait_s = 1.0;
+  // A sample stamped more than this after the newest one is held until the
+  // next sample confirms the new time (StampGate): one stamp from a wrong clock
+  // or a hostile sender would move the filter's time past every real sample.
+  double max_stamp_jump_s = 10.0;
+  // Samples waiting at most (inbox and queue each); more are dropped (a flood).
+  std::size_t max_held = 20000;
 };
 
 struct SensorQueueCounters {
@@ -54,6 +63,95 @@ struct SensorQueueCounters {
   std::uint64_t reordered = 0;  // arrived after a younger sample of its stream; sorted in
   std::uint64_t late = 0;       // older than what was already released: released at once (the
                                 // filter applies a frame at its stamp, FastSlam2::frames_late)
+  std::uint64_t ahead = 0;      // dropped: a jump past max_stamp_jump_s that no sample confirmed (StampGate)
+  std::uint64_t overflow = 0;   // dropped: max_held samples were waiting already
+};
+
+// Passes on samples in arrival order unless a stamp jumps more than
+// max_jump_s past the newest one passed on (of any stream): that sample is
+// held until the next sample of its own stream confirms the new time (stamped
+// within max_jump_s of it, as after a restart or a clock step), and dropped
+// (counted) when its stream goes on at the old time or max_hold_s passes: one
+// stamp from a wrong clock or a hostile sender does not move the time. The
+// first sample of each stream is held the same way until the time is known,
+// so that none can set it alone. Two consistent samples of one stream do move
+// it. Stamps in ns on the stamps' clock, arrivals in ns on any steady clock.
+// Thread-compatible.
+template <class T>
+class StampGate {
+ public:
+  StampGate(std::size_t streams, double max_jump_s, double max_hold_s = 1.0)
+      : max_jump_ns_(max_jump_s * 1e9), max_hold_ns_(max_hold_s * 1e9), held_(streams) {}
+
+  // What may go on now, in arrival order: nothing (held), or this sample and
+  // whatever the time it confirms releases.
+  std::vector<T> offer(T item, std::size_t stream, std::uint64_t stamp_ns, std::uint64_t arrival_ns) {
+    std::vector<T> out;
+    for (Held& h : held_) {
+      if (h.has && static_cast<double>(arrival_ns) - static_cast<double>(h.arrival_ns) > max_hold_ns_) drop(h);
+    }
+    Held& mine = held_[stream];
+    if (known(stamp_ns)) {
+      reference_ns_ = std::max(reference_ns_, stamp_ns);
+      if (mine.has) drop(mine);  // its stream goes on at the old time
+      out.push_back(std::move(item));
+    } else if (mine.has && std::abs(static_cast<double>(stamp_ns) - static_cast<double>(mine.stamp_ns)) <= max_jump_ns_) {
+      reference_ns_ = has_reference_ ? std::max({reference_ns_, mine.stamp_ns, stamp_ns})
+                                     : std::max(mine.stamp_ns, stamp_ns);
+      has_reference_ = true;
+      mine.has = false;
+      out.push_back(std::move(mine.item));
+      out.push_back(std::move(item));
+    } else {
+      if (mine.has) drop(mine);
+      mine = Held{true, std::move(item), stamp_ns, arrival_ns};
+    }
+    for (Held& h : held_) {
+      if (h.has && known(h.stamp_ns)) {
+        h.has = false;
+        out.push_back(std::move(h.item));
+      }
+    }
+    return out;
+  }
+  // At the end: held first samples go on while the time is still unknown;
+  // held jumps are dropped.
+  std::vector<T> flush() {
+    std::vector<T> out;
+    for (Held& h : held_) {
+      if (!h.has) continue;
+      if (has_reference_) {
+        drop(h);
+      } else {
+        h.has = false;
+        out.push_back(std::move(h.item));
+      }
+    }
+    return out;
+  }
+  std::uint64_t dropped() const { return dropped_; }
+
+ private:
+  struct Held {
+    bool has = false;
+    T item{};
+    std::uint64_t stamp_ns = 0;
+    std::uint64_t arrival_ns = 0;
+  };
+  bool known(std::uint64_t stamp_ns) const {
+    return has_reference_ && static_cast<double>(stamp_ns) - static_cast<double>(reference_ns_) <= max_jump_ns_;
+  }
+  void drop(Held& h) {
+    h.has = false;
+    ++dropped_;
+  }
+
+  double max_jump_ns_;
+  double max_hold_ns_;
+  std::vector<Held> held_;
+  bool has_reference_ = false;
+  std::uint64_t reference_ns_ = 0;
+  std::uint64_t dropped_ = 0;
 };
 
 // Merges the odometry and camera streams into one time-ordered sequence for
@@ -72,8 +170,9 @@ class SensorQueue {
  public:
   explicit SensorQueue(const SensorQueueOptions& options);
 
-  void push(const OdometryInput& odometry, double arrival_s = -std::numeric_limits<double>::infinity());
-  void push(const ObservationInput& observation, double arrival_s = -std::numeric_limits<double>::infinity());
+  // False (and counted) when the sample is dropped: max_held samples held.
+  bool push(const OdometryInput& odometry, double arrival_s = -std::numeric_limits<double>::infinity());
+  bool push(const ObservationInput& observation, double arrival_s = -std::numeric_limits<double>::infinity());
 
   // Samples that may go to the filter now, oldest first.
   std::vector<SensorInput> pop_ready(double now_s);
@@ -91,6 +190,7 @@ class SensorQueue {
   double observation_horizon_s(double now_s) const;
   void note_arrival(double stamp_end_s, double arrival_s, double max_delay_s);
   bool is_late(double t_s) const { return has_released_ && t_s < released_until_s_; }
+  bool admit();
 
   SensorQueueOptions options_;
   std::deque<OdometryInput> odometry_;         // sorted by stamp

@@ -97,6 +97,11 @@ struct FilterOptions {
   // Detections outside [min_range_m, max_range_m] are rejected as invalid.
   double min_range_m = 0.05;
   double max_range_m = 50.0;
+  // Landmarks the map may hold (a MapState carries up to 4096): detections that
+  // would start more are dropped and counted (observations_over_map_limit); with
+  // maximum likelihood, where any detection may start one, a frame that could
+  // pass the limit is dropped whole.
+  int max_map_landmarks = 4096;
 
   // Mahalanobis gate on observations of mapped landmarks, per particle.
   bool gate_enabled = true;

@@ -35,6 +35,12 @@ struct RangeBearing {
   double bearing_sigma_rad = 0.0;
 };
 
+// A detection's own sigma: 0 (or less) = use the configured noise; otherwise it
+// must be a usable number (1 um .. 1 km, or rad).
+inline bool plausible_sigma(double sigma) {
+  return std::isfinite(sigma) && (sigma <= 0.0 || (sigma >= 1e-6 && sigma <= 1e3));
+}
+
 // All detections of one camera frame (one timestamp).
 struct ObservationFrame {
   double t_s = 0.0;

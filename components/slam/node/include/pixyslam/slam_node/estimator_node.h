@@ -37,6 +37,10 @@ struct EstimatorCounters {
   std::uint64_t map_states_published = 0;
   std::uint64_t samples_late = 0;
   std::uint64_t samples_reordered = 0;
+  std::uint64_t samples_ahead = 0;          // dropped: a stamp jump (max_stamp_jump_s) no sample confirmed
+  std::uint64_t samples_flood_dropped = 0;  // dropped: max_held_samples were waiting
+  std::uint64_t truth_invalid = 0;          // GroundTruth poses not finite or beyond 1e6 m: not a start pose
+  std::uint64_t step_errors = 0;            // filter steps that threw: the sample is dropped
   std::uint64_t checkpoints_written = 0;
   std::uint64_t checkpoint_errors = 0;
   bool resumed = false;                  // started from a checkpoint
@@ -88,6 +92,7 @@ class EstimatorNode {
   std::mutex truth_mutex_;
   std::condition_variable truth_cv_;
   std::optional<slam::Pose2> first_truth_;
+  std::atomic<std::uint64_t> truth_invalid_{0};
   std::optional<slam::Pose2> start_pose_;  // filter thread only
   std::unique_ptr<dds::Reader<msg::GroundTruth>> truth_reader_;
   std::unique_ptr<dds::Reader<msg::Odometry>> odometry_reader_;

@@ -1,8 +1,10 @@
 #pragma once
 
 #include <condition_variable>
+#include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <mutex>
 #include <variant>
 #include <vector>
@@ -17,8 +19,9 @@ namespace pixyslam::slam_node {
 // order on one thread (the estimator's filter, the map optimiser): DDS
 // callbacks only push(); the consumer's thread calls wait_ready() in a loop and
 // gets the inputs the SensorQueue releases, oldest first, on seconds since the
-// first stamp received (the epoch; a replay shifted by a constant computes the
-// same). Thread-safe.
+// first stamp passed on (the epoch; a replay shifted by a constant computes the
+// same). A stamp that jumps more than max_stamp_jump_s ahead waits for the next
+// sample to confirm it (slam::StampGate); the first sample too. Thread-safe.
 class SensorInbox {
  public:
   SensorInbox(const slam::SensorQueueOptions& queue, bool use_detection_sigmas);
@@ -38,6 +41,8 @@ class SensorInbox {
 
   // 0 until the first message arrived.
   std::uint64_t epoch_ns() const;
+  // The queue's counters, with what the inbox dropped before it (ahead: a stamp
+  // jump no sample confirmed; overflow: max_held samples waiting already).
   slam::SensorQueueCounters queue_counters() const;
 
  private:
@@ -46,15 +51,25 @@ class SensorInbox {
   double now_s() const;  // wall clock on the epoch's time base (queue_mutex_ held)
 
   const bool use_detection_sigmas_;
-  std::mutex inbox_mutex_;
+  const std::size_t max_pending_;
+  mutable std::mutex inbox_mutex_;
   std::condition_variable inbox_cv_;
   std::deque<Message> inbox_;
   bool stopping_ = false;
+  std::uint64_t overflow_ = 0;  // dropped by enqueue()
 
   mutable std::mutex queue_mutex_;
+  slam::StampGate<Message> gate_;  // streams by Message index: a jump needs its stream's next sample
   slam::SensorQueue queue_;
   bool has_epoch_ = false;
   std::uint64_t epoch_ns_ = 0;
 };
+
+// Runs `step` on every input in order. An input it throws on (an invariant a
+// hostile sample broke) is dropped and counted in `errors`, under `mutex`; the
+// first and every 100th are logged as "PROCESS: input stamped T s dropped: ...".
+void step_each(const std::vector<slam::SensorInput>& inputs,
+               const std::function<void(const slam::SensorInput&)>& step, const char* process, std::mutex& mutex,
+               std::uint64_t& errors);
 
 }  // namespace pixyslam::slam_node

@@ -7,7 +7,7 @@
 namespace pixyslam::map_view {
 
 // An axis-aligned box of the map frame, metres. Empty until extended;
-// non-finite coordinates are ignored.
+// non-finite coordinates, and any beyond 1e6 m (no robot's map), are ignored.
 struct WorldBox {
   double min_x_m = 0.0;
   double min_y_m = 0.0;
