@@ -6,7 +6,7 @@
 # (dds.robot_id robot1 and robot2) and `pixyslam_log record` listening. Passes
 # if the recording holds every sample once, seq 1..N per robot and topic, and
 # each estimator took exactly its own robot's samples and counted the other's,
-# and `pixyslam_log hz --robot robot2` counted robot 2's 80 odometry samples only
+# and `pixyslam_log hz --robot-id robot2` counted robot 2's 80 odometry samples only
 # (the bridge waits for it: a second recorder on the other topics gives each
 # topic four readers, and records just those two topics);
 # the recording's robot sightings print, fleet_map fused both robots' maps,
@@ -45,7 +45,7 @@ done
   > "$work/fleet_map.log" 2>&1 &
 fleet_pid=$!
 pids+=("$fleet_pid")
-# `hz --robot`: robot 2's odometry only. The bridge waits for it too: a
+# `hz --robot-id`: robot 2's odometry only. The bridge waits for it too: a
 # second recorder on the other two topics makes every topic's reader count 4
 # (its own robot_id, so that its diagnostics are not taken for the first's).
 "$bin/pixyslam_log" record pixyslam/landmark_observation pixyslam/ground_truth --out "$work/others.mcap" \
@@ -53,7 +53,7 @@ pids+=("$fleet_pid")
   --domain "$domain" > "$work/record_others.log" 2>&1 &
 others_pid=$!
 pids+=("$others_pid")
-"$bin/pixyslam_log" hz pixyslam/odometry --robot robot2 --duration 6 --json --domain "$domain" \
+"$bin/pixyslam_log" hz pixyslam/odometry --robot-id robot2 --duration 6 --json --domain "$domain" \
   > "$work/hz.out" 2> "$work/hz.log" &
 hz_pid=$!
 pids+=("$hz_pid")
@@ -68,9 +68,9 @@ if grep -q "fewer than" "$work/bridge.log"; then fail "the bridge did not see it
 grep -q "published 180 odometry, 18 observations, 180 ground truth, 3 robot sightings" "$work/bridge.log" ||
   fail "bridge counts"
 
-wait "$hz_pid" || fail "pixyslam_log hz --robot robot2: exit $?"
+wait "$hz_pid" || fail "pixyslam_log hz --robot-id robot2: exit $?"
 tail -n 1 "$work/hz.out"
-tail -n 1 "$work/hz.out" | grep -q '"messages":80,' || fail "hz --robot robot2 did not count robot 2's 80 odometry samples"
+tail -n 1 "$work/hz.out" | grep -q '"messages":80,' || fail "hz --robot-id robot2 did not count robot 2's 80 odometry samples"
 
 sleep 0.5
 for r in 1 2; do

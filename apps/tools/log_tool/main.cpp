@@ -146,7 +146,10 @@ int main(int argc, char** argv) {
   echo.option("topic", echo_request.topic, "the topic").required().type("TOPIC");
   echo.flag("--json", echo_request.json, "one JSON object per line");
   echo.option("--count", count, "stop after N samples (0: no limit)").non_negative().type("N");
-  echo.option("--robot", echo_request.robot, "only this robot's samples (header.robot_id)").type("ID");
+  // --robot-id as in dds.robot_id (--robot elsewhere is an MRCLAM robot number); --robot still accepted.
+  echo.option("--robot-id,--robot", echo_request.robot,
+              "only this robot's samples (header.robot_id; --robot: its old name, deprecated)")
+      .type("ID");
   add_duration(echo, "0: until Ctrl-C or --count");
   dds_args.add_to(echo);
 
@@ -155,7 +158,8 @@ int main(int argc, char** argv) {
   hz.option("topic", hz_topic, "the topic").required().type("TOPIC");
   hz.flag("--json", json, "a JSON line every second and one for the summary");
   std::string hz_robot;
-  hz.option("--robot", hz_robot, "only this robot's samples (header.robot_id)").type("ID");
+  hz.option("--robot-id,--robot", hz_robot, "only this robot's samples (header.robot_id; --robot: its old name, deprecated)")
+      .type("ID");
   add_duration(hz, "5");
   dds_args.add_to(hz);
 
