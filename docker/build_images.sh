@@ -21,7 +21,7 @@ done
 command -v "$engine" >/dev/null || { echo "SKIP: $engine is not installed"; exit 77; }
 root=$(cd "$(dirname "$0")/.." && pwd)
 export CONTAINERS_CONF=${CONTAINERS_CONF:-$root/docker/containers.conf}
-packages=builder packages_id=""
+packages=builder packages_id="" robot_depends="" station_depends=""
 if ((from_source == 0)); then
   build_dir=${build_dir:-$root/build}
   [[ -f $build_dir/CPackConfig.cmake ]] || { echo "$build_dir is not configured: run scripts/build.sh first (or --from-source)" >&2; exit 1; }
@@ -31,6 +31,14 @@ if ((from_source == 0)); then
   rm -rf "$root/build/packages/_CPack_Packages"
   packages=context
   packages_id=$(cat "$root"/build/packages/pixyslam-*.deb | sha256sum | cut -c1-16)
+  # The Debian packages each .deb depends on (first of alternatives, no versions): installed
+  # in a layer of their own, reused from the last build while the list is the same.
+  depends_of() {
+    dpkg-deb -f "$1" Depends | tr ',' '\n' | sed -E 's/\|.*//; s/\(.*\)//; s/^ +//; s/ +$//' |
+      grep -v -e '^pixyslam' -e '^$' | sort -u | tr '\n' ' '
+  }
+  robot_depends=$(depends_of "$root"/build/packages/pixyslam-robot_*.deb)
+  station_depends=$(depends_of "$root"/build/packages/pixyslam-station_*.deb)
 else
   packages_id="source-$(date +%s)"  # the builder stage's packages are new: install them again
 fi
@@ -40,7 +48,8 @@ for role in robot estimator logger viewer; do
   # --network host: only for apt inside the build (the images run without it).
   "$engine" build --network host -q -f "$root/docker/Dockerfile" --target "$role" \
     --build-arg BASE_IMAGE=localhost/pixyslam-base:bookworm --build-arg PACKAGES=$packages \
-    --build-arg PACKAGES_ID="$packages_id" \
+    --build-arg PACKAGES_ID="$packages_id" --build-arg ROBOT_DEPENDS="$robot_depends" \
+    --build-arg STATION_DEPENDS="$station_depends" \
     -t "localhost/pixyslam-$role:latest" "$root" > /dev/null
 done
 # The previous builds' images, untagged now: only ours (the Dockerfile's label), nobody else's.
