@@ -1,6 +1,6 @@
 // Logger throughput on loopback: this process publishes Odometry at a fixed
 // rate to a separate `logger` process, then checks the file it wrote.
-//   bench_logger_throughput [--rate 10000] [--duration 10] [--compression zstd]
+//   bench_logger_throughput [--rate-hz 10000] [--duration 10] [--compression zstd]
 //                           [--out FILE.mcap] [--domain D]
 // The logger runs with config/logger.yaml's settings (1 MiB chunks, flush
 // every 1 s) on a domain of its own, recording Odometry only. Reports: messages
@@ -183,7 +183,7 @@ int main(int argc, char** argv) {
   bench::Arguments a;
   app::Cli cli{"bench_logger_throughput",
                "Odometry at RATE per second to a separate logger on loopback: its CPU use and what it lost."};
-  cli.option("--rate", a.rate_hz, "messages per second (default 10000)").positive().type("HZ");
+  cli.option("--rate-hz", a.rate_hz, "messages per second (default 10000)").positive().type("HZ");
   cli.option("--duration", a.duration_s, "seconds (default 10)").positive().type("S");
   cli.option("--compression", a.compression, "chunk compression (default zstd)").choices({"none", "zstd", "lz4"}).type("C");
   cli.option("--out", a.out, "the MCAP file to write (default: a temporary file)").type("FILE.mcap");

@@ -18,7 +18,9 @@ the evaluations and benchmarks on the MRCLAM data set (`mrclam_eval`, `bench_mrc
 `bench_map_optimizer`) exit 77 when it is absent (skipped), `slam_offline mrclam` 1.
 Flags mean the same everywhere: `--config FILE` (the process's YAML; for the inspection tools one
 with a `dds:` mapping), `--domain N`, `--set KEY=VALUE` (a parameter of the config, listed under
-`--help`), `--out FILE`, `--out-dir DIR`, `--duration S`, `--json`, `--verbose`.
+`--help`), `--out FILE`, `--out-dir DIR`, `--duration S`, `--json`, `--verbose`, `--rate R` (a
+speed factor: recorded seconds per wall or video second), `--rate-hz HZ` (messages per second),
+`--robot N` (an MRCLAM robot number), `--robot-id ID` (a `dds.robot_id`).
 `pixyslam_log` is `pixyslam_spy` under its old name. Regenerate with
 `scripts/tool_help.sh > docs/tools.md`.
 TEXT

@@ -69,7 +69,7 @@ relay_pid=$!
 for _ in $(seq 400); do grep -q ready "$work/relay.log" && break; kill -0 "$relay_pid" 2>/dev/null || break; sleep 0.1; done
 grep -q ready "$work/relay.log" || fail "cyclone_relay did not match the recorder on domain $((domain + 1))"
 "${fast[@]}" "$bin/mcap_sample_publisher" --profiles "$config/dds/profiles.xml" --domain "$domain" \
-  --count "$count" --rate 100 --topics all --diagnostics --readers 2 --wait-readers 30 > "$work/publisher.log" 2>&1 ||
+  --count "$count" --rate-hz 100 --topics all --diagnostics --readers 2 --wait-readers 30 > "$work/publisher.log" 2>&1 ||
   fail "publisher (no Cyclone reader matched, or samples not acknowledged)"
 sleep 1  # the last samples reach the relay
 # The relay first: it waits for the relayed recorder's acknowledgments.

@@ -74,7 +74,7 @@ client_pid=$!
 pids+=("$client_pid")
 sleep 1
 # Two readers per topic: the bridge and the recorder.
-"$bin/mcap_sample_publisher" --profiles "$config/dds/profiles.xml" --domain "$domain" --count 200 --rate 30 \
+"$bin/mcap_sample_publisher" --profiles "$config/dds/profiles.xml" --domain "$domain" --count 200 --rate-hz 30 \
   --diagnostics --wait-readers 10 --readers 2 > "$work/publisher.log" 2>&1 || fail "mcap_sample_publisher failed"
 live_status=0
 wait "$client_pid" || live_status=$?

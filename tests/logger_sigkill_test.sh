@@ -40,7 +40,7 @@ YAML
 "$logger" --config "$work/logger.yaml" > "$work/logger.out" 2> "$work/logger.err" &
 logger_pid=$!
 "$publisher" --profiles "$source_dir/config/dds/profiles.xml" --domain "$domain" --topics odometry \
-  --count $((rate * 60)) --rate "$rate" > "$work/publisher.out" 2> "$work/publisher.err" &
+  --count $((rate * 60)) --rate-hz "$rate" > "$work/publisher.out" 2> "$work/publisher.err" &
 publisher_pid=$!
 
 # Publishing starts once the logger's reader matched: wait for the first progress line.

@@ -118,7 +118,7 @@ YAML
   "$logger" --config "$dir/logger.yaml" > "$dir/logger.out" 2> "$dir/logger.err" &
   logger_pid=$!
   if ! "$publisher" --profiles "$source_dir/config/dds/profiles.xml" --domain "$domain" --count "$count" \
-      --rate 1000 > "$dir/publisher.out" 2> "$dir/publisher.err"; then
+      --rate-hz 1000 > "$dir/publisher.out" 2> "$dir/publisher.err"; then
     echo "FAIL $name: publisher failed"; cat "$dir/publisher.err" "$dir/logger.err"; return 1
   fi
   sleep 0.5

@@ -4,7 +4,7 @@
 //                  [--set KEY=VALUE ...] [--domain N] [--verbose]
 // --checkpoint (or estimator.checkpoint.file) saves the pose and map every
 // period and resumes from the file at start when it is fresh (a restart).
-// --out-dir writes DIR/trajectory.csv (every MapState's mean pose) and DIR/landmarks.csv at exit.
+// --out-dir writes DIR/trajectory.csv (the mean pose after every filter step) and DIR/landmarks.csv at exit.
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   app::Cli cli{"slam_estimator", "FastSLAM 2.0 over DDS: Odometry and LandmarkObservation in, MapState out, until SIGINT/SIGTERM."};
   app::add_config(cli, config, "config/slam_estimator.yaml: filter:, estimator:, dds:");
   cli.option("--seed", seed, "the same as --set filter.seed=S").type("S");
-  cli.option("--out-dir", out_dir, "at exit, DIR/trajectory.csv (every MapState's mean pose) and DIR/landmarks.csv")
+  cli.option("--out-dir", out_dir, "at exit, DIR/trajectory.csv (the mean pose after every filter step) and DIR/landmarks.csv")
       .type("DIR");
   cli.option("--checkpoint", checkpoint,
                  "save pose and map here every period, resume from it at start when fresh (estimator.checkpoint.file)")
@@ -71,6 +71,7 @@ int main(int argc, char** argv) {
       throw app::UsageError(std::string("--seed/--set: ") + e.what());
     }
     if (!checkpoint.empty()) options.checkpoint.file = checkpoint;
+    options.keep_trajectory = !out_dir.empty();
     std::fprintf(stderr, "slam_estimator: %d particles, seed %llu, DDS domain %d, profiles '%s'\n",
                  options.filter.particles, static_cast<unsigned long long>(options.filter.seed),
                  options.dds.domain_id, options.dds.profiles_file.c_str());

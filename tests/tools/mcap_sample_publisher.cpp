@@ -1,7 +1,7 @@
 // Test publisher for the logger's integration tests: N rounds, each one message
 // of every topic (or of Odometry only), at a fixed rate, seq 1..N per topic.
 //   mcap_sample_publisher --profiles config/dds/profiles.xml --domain D --count N
-//                         [--rate HZ] [--topics all|odometry] [--diagnostics] [--readers N] [--wait-readers S]
+//                         [--rate-hz HZ] [--topics all|odometry] [--diagnostics] [--readers N] [--wait-readers S]
 // Waits for one matched reader per topic, then publishes; prints
 // "progress N" (rounds published) every 10 rounds, line-buffered, so that a
 // test knows how far it got; then waits for the readers' acknowledgments and
@@ -204,7 +204,7 @@ int run(int argc, char** argv) {
   std::vector<std::string> dds_overrides;
   app::add_domain(cli, dds_overrides);
   cli.option("--count", count, "messages per topic").required().range(1, 100000000).type("N");
-  cli.option("--rate", rate_hz, "rounds per second").positive().type("HZ");
+  cli.option("--rate-hz", rate_hz, "rounds per second").positive().type("HZ");
   cli.option("--topics", topics, "every data topic, or Odometry only").choices({"all", "odometry"});
   cli.flag("--diagnostics", with_diagnostics, "also publish N Diagnostics");
   cli.option("--wait-readers", wait_s, "seconds to wait for the readers").non_negative().type("S");

@@ -3,7 +3,7 @@
 // map optimiser's solution.
 //   map_view live   [--config FILE] [--out-dir DIR] [--period S] [--no-window] [--domain N] [--verbose]
 //   map_view render LOG.mcap --out FILE.png [--config FILE] [--width N] [--height N] [--no-truth]
-//   map_view video  LOG.mcap --out FILE.avi|--out-dir DIR [--config FILE] [--fps N] [--speed X]
+//   map_view video  LOG.mcap --out FILE.avi|--out-dir DIR [--config FILE] [--fps N] [--rate R]
 //                   [--width N] [--height N] [--no-truth]
 // --config: a map_view.yaml (config/map_view.yaml); without it the defaults
 // and, live, the loopback profile on domain 0. Exit status: 0 done, 2 a bad
@@ -107,7 +107,10 @@ int main(int argc, char** argv) {
       video.option("--out-dir", video_out_dir, "a folder for numbered PNG frames instead").type("DIR");
   video_out.excludes(video_frames);
   video.option("--fps", video_request.fps, "frames per second of video").range(0.1, 240.0).type("N");
-  video.option("--speed", video_request.speed, "log seconds per video second").range(0.01, 10000.0).type("X");
+  // --rate: a speed factor, as in pixyslam_play and dataset_bridge (--speed: its old name, still accepted).
+  video.option("--rate,--speed", video_request.rate, "log seconds per video second (--speed: its old name, deprecated)")
+      .range(0.01, 10000.0)
+      .type("R");
   video_view.add_to(video, true);
 
   ViewArguments live_view;

@@ -28,6 +28,7 @@ EstimatorOptions test_options() {
   EstimatorOptions o = read_estimator_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/slam_estimator.yaml");
   o.status_period_s = 0.0;
   o.dds.robot_id = "test_robot";
+  o.keep_trajectory = true;  // what slam_estimator --out-dir sets
   return o;
 }
 
@@ -428,6 +429,7 @@ TEST(EstimatorNode, TwoRobotsOnOneDomainEachEstimatorReadsItsOwn) {
 // per topic (diagnostics), dropped, and the filter goes on with the good ones.
 TEST(EstimatorNode, MalformedSamplesAreCountedAndTheFilterGoesOn) {
   EstimatorOptions options = test_options();
+  options.keep_trajectory = false;  // the default: no history grows with the run
   EstimatorNode node(options);
   node.start();
   dds::Participant hostile(options.dds, "test_hostile");
@@ -460,6 +462,7 @@ TEST(EstimatorNode, MalformedSamplesAreCountedAndTheFilterGoesOn) {
   EXPECT_EQ(c.odometry_malformed, bad_o.size());
   EXPECT_EQ(c.observations_malformed, bad_f.size());
   EXPECT_GE(c.steps, 5u);
+  EXPECT_TRUE(node.trajectory().empty());
 }
 
 // Samples that decode fine but are stamped years ahead (a hostile sender, a

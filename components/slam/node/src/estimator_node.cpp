@@ -230,8 +230,9 @@ void EstimatorNode::step(const slam::SensorInput& input) {
   fill_map_state(*filter_, info, options_.published_particle_poses, options_.landmarks == "mixture",
                  map_state_);
   const msg::Pose2D& mean = map_state_.mean_pose();
-  trajectory_.emplace_back(map_state_.header().stamp_ns(),
-                           slam::Pose2(mean.x_m(), mean.y_m(), mean.theta_rad()));
+  if (options_.keep_trajectory) {
+    trajectory_.emplace_back(map_state_.header().stamp_ns(), slam::Pose2(mean.x_m(), mean.y_m(), mean.theta_rad()));
+  }
   ++counters_.steps;
   const std::uint64_t stamp = map_state_.header().stamp_ns();
   const auto period_ns = static_cast<std::uint64_t>(options_.map_state_period_s * 1e9);

@@ -141,16 +141,16 @@ WorldBox run_bounds(const MapLog& log, double sigma_scale, bool include_truth) {
   return box;
 }
 
-std::vector<std::uint64_t> frame_times(std::uint64_t start_ns, std::uint64_t end_ns, double fps, double speed) {
+std::vector<std::uint64_t> frame_times(std::uint64_t start_ns, std::uint64_t end_ns, double fps, double rate) {
   if (!(fps > 0.0) || !std::isfinite(fps)) throw std::invalid_argument("fps must be a number > 0");
-  if (!(speed > 0.0) || !std::isfinite(speed)) throw std::invalid_argument("speed must be a number > 0");
+  if (!(rate > 0.0) || !std::isfinite(rate)) throw std::invalid_argument("rate must be a number > 0");
   std::vector<std::uint64_t> out;
-  const double step_ns = speed / fps * 1e9;
+  const double step_ns = rate / fps * 1e9;
   if (end_ns < start_ns) return {end_ns};
   const double span_ns = static_cast<double>(end_ns - start_ns);
   constexpr double kMaxFrames = 1e6;
   if (span_ns / step_ns > kMaxFrames) {
-    throw std::invalid_argument("fps and speed would give more than 1000000 frames for this log");
+    throw std::invalid_argument("fps and rate would give more than 1000000 frames for this log");
   }
   for (double k = 0.0; k * step_ns < span_ns; k += 1.0) {
     out.push_back(start_ns + static_cast<std::uint64_t>(k * step_ns));

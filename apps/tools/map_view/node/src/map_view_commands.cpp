@@ -48,9 +48,9 @@ int run_video(const MapViewOptions& options, const VideoRequest& request) {
   const MapLog log = read_log(request.log);
   std::vector<std::uint64_t> times;
   try {
-    times = frame_times(log.start_ns(), log.end_ns(), request.fps, request.speed);
+    times = frame_times(log.start_ns(), log.end_ns(), request.fps, request.rate);
   } catch (const std::invalid_argument& e) {
-    throw InputError(std::string("--fps/--speed: ") + e.what());
+    throw InputError(std::string("--fps/--rate: ") + e.what());
   }
   RenderOptions render = options.render;
   render.view = run_bounds(log, render.sigma_scale, render.ground_truth);
@@ -63,7 +63,7 @@ int run_video(const MapViewOptions& options, const VideoRequest& request) {
   }
   sink.close();
   std::printf("map_view: %s: %zu frames at %g fps (%gx log speed, %.1f s of log) -> %s%s\n", request.log.c_str(),
-              sink.frames(), request.fps, request.speed, static_cast<double>(log.end_ns() - log.start_ns()) * 1e-9,
+              sink.frames(), request.fps, request.rate, static_cast<double>(log.end_ns() - log.start_ns()) * 1e-9,
               request.out.c_str(), sink.is_video() ? " (MJPG)" : "/frame_NNNNN.png");
   return 0;
 }

@@ -65,7 +65,8 @@ class EstimatorNode {
   EstimatorCounters counters() const;
   // A copy of the latest MapState (for the status line and for tests).
   msg::MapState latest_map_state() const;
-  // The mean pose after every step (stamps in ns), for --out files.
+  // The mean pose after every step (stamps in ns), for --out-dir files; empty
+  // unless EstimatorOptions::keep_trajectory.
   std::vector<std::pair<std::uint64_t, slam::Pose2>> trajectory() const;
 
  private:

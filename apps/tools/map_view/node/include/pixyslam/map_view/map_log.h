@@ -94,9 +94,9 @@ MapViewState final_state(const MapLog& log, double trajectory_min_step_m);
 // view under which a video's frame does not jump.
 WorldBox run_bounds(const MapLog& log, double sigma_scale, bool include_truth);
 
-// Log times of a video's frames: from start to end every speed / fps seconds
+// Log times of a video's frames: from start to end every rate / fps seconds
 // of log time, plus the end itself. Throws std::invalid_argument unless
-// fps > 0 and speed > 0 (finite), or if that would be more than 10^6 frames.
-std::vector<std::uint64_t> frame_times(std::uint64_t start_ns, std::uint64_t end_ns, double fps, double speed);
+// fps > 0 and rate > 0 (finite), or if that would be more than 10^6 frames.
+std::vector<std::uint64_t> frame_times(std::uint64_t start_ns, std::uint64_t end_ns, double fps, double rate);
 
 }  // namespace pixyslam::map_view

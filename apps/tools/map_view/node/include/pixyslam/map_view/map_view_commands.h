@@ -19,7 +19,7 @@ struct VideoRequest {
   std::string log;
   std::string out;
   double fps = 10.0;
-  double speed = 1.0;  // log seconds per video second
+  double rate = 1.0;  // log seconds per video second (--rate)
 };
 int run_video(const MapViewOptions& options, const VideoRequest& request);
 
