@@ -377,6 +377,38 @@ TEST(EncoderNode, MissingAndHungUpDeviceIsLoggedAndReopened) {
   EXPECT_TRUE(log.contains("final status: device '/dev/ttyTEST7'", "hang-ups 1")) << log.all();
 }
 
+TEST(EncoderNode, ADeviceThatFallsSilentWithoutAHangupIsNamedOncePerSilence) {
+  // Given an Arduino that sends, then nothing for 7 s (a UART wire pulled: no
+  // hang-up), then again, then nothing for 3 s,
+  auto script = std::make_shared<bridge::ByteScript>();
+  std::mt19937 prng(7);
+  for (std::uint32_t j = 0; j < 10; ++j) script->add_bytes(encoder::format_line(sample_number(j)), arrival_ns(j, prng));
+  const std::uint64_t quiet_from = arrival_ns(9, prng);
+  for (int k = 1; k <= 70; ++k) script->add_idle(quiet_from + static_cast<std::uint64_t>(k) * 100 * kMs);
+  const std::uint64_t back_ns = quiet_from + 7100 * kMs;
+  script->add_bytes(encoder::format_line(sample_number(10)), back_ns);
+  for (int k = 1; k <= 30; ++k) script->add_idle(back_ns + static_cast<std::uint64_t>(k) * 100 * kMs);
+
+  LogLines log;
+  EncoderNodeOptions options = node_options();
+  options.process.silence_warn_s = 5.0;
+  EncoderNode node(options, std::make_unique<bridge::ScriptedByteSource>(script, "/dev/ttyTEST8"), log.sink(),
+                   bridge::ByteScript::clock(script));
+  node.start();
+  ASSERT_TRUE(script->wait_finished(std::chrono::seconds(10)));
+  node.stop();
+
+  // Then the silence of 7 s was named once, with the device, and its end; the
+  // 3 s after it were not.
+  const EncoderNodeCounters c = node.counters();
+  EXPECT_EQ(c.device.silences, 1u);
+  EXPECT_FALSE(c.device.silent);
+  EXPECT_EQ(c.device.hangups, 0u);
+  EXPECT_TRUE(log.contains("no bytes from serial device '/dev/ttyTEST8' for 5.", "no hang-up")) << log.all();
+  EXPECT_TRUE(log.contains("serial device '/dev/ttyTEST8' sends again after 7.")) << log.all();
+  EXPECT_TRUE(log.contains("final status: device '/dev/ttyTEST8'", "silences 1")) << log.all();
+}
+
 TEST(EncoderNode, ReadsARealPseudoTerminalAndReportsItsHangup) {
   // Given the Arduino's lines written in real time (50 Hz) into a pty,
   // (through a symbolic link, so that the device is surely gone afterwards)

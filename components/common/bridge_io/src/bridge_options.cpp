@@ -10,6 +10,7 @@ namespace pixyslam::bridge {
 DeviceReaderOptions device_reader_options(const BridgeProcessOptions& o) {
   DeviceReaderOptions d;
   d.reopen_period = std::chrono::milliseconds(std::llround(o.reopen_period_s * 1000.0));
+  d.silence_warn = std::chrono::milliseconds(std::llround(o.silence_warn_s * 1000.0));
   return d;
 }
 

@@ -7,6 +7,13 @@
 #include <vector>
 
 namespace pixyslam::bridge {
+namespace {
+std::string seconds_text(std::uint64_t now_ns, std::uint64_t since_ns) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f", static_cast<double>(now_ns - since_ns) * 1e-9);
+  return text;
+}
+}  // namespace
 
 LogFunction stderr_log(const std::string& process) {
   return [process](const std::string& line) {
@@ -52,7 +59,8 @@ std::string DeviceReader::status_line() const {
   const DeviceCounters d = counters();
   return "status: device '" + device_name_ + "': opens " + std::to_string(d.opens) + ", open failures " +
          std::to_string(d.open_failures) + ", hang-ups " + std::to_string(d.hangups) + ", read errors " +
-         std::to_string(d.read_errors) + ", bytes " + std::to_string(d.bytes);
+         std::to_string(d.read_errors) + ", bytes " + std::to_string(d.bytes) + ", silences " +
+         std::to_string(d.silences) + (d.silent ? " (silent now)" : "");
 }
 
 std::chrono::milliseconds DeviceReader::read_timeout() {
@@ -79,6 +87,21 @@ void DeviceReader::run_handler(const char* name, const Call& call) {
   }
 }
 
+void DeviceReader::note_silence(std::uint64_t now_ns, std::uint64_t& last_bytes_ns) {
+  if (options_.silence_warn.count() <= 0) return;
+  if (now_ns < last_bytes_ns) last_bytes_ns = now_ns;  // the host clock stepped back
+  const auto warn_ns = static_cast<std::uint64_t>(options_.silence_warn.count()) * 1'000'000u;
+  if (now_ns - last_bytes_ns < warn_ns) return;
+  {
+    std::lock_guard<std::mutex> lock(counters_mutex_);
+    if (counters_.silent) return;
+    counters_.silent = true;
+    ++counters_.silences;
+  }
+  log_("no bytes from serial device '" + device_name_ + "' for " + seconds_text(now_ns, last_bytes_ns) +
+       " s (open, no hang-up): a pulled UART wire, the wrong device or baud rate, or a sender with nothing to send");
+}
+
 void DeviceReader::wait(std::chrono::milliseconds period) {
   const auto end = std::chrono::steady_clock::now() + period;
   while (!stopping()) {
@@ -100,6 +123,7 @@ void DeviceReader::loop() {
                 static_cast<double>(options_.reopen_period.count()) / 1000.0);
   const std::string retry = std::string("retrying every ") + period_text + " s";
   std::uint64_t failures_in_row = 0;
+  std::uint64_t last_bytes_ns = 0;  // host time of the last byte (or the open)
   std::string last_error;
   auto last_error_log = std::chrono::steady_clock::time_point{};
 
@@ -127,11 +151,13 @@ void DeviceReader::loop() {
       {
         std::lock_guard<std::mutex> lock(counters_mutex_);
         ++counters_.opens;
+        counters_.silent = false;  // a silence is timed from this open
       }
       log_("opened serial device '" + device_name_ + "'" +
            (failures_in_row > 0 ? " after " + std::to_string(failures_in_row) + " failed attempts" : ""));
       failures_in_row = 0;
       last_error.clear();
+      last_bytes_ns = clock_();
       if (handlers_.on_open) run_handler("on_open", [&] { handlers_.on_open(); });
     }
 
@@ -150,11 +176,15 @@ void DeviceReader::loop() {
     }
     const std::uint64_t now_ns = clock_();
     if (result.status == serial::ReadStatus::kData && result.bytes > 0) {
+      bool was_silent = false;
       {
         std::lock_guard<std::mutex> lock(counters_mutex_);
         ++counters_.reads;
         counters_.bytes += result.bytes;
+        was_silent = std::exchange(counters_.silent, false);
       }
+      if (was_silent) log_("serial device '" + device_name_ + "' sends again after " + seconds_text(now_ns, last_bytes_ns) + " s");
+      last_bytes_ns = now_ns;
       if (handlers_.on_bytes) {
         run_handler("on_bytes", [&] { handlers_.on_bytes(buffer.data(), result.bytes, now_ns); });
       }
@@ -169,6 +199,7 @@ void DeviceReader::loop() {
       wait(options_.reopen_period);
       continue;
     }
+    if (result.status != serial::ReadStatus::kData) note_silence(now_ns, last_bytes_ns);
     if (handlers_.on_poll) run_handler("on_poll", [&] { handlers_.on_poll(now_ns); });
   }
   source_->close();

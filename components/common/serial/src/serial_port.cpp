@@ -1,6 +1,8 @@
 #include "pixyslam/serial/serial_port.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
+#include <sys/ioctl.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -125,8 +127,24 @@ void SerialPort::open(const std::string& path, long baud) {
   const std::string name = device_name(path);
   const speed_t speed = speed_constant(baud, path);  // before touching the device
   detail::UniqueFd fd(::open(path.c_str(), O_RDWR | O_NOCTTY | O_CLOEXEC | O_NONBLOCK));
-  if (fd.get() < 0) throw detail::os_error(errno, name + ": open failed");
+  if (fd.get() < 0) {
+    const int err = errno;
+    std::string hint;
+    if (err == EACCES || err == EPERM) hint = " (serial devices belong to the group 'dialout': is this user in it?)";
+    if (err == EBUSY) hint = " (in use by another process: another bridge, or a terminal program)";
+    throw detail::os_error(err, name + ": open failed" + hint);
+  }
+  // One reader per device: two would each get part of the bytes. flock() holds
+  // against another bridge (root too); TIOCEXCL against a terminal program.
+  if (::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    if (err == EWOULDBLOCK) {
+      throw detail::os_error(EBUSY, name + ": in use by another process (another bridge, or a terminal program)");
+    }
+    throw detail::os_error(err, name + ": flock");
+  }
   detail::make_raw(fd.get(), speed, name);
+  if (::ioctl(fd.get(), TIOCEXCL) != 0) throw detail::os_error(errno, name + ": TIOCEXCL");
   // Bytes that arrived before this open are stale.
   if (::tcflush(fd.get(), TCIFLUSH) != 0) throw detail::os_error(errno, name + ": tcflush");
   fd_ = fd.release();
@@ -135,6 +153,8 @@ void SerialPort::open(const std::string& path, long baud) {
 }
 
 void SerialPort::close() noexcept {
+  // Exclusive mode outlives this descriptor while others hold the tty open (a pty's other side).
+  if (fd_ >= 0) ::ioctl(fd_, TIOCNXCL);
   detail::close_fd(fd_);
   fd_ = -1;
 }

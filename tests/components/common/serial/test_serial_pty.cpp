@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <cstdint>
 #include <cstdlib>
@@ -173,6 +174,28 @@ TEST(SerialPty, ClosingTheMasterIsAHangup) {
   if (r.status == ReadStatus::kData) r = port.read_some(buf, sizeof buf, milliseconds(1000));
   EXPECT_EQ(r.status, ReadStatus::kHangup);
   EXPECT_THROW(port.write_all(std::string("x"), milliseconds(100)), std::system_error);
+}
+
+// Two readers of one device would each get part of its bytes: the second open
+// is refused, naming the device, until the first port closes.
+TEST(SerialPty, ASecondOpenOfTheSameDeviceIsRefusedUntilTheFirstCloses) {
+  PseudoTerminal pty;
+  {
+    SerialPort first(pty.slave_path(), 115200);
+    try {
+      SerialPort second(pty.slave_path(), 115200);
+      ADD_FAILURE() << "a second open of " << pty.slave_path() << " succeeded";
+    } catch (const std::system_error& e) {
+      EXPECT_EQ(e.code().value(), EBUSY);
+      EXPECT_NE(std::string(e.what()).find(pty.slave_path() + ": in use by another process"), std::string::npos)
+          << e.what();
+    }
+    ASSERT_EQ(pty.write_all(std::string("ok")), 2u);
+    EXPECT_EQ(read_exactly(first, 2), std::vector<std::uint8_t>({'o', 'k'}));
+  }
+  SerialPort again(pty.slave_path(), 115200);  // free once the first closed
+  ASSERT_EQ(pty.write_all(std::string("go")), 2u);
+  EXPECT_EQ(read_exactly(again, 2), std::vector<std::uint8_t>({'g', 'o'}));
 }
 
 TEST(SerialPty, ClientRestartDoesNotHangTheMasterUp) {

@@ -4,7 +4,10 @@ namespace pixyslam::map_view {
 
 Pose2 to_pose(const msg::Pose2D& pose) { return {pose.x_m(), pose.y_m(), pose.theta_rad()}; }
 
-LandmarkView to_landmark(const msg::LandmarkEstimate& l) {
+namespace {
+// The fields a filter's and an optimiser's landmark share.
+template <class Landmark>
+LandmarkView landmark_view(const Landmark& l, unsigned times_observed) {
   LandmarkView v;
   v.id = l.landmark_id();
   v.x_m = l.x_m();
@@ -12,9 +15,12 @@ LandmarkView to_landmark(const msg::LandmarkEstimate& l) {
   v.cov_xx_m2 = l.cov_xx_m2();
   v.cov_xy_m2 = l.cov_xy_m2();
   v.cov_yy_m2 = l.cov_yy_m2();
-  v.times_observed = l.times_observed();
+  v.times_observed = times_observed;
   return v;
 }
+}  // namespace
+
+LandmarkView to_landmark(const msg::LandmarkEstimate& l) { return landmark_view(l, l.times_observed()); }
 
 std::vector<LandmarkView> to_landmarks(const msg::MapState& state) {
   std::vector<LandmarkView> out;
@@ -30,17 +36,7 @@ std::vector<TrueLandmarkView> to_true_landmarks(const msg::GroundTruth& truth) {
   return out;
 }
 
-LandmarkView to_landmark(const msg::OptimisedLandmark& l) {
-  LandmarkView v;
-  v.id = l.landmark_id();
-  v.x_m = l.x_m();
-  v.y_m = l.y_m();
-  v.cov_xx_m2 = l.cov_xx_m2();
-  v.cov_xy_m2 = l.cov_xy_m2();
-  v.cov_yy_m2 = l.cov_yy_m2();
-  v.times_observed = l.observations();
-  return v;
-}
+LandmarkView to_landmark(const msg::OptimisedLandmark& l) { return landmark_view(l, l.observations()); }
 
 std::vector<LandmarkView> to_landmarks(const msg::OptimisedMap& map) {
   std::vector<LandmarkView> out;

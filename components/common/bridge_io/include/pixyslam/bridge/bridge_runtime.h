@@ -161,6 +161,8 @@ class BridgeRuntime {
     s.counters.push_back({"device_hangups", d.hangups, true});
     s.counters.push_back({"device_read_errors", d.read_errors, true});
     s.counters.push_back({"device_bytes", d.bytes, false});
+    // An open device that went silent (node.silence_warn_s): a warning while it increases.
+    s.counters.push_back({"device_silences", d.silences, true});
     if (d.opens <= d.hangups + d.read_errors) {
       s.error = "device '" + reader_.device_name() + "' is not open (" + std::to_string(d.open_failures) +
                 " failed attempts so far)";

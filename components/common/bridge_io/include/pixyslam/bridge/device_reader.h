@@ -29,6 +29,11 @@ struct DeviceReaderOptions {
   std::chrono::milliseconds reopen_period{1000};  // between open attempts after a failure or hang-up
   std::chrono::milliseconds poll_period{50};      // read timeout: on_poll runs at least this often
   std::chrono::seconds repeat_error_log{60};      // a persisting open failure is logged again after this
+  // An open device that sends no byte for this long (host clock) is named in the
+  // log and counted (DeviceCounters::silences), once per silent stretch, since
+  // a cable pulled from a UART, a wrong device or baud rate, or a sender that
+  // stopped shows no hang-up. 0: never.
+  std::chrono::milliseconds silence_warn{0};
   // Most bytes handed over per on_bytes call: one read takes all a tty holds
   // (Linux buffers 4096 bytes per tty), so what a busy host left unread comes
   // in one chunk, and the pixy bridge can spread its frames back in time.
@@ -44,6 +49,8 @@ struct DeviceCounters {
   std::uint64_t handler_errors = 0;  // exceptions thrown by a handler (logged, then ignored)
   std::uint64_t reads = 0;          // reads that returned data
   std::uint64_t bytes = 0;          // bytes read
+  std::uint64_t silences = 0;       // times an open device sent nothing for silence_warn
+  bool silent = false;              // it is silent now (until its next byte)
 };
 
 // Owns the thread that reads a bridge's device: keeps the ByteSource open,
@@ -90,6 +97,8 @@ class DeviceReader {
   // Waits `period` (or until stop), calling on_poll every poll_period.
   void wait(std::chrono::milliseconds period);
   bool stopping() const { return stop_.load(); }
+  // After a read without bytes: logs and counts a silence of silence_warn (once per stretch).
+  void note_silence(std::uint64_t now_ns, std::uint64_t& last_bytes_ns);
   template <class Call>
   void run_handler(const char* name, const Call& call);
 

@@ -13,6 +13,7 @@ namespace pixyslam::bridge {
 // Process settings every bridge has, in its config file's `node:` mapping.
 struct BridgeProcessOptions {
   double reopen_period_s = 1.0;   // between attempts to open a missing or hung-up device
+  double silence_warn_s = 5.0;    // an open device silent this long is logged and counted (0: never)
   double status_period_s = 10.0;  // counters to the log this often (0: only at exit)
   // Messages are held until this many readers matched (the writer is
   // volatile: a reader that matches later misses what went before), at most
@@ -22,7 +23,7 @@ struct BridgeProcessOptions {
   double wait_readers_timeout_s = 3.0;
 };
 
-// The `node:` parameters every bridge has (reopen_period_s, status_period_s),
+// The `node:` parameters every bridge has (reopen_period_s, silence_warn_s, status_period_s, ...),
 // for a bridge's own `node:` table; `member` finds them in its options.
 template <class Options>
 parameters::Table<Options> process_parameters(std::function<BridgeProcessOptions&(Options&)> member) {
@@ -30,6 +31,9 @@ parameters::Table<Options> process_parameters(std::function<BridgeProcessOptions
   return {
       P::real<Options>("reopen_period_s", 0.01, 3600.0, "s", "between attempts to open a missing or hung-up device",
                        [member](Options& o) -> double& { return member(o).reopen_period_s; }),
+      P::real<Options>("silence_warn_s", 0.0, 86400.0, "s",
+                       "an open device that sends nothing this long is logged and counted (device_silences; 0: never)",
+                       [member](Options& o) -> double& { return member(o).silence_warn_s; }),
       P::real<Options>("status_period_s", 0.0, 86400.0, "s", "counters to the log this often (0: only at exit)",
                        [member](Options& o) -> double& { return member(o).status_period_s; }),
       P::integer<Options, int>("wait_readers", 0, 100, "", "readers to wait for before the first message is "
