@@ -138,6 +138,24 @@ TEST(OdometryStream, AStalledLinkKeepsTheRateWithNoDataPeriods) {
   EXPECT_GT(d.out.back().odometry.v_mps, 0.0);
 }
 
+// An Arduino that repeats one line (same seq) has stalled: the repeats hold
+// off neither the "no data" periods nor pile up as sample times.
+TEST(OdometryStream, ARepeatedLineIsAStallNotAStreamOfSamples) {
+  Driver d;
+  for (int i = 0; i <= 25; ++i) d.sample_at(0.02 * i, 10);  // samples up to 0.5 s
+  const std::size_t before = d.out.size();
+  const std::uint32_t repeated_seq = d.seq - 1;
+  for (int k = 1; k <= 100; ++k) {  // the last line again, read every 20 ms up to 2.5 s
+    const auto receive = kEpoch + static_cast<std::uint64_t>((0.5 + 0.02 * k) * 1e9) + 2 * kMs;
+    d.stream.add_sample({repeated_seq, 1500000, d.ticks, d.ticks}, receive,
+                        [&](const StreamOutput& o) { d.out.push_back(o); });
+    if (k % 5 == 0) d.poll_at(0.5 + 0.02 * k);
+  }
+  ASSERT_GT(d.out.size(), before + 10);  // the periods went on as "no data"
+  for (std::size_t i = before + 1; i < d.out.size(); ++i) EXPECT_EQ(d.out[i].samples, 0u) << i;
+  EXPECT_EQ(d.stream.wheel_counters().duplicates, 100u);
+}
+
 TEST(OdometryStream, NoPollOutputBeforeTheFirstSample) {
   Driver d;
   d.poll_at(10.0);

@@ -99,6 +99,7 @@ void expect_same_counters(const PixyParserCounters& a, const PixyParserCounters&
   EXPECT_EQ(a.blocks_ok, b.blocks_ok);
   EXPECT_EQ(a.colour_code_blocks_ok, b.colour_code_blocks_ok);
   EXPECT_EQ(a.blocks_outside_frame, b.blocks_outside_frame);
+  EXPECT_EQ(a.blocks_over_frame_limit, b.blocks_over_frame_limit);
   EXPECT_EQ(a.checksum_errors, b.checksum_errors);
   EXPECT_EQ(a.zero_signature_blocks, b.zero_signature_blocks);
   EXPECT_EQ(a.zero_words, b.zero_words);
@@ -394,6 +395,28 @@ TEST(PixyProtocol, DeliversEmptyFramesAndFlushesTheOpenOne) {
   expect_bytes_add_up(p);
 }
 
+// Valid blocks that never meet a frame start (a broken or hostile sender) do
+// not grow the open frame without end: past the limit they are counted and dropped.
+TEST(PixyProtocol, AFrameKeepsAtMostTheBlockLimitAndCountsTheRest) {
+  const PixyBlock a = normal(1, 100, 80, 10, 20);
+  std::vector<std::uint8_t> bytes = encode_frame({});
+  for (std::size_t i = 0; i < kPixyMaxBlocksPerFrame + 100; ++i) encode_block(a, bytes);
+  PixyBlockParser p;
+  EXPECT_TRUE(p.feed(bytes).empty());
+  const std::optional<PixyFrame> frame = p.flush();
+  ASSERT_TRUE(frame.has_value());
+  EXPECT_EQ(frame->blocks.size(), kPixyMaxBlocksPerFrame);
+  EXPECT_EQ(p.counters().blocks_over_frame_limit, 100u);
+  EXPECT_EQ(p.counters().blocks_ok, kPixyMaxBlocksPerFrame + 100);
+  // The next frame starts with a clean count.
+  std::vector<std::uint8_t> next = encode_frame({a, a});
+  p.feed(next);
+  const std::optional<PixyFrame> second = p.flush();
+  ASSERT_TRUE(second.has_value());
+  EXPECT_EQ(second->blocks.size(), 2u);
+  expect_bytes_add_up(p);
+}
+
 TEST(PixyProtocol, ColourCodeWithZeroChecksumRoundTrips) {
   // 012 + 50 + 50 + 30 + 40 = 180; angle -180 makes the sum 0.
   const PixyBlock z = colour_code(012, 50, 50, 30, 40, -180);
@@ -462,7 +485,7 @@ TEST(PixyProtocol, FuzzedBuffersNeverBreakTheCounters) {
     std::uint64_t open_blocks = 0;
     const bool was_open = p.frame_open();
     if (std::optional<PixyFrame> last = p.flush()) open_blocks = last->blocks.size();
-    EXPECT_EQ(c.blocks_ok, in_frames + open_blocks + c.blocks_outside_frame);
+    EXPECT_EQ(c.blocks_ok, in_frames + open_blocks + c.blocks_outside_frame + c.blocks_over_frame_limit);
     EXPECT_EQ(c.frames, got.size());
     EXPECT_EQ(c.frame_syncs, got.size() + (was_open ? 1u : 0u));
     EXPECT_LE(c.colour_code_blocks_ok, c.blocks_ok);

@@ -23,9 +23,12 @@ void OdometryStream::add_sample(const EncoderSample& sample, std::uint64_t recei
     has_epoch_ = true;
   }
   const double t_s = to_seconds(host_ns);
+  const WheelUpdate update = odometry_.update(sample);
+  // A repeated line is no news: it neither counts as a sample of a period nor
+  // holds off the stall timer (an Arduino that repeats one line has stalled).
+  if (update.status == WheelStatus::kDuplicate) return;
   sample_times_.push_back(t_s);
   last_sample_ns_ = receive_ns;
-  const WheelUpdate update = odometry_.update(sample);
   accumulator_.add(t_s, update, [&](const OdometryOutput& o) { output(o, emit); });
   last_time_s_ = std::max(last_time_s_, t_s);
 }

@@ -144,7 +144,9 @@ void PixyBlockParser::feed(const std::uint8_t* data, std::size_t size, const Fra
     }
     ++counters_.blocks_ok;
     if (colour_code) ++counters_.colour_code_blocks_ok;
-    if (frame_open_) {
+    if (frame_open_ && frame_.blocks.size() >= kPixyMaxBlocksPerFrame) {
+      ++counters_.blocks_over_frame_limit;
+    } else if (frame_open_) {
       frame_.blocks.push_back(b);
     } else {
       ++counters_.blocks_outside_frame;

@@ -62,6 +62,7 @@ std::vector<diagnostics::Counter> PixyNode::diagnostic_counters_locked() const {
           {"empty_frames_rate_limited", r.empty_rate_limited, false},
           {"blocks_ok", p.blocks_ok, false},
           {"checksum_errors", p.checksum_errors, true},
+          {"blocks_over_frame_limit", p.blocks_over_frame_limit, true},
           {"resyncs", p.resyncs, true},
           {"detections", k.detections, false},
           {"unknown_signature", k.unknown_signature, true},
@@ -106,7 +107,7 @@ std::vector<std::string> PixyNode::status_lines_locked() const {
   stream << "status: frames " << p.frames << " (ended by the pause after them " << frames_timed_out_ << ", over the frame rate limit "
          << r.rate_limited << ", of which without blocks " << r.empty_rate_limited << "), blocks " << p.blocks_ok
          << " (colour code " << p.colour_code_blocks_ok << ", outside a frame " << p.blocks_outside_frame
-         << "), checksum errors " << p.checksum_errors << ", signature 0 " << p.zero_signature_blocks
+         << ", over the per-frame limit " << p.blocks_over_frame_limit << "), checksum errors " << p.checksum_errors << ", signature 0 " << p.zero_signature_blocks
          << ", resyncs " << p.resyncs << ", bytes skipped " << p.bytes_skipped;
   detections << "status: detections " << k.detections << " of " << k.blocks << " blocks; rejected: unknown signature "
              << k.unknown_signature << ", zero height " << k.zero_height << ", outside image " << k.outside_image

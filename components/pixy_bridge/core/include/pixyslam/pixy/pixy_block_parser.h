@@ -71,6 +71,10 @@ inline constexpr std::uint16_t kPixySyncNormal = 0xaa55;
 inline constexpr std::uint16_t kPixySyncColourCode = 0xaa56;
 inline constexpr std::size_t kPixyNormalBlockBytes = 14;
 inline constexpr std::size_t kPixyColourCodeBlockBytes = 16;
+// Most blocks one frame keeps: a stream of valid blocks without frame starts
+// would otherwise grow the open frame without end. A camera frame at 50 Hz
+// carries a few blocks at 19200 baud, at most ~80 at 460800.
+inline constexpr std::size_t kPixyMaxBlocksPerFrame = 256;
 
 // One detected colour block, exactly as the camera reports it (pixels, image
 // frame: x right, y down, origin at the top-left corner).
@@ -109,6 +113,7 @@ struct PixyParserCounters {
   std::uint64_t blocks_ok = 0;              // blocks with a matching checksum
   std::uint64_t colour_code_blocks_ok = 0;  // of which colour codes
   std::uint64_t blocks_outside_frame = 0;   // of which dropped: before any frame start
+  std::uint64_t blocks_over_frame_limit = 0;  // of which dropped: past kPixyMaxBlocksPerFrame in one frame
   std::uint64_t checksum_errors = 0;        // blocks dropped for a bad checksum
   std::uint64_t zero_signature_blocks = 0;  // blocks dropped for signature 0
   std::uint64_t zero_words = 0;             // idle 0x0000 words between blocks
