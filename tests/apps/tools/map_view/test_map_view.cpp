@@ -601,6 +601,23 @@ TEST(MsgConversion, OptimisedMapReplacesTheOptimisedSolution) {
   EXPECT_EQ(builder.optimised_maps(), 2u);
 }
 
+// Any participant can invent robot ids: past kMaxRobots their samples are
+// dropped and counted, and the robots already drawn go on.
+TEST(FleetView, InventedRobotsPastTheLimitAreDroppedAndCounted) {
+  FleetViewBuilder fleet;
+  const std::size_t extra = 10;
+  for (std::size_t r = 0; r < FleetViewBuilder::kMaxRobots + extra; ++r) {
+    msg::MapState m = map_state(1000, 0.0, 1);
+    m.header().robot_id("robot" + std::to_string(r));
+    EXPECT_EQ(fleet.add(m), r < FleetViewBuilder::kMaxRobots) << r;
+  }
+  EXPECT_EQ(fleet.robots(), FleetViewBuilder::kMaxRobots);
+  EXPECT_EQ(fleet.over_robot_limit(), extra);
+  msg::MapState again = map_state(2000, 0.5, 1);
+  again.header().robot_id("robot0");
+  EXPECT_TRUE(fleet.add(again));
+}
+
 TEST(FleetView, EveryRobotIsDrawnInOnePictureInItsOwnColour) {
   // Given two robots' states and ground truth on one domain,
   FleetViewBuilder fleet;
@@ -673,6 +690,20 @@ TEST(MsgConversion, TrajectoryDecimation) {
   append_point(path, {std::nan(""), 0.0}, 0.0);
   ASSERT_EQ(path.size(), 2u);
   EXPECT_DOUBLE_EQ(path[1].x_m, 0.11);
+}
+
+// A live view that runs for days: past the limit every other point goes, the
+// first and the newest stay, and the path never holds more than the limit.
+TEST(MsgConversion, APathKeepsAtMostItsLimitWithItsEnds) {
+  std::vector<Point2> path;
+  for (int i = 0; i < 1000; ++i) {
+    append_point(path, {0.01 * i, 0.0}, 0.0, 100);
+    ASSERT_LE(path.size(), 100u) << i;
+  }
+  EXPECT_GE(path.size(), 50u);
+  EXPECT_DOUBLE_EQ(path.front().x_m, 0.0);
+  EXPECT_DOUBLE_EQ(path.back().x_m, 9.99);
+  for (std::size_t i = 1; i < path.size(); ++i) EXPECT_LT(path[i - 1].x_m, path[i].x_m) << i;
 }
 
 // ---- MCAP logs -----------------------------------------------------------

@@ -120,8 +120,13 @@ bool FleetViewBuilder::add(const msg::FleetMap& map) {
   return true;
 }
 
-MapViewBuilder& FleetViewBuilder::robot(const std::string& robot_id) {
-  return robots_.try_emplace(robot_id, min_step_m_).first->second;
+MapViewBuilder* FleetViewBuilder::robot(const std::string& robot_id) {
+  if (const auto it = robots_.find(robot_id); it != robots_.end()) return &it->second;
+  if (robots_.size() >= kMaxRobots) {
+    ++over_robot_limit_;
+    return nullptr;
+  }
+  return &robots_.try_emplace(robot_id, min_step_m_).first->second;
 }
 
 MapViewState FleetViewBuilder::state() const {

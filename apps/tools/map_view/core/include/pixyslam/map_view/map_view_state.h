@@ -61,10 +61,14 @@ struct MapViewState {
   std::vector<MapViewState> other_robots;
 };
 
+// Most points a drawn path keeps (320 KB): a live view runs for days.
+inline constexpr std::size_t kMaxPathPoints = 20000;
+
 // Appends `p` to `path` unless it is closer than `min_step_m` to the last point
-// kept (a cheap decimation for long runs; 0 keeps every point). Non-finite
-// points are dropped.
-void append_point(std::vector<Point2>& path, Point2 p, double min_step_m);
+// kept (a cheap decimation for long runs; 0 keeps every point). Past
+// `max_points` every other point is dropped (the newest kept), so the whole run
+// stays drawn at half the density. Non-finite points are dropped.
+void append_point(std::vector<Point2>& path, Point2 p, double min_step_m, std::size_t max_points = kMaxPathPoints);
 
 // What the caption reports about one estimator state.
 struct CaptionInfo {

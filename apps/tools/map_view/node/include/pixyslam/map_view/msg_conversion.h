@@ -64,14 +64,25 @@ class MapViewBuilder {
 // One MapViewBuilder per robot (header.robot_id): several robots on one
 // domain or in one log are drawn in one picture. state() is the first robot's
 // (by id) with the others in other_robots; each robot's times count from its
-// own first stamp. Thread-compatible.
+// own first stamp. At most kMaxRobots robots: samples of further robot ids
+// (any participant can invent them) are dropped and counted. Thread-compatible.
 class FleetViewBuilder {
  public:
+  static constexpr std::size_t kMaxRobots = 64;  // as fleet_map.max_robots
+
   explicit FleetViewBuilder(double trajectory_min_step_m = 0.0) : min_step_m_(trajectory_min_step_m) {}
 
-  bool add(const msg::MapState& state) { return robot(state.header().robot_id()).add(state); }
-  void add(const msg::GroundTruth& truth) { robot(truth.header().robot_id()).add(truth); }
-  bool add(const msg::OptimisedMap& map) { return robot(map.header().robot_id()).add(map); }
+  bool add(const msg::MapState& state) {
+    MapViewBuilder* b = robot(state.header().robot_id());
+    return b != nullptr && b->add(state);
+  }
+  void add(const msg::GroundTruth& truth) {
+    if (MapViewBuilder* b = robot(truth.header().robot_id())) b->add(truth);
+  }
+  bool add(const msg::OptimisedMap& map) {
+    MapViewBuilder* b = robot(map.header().robot_id());
+    return b != nullptr && b->add(map);
+  }
   // The newest fleet map (older ones are ignored: false).
   bool add(const msg::FleetMap& map);
 
@@ -82,15 +93,19 @@ class FleetViewBuilder {
   std::size_t ground_truths() const { return total(&MapViewBuilder::ground_truths); }
   std::size_t optimised_maps() const { return total(&MapViewBuilder::optimised_maps); }
   std::size_t fleet_maps() const { return fleet_maps_; }
+  // Samples dropped because their robot id would be robot kMaxRobots + 1.
+  std::size_t over_robot_limit() const { return over_robot_limit_; }
 
  private:
-  MapViewBuilder& robot(const std::string& robot_id);
+  // The robot's builder, nullptr past kMaxRobots.
+  MapViewBuilder* robot(const std::string& robot_id);
   std::size_t total(std::size_t (MapViewBuilder::*count)() const) const;
 
   double min_step_m_;
   std::map<std::string, MapViewBuilder> robots_;
   std::vector<LandmarkView> fleet_landmarks_;
   std::size_t fleet_maps_ = 0;
+  std::size_t over_robot_limit_ = 0;
   std::uint64_t last_fleet_ns_ = 0;
 };
 
