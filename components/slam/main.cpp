@@ -4,9 +4,10 @@
 //                  [--set KEY=VALUE ...] [--domain N] [--verbose]
 // --checkpoint (or estimator.checkpoint.file) saves the pose and map every
 // period and resumes from the file at start when it is fresh (a restart).
-// --out-dir writes DIR/trajectory.csv (the mean pose after every filter step) and DIR/landmarks.csv at exit.
+// --out-dir writes DIR/trajectory.csv (the mean pose after every filter step, as it goes) and DIR/landmarks.csv at exit.
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,15 +20,41 @@
 
 namespace {
 
-// DIR/trajectory.csv (t in seconds of the stamps' clock) and DIR/landmarks.csv.
-void write_outputs(const std::string& dir, const pixyslam::slam_node::EstimatorNode& node) {
-  using namespace pixyslam;
-  std::filesystem::create_directories(dir);
-  std::vector<eval::TimedPose> poses;
-  for (const auto& [stamp_ns, pose] : node.trajectory()) {
-    poses.push_back({static_cast<double>(stamp_ns) * 1e-9, pose.x(), pose.y(), pose.z()});
+// DIR/trajectory.csv, written as the steps come (t in seconds of the stamps'
+// clock): a station that runs for days holds no trajectory in memory. A write
+// failure (disk full) is reported once; the filter goes on.
+class TrajectoryOutput {
+ public:
+  explicit TrajectoryOutput(const std::string& dir) : writer_(prepare(dir) + "/trajectory.csv") {}
+
+  void add(std::uint64_t stamp_ns, const pixyslam::slam::Pose2& pose) {
+    if (failed_) return;
+    try {
+      writer_.append({static_cast<double>(stamp_ns) * 1e-9, pose.x(), pose.y(), pose.z()});
+    } catch (const std::exception& e) {
+      failed_ = true;
+      std::fprintf(stderr, "slam_estimator: ERROR: %s; the trajectory file ends here, the filter goes on\n", e.what());
+    }
   }
-  eval::write_trajectory_csv(dir + "/trajectory.csv", poses);
+  // Flushes; the number of rows written.
+  std::size_t finish() {
+    if (!failed_) writer_.flush();
+    return writer_.rows();
+  }
+  const std::string& path() const { return writer_.path(); }
+
+ private:
+  static std::string prepare(const std::string& dir) {
+    std::filesystem::create_directories(dir);
+    return dir;
+  }
+  pixyslam::eval::TrajectoryCsvWriter writer_;
+  bool failed_ = false;
+};
+
+// DIR/landmarks.csv: the last MapState's landmarks.
+void write_landmarks(const std::string& dir, const pixyslam::slam_node::EstimatorNode& node) {
+  using namespace pixyslam;
   std::vector<eval::LandmarkRow> rows;
   // A named copy: iterating over a member of the returned temporary would dangle.
   const msg::MapState last = node.latest_map_state();
@@ -35,8 +62,7 @@ void write_outputs(const std::string& dir, const pixyslam::slam_node::EstimatorN
     rows.push_back({l.landmark_id(), l.x_m(), l.y_m(), l.cov_xx_m2(), l.cov_xy_m2(), l.cov_yy_m2()});
   }
   eval::write_landmarks_csv(dir + "/landmarks.csv", rows);
-  std::fprintf(stderr, "slam_estimator: wrote %s/trajectory.csv (%zu poses), %s/landmarks.csv (%zu)\n",
-               dir.c_str(), poses.size(), dir.c_str(), rows.size());
+  std::fprintf(stderr, "slam_estimator: wrote %s/landmarks.csv (%zu)\n", dir.c_str(), rows.size());
 }
 
 }  // namespace
@@ -50,7 +76,7 @@ int main(int argc, char** argv) {
   app::Cli cli{"slam_estimator", "FastSLAM 2.0 over DDS: Odometry and LandmarkObservation in, MapState out, until SIGINT/SIGTERM."};
   app::add_config(cli, config, "config/slam_estimator.yaml: filter:, estimator:, dds:");
   cli.option("--seed", seed, "the same as --set filter.seed=S").type("S");
-  cli.option("--out-dir", out_dir, "at exit, DIR/trajectory.csv (the mean pose after every filter step) and DIR/landmarks.csv")
+  cli.option("--out-dir", out_dir, "DIR/trajectory.csv (the mean pose after every filter step, written as it goes) and at exit DIR/landmarks.csv")
       .type("DIR");
   cli.option("--checkpoint", checkpoint,
                  "save pose and map here every period, resume from it at start when fresh (estimator.checkpoint.file)")
@@ -71,18 +97,28 @@ int main(int argc, char** argv) {
       throw app::UsageError(std::string("--seed/--set: ") + e.what());
     }
     if (!checkpoint.empty()) options.checkpoint.file = checkpoint;
-    options.keep_trajectory = !out_dir.empty();
     std::fprintf(stderr, "slam_estimator: %d particles, seed %llu, DDS domain %d, profiles '%s'\n",
                  options.filter.particles, static_cast<unsigned long long>(options.filter.seed),
                  options.dds.domain_id, options.dds.profiles_file.c_str());
     if (verbose) app::print_effective_configuration("slam_estimator", slam_node::to_yaml(options));
 
     slam_node::EstimatorNode node(options);
+    std::optional<TrajectoryOutput> trajectory;
+    if (!out_dir.empty()) {
+      trajectory.emplace(out_dir);  // a folder that cannot be written fails now, not at the end
+      node.set_step_observer([&trajectory](std::uint64_t stamp_ns, const slam::Pose2& pose) {
+        trajectory->add(stamp_ns, pose);
+      });
+    }
     node.start();
     while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
     }
     node.stop();
-    if (!out_dir.empty()) write_outputs(out_dir, node);
+    if (trajectory) {
+      const std::size_t rows = trajectory->finish();
+      std::fprintf(stderr, "slam_estimator: wrote %s (%zu poses)\n", trajectory->path().c_str(), rows);
+      write_landmarks(out_dir, node);
+    }
     return 0;
   });
 }

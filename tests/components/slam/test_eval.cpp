@@ -253,6 +253,29 @@ TEST_F(CsvTest, TrajectoryRoundTripIsExact) {
   }
 }
 
+// The streamed file (a live estimator's --out-dir) is the same file as the one
+// written at once: the rows readable while it is still open, non-finite poses
+// skipped and counted, an unwritable path named.
+TEST_F(CsvTest, AStreamedTrajectoryIsTheSameFileAsOneWrittenAtOnce) {
+  const std::vector<TimedPose> poses = {{1248444175.103, 1.4127729, -3.8910776, 2.2696},
+                                        {1248444175.115123456, -0.1, 1e-7, -3.14159}};
+  write_trajectory_csv(path("whole.csv"), poses);
+  TrajectoryCsvWriter writer(path("streamed.csv"));
+  writer.append(poses[0]);
+  writer.append({1248444175.11, std::nan(""), 0.0, 0.0});
+  writer.append(poses[1]);
+  writer.flush();
+  EXPECT_EQ(read_text(path("streamed.csv")), read_text(path("whole.csv")));
+  EXPECT_EQ(writer.rows(), 2u);
+  EXPECT_EQ(writer.skipped(), 1u);
+  try {
+    TrajectoryCsvWriter missing(path("no_such_dir/x.csv"));
+    FAIL() << "expected std::runtime_error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_dir/x.csv: cannot open"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(CsvTest, TrajectoryReaderAcceptsCrlfAndBlankLines) {
   write_text("crlf.csv", "t,x,y,theta\r\n1.5,2,3,0.25\r\n\r\n2.5, 4 ,5,-0.5\r\n");
   const std::vector<TimedPose> poses = read_trajectory_csv(path("crlf.csv"));

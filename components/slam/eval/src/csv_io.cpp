@@ -171,6 +171,30 @@ void write_trajectory_csv(const std::string& path, const std::vector<TimedPose>&
   write_file(path, text);
 }
 
+TrajectoryCsvWriter::TrajectoryCsvWriter(const std::string& path)
+    : path_(path), out_(path, std::ios::binary | std::ios::trunc) {
+  if (!out_) throw std::runtime_error(path + ": cannot open file for writing");
+  out_ << kTrajectoryHeader << '\n';
+  flush();
+}
+
+void TrajectoryCsvWriter::append(const TimedPose& p) {
+  if (!std::isfinite(p.t_s) || !std::isfinite(p.x_m) || !std::isfinite(p.y_m) || !std::isfinite(p.theta_rad)) {
+    ++skipped_;
+    return;
+  }
+  line_.clear();
+  append_row(line_, p.t_s, p.x_m, p.y_m, p.theta_rad);
+  out_.write(line_.data(), static_cast<std::streamsize>(line_.size()));
+  if (!out_) throw std::runtime_error(path_ + ": write failed");
+  ++rows_;
+}
+
+void TrajectoryCsvWriter::flush() {
+  out_.flush();
+  if (!out_) throw std::runtime_error(path_ + ": write failed");
+}
+
 std::vector<LandmarkRow> read_landmarks_csv(const std::string& path) {
   std::vector<LandmarkRow> rows;
   read_csv(path, kLandmarkHeader, [&](const std::vector<std::string_view>& f, const LineRef& at) {

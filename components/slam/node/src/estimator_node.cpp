@@ -169,11 +169,6 @@ msg::MapState EstimatorNode::latest_map_state() const {
   return map_state_;
 }
 
-std::vector<std::pair<std::uint64_t, slam::Pose2>> EstimatorNode::trajectory() const {
-  std::lock_guard<std::mutex> lock(state_mutex_);
-  return trajectory_;
-}
-
 namespace {
 // Samples older than the filter time when they came (the status line's "late").
 std::uint64_t late_samples(const slam::FilterCounters& f) {
@@ -230,8 +225,8 @@ void EstimatorNode::step(const slam::SensorInput& input) {
   fill_map_state(*filter_, info, options_.published_particle_poses, options_.landmarks == "mixture",
                  map_state_);
   const msg::Pose2D& mean = map_state_.mean_pose();
-  if (options_.keep_trajectory) {
-    trajectory_.emplace_back(map_state_.header().stamp_ns(), slam::Pose2(mean.x_m(), mean.y_m(), mean.theta_rad()));
+  if (step_observer_) {
+    step_observer_(map_state_.header().stamp_ns(), slam::Pose2(mean.x_m(), mean.y_m(), mean.theta_rad()));
   }
   ++counters_.steps;
   const std::uint64_t stamp = map_state_.header().stamp_ns();

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,28 @@ struct LandmarkRow {
 // std::runtime_error if the file cannot be written or a value is not finite.
 std::vector<TimedPose> read_trajectory_csv(const std::string& path);
 void write_trajectory_csv(const std::string& path, const std::vector<TimedPose>& poses);
+
+// The same file written as the poses come (a live estimator that runs for
+// days holds none of them): the header at construction, a row per append().
+// Non-finite poses are skipped and counted, not written. Throws
+// std::runtime_error naming the file when it cannot be opened or written.
+class TrajectoryCsvWriter {
+ public:
+  explicit TrajectoryCsvWriter(const std::string& path);
+  void append(const TimedPose& pose);
+  // Writes what is buffered; the destructor closes the file (without throwing).
+  void flush();
+  std::size_t rows() const { return rows_; }
+  std::size_t skipped() const { return skipped_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::ofstream out_;
+  std::string line_;
+  std::size_t rows_ = 0;
+  std::size_t skipped_ = 0;
+};
 
 // Landmark CSV files: header line exactly "id,x,y,cov_xx,cov_xy,cov_yy", then
 // one landmark per line; same conventions and errors as the trajectory files.

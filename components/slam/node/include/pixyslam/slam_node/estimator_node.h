@@ -3,6 +3,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -65,9 +66,11 @@ class EstimatorNode {
   EstimatorCounters counters() const;
   // A copy of the latest MapState (for the status line and for tests).
   msg::MapState latest_map_state() const;
-  // The mean pose after every step (stamps in ns), for --out-dir files; empty
-  // unless EstimatorOptions::keep_trajectory.
-  std::vector<std::pair<std::uint64_t, slam::Pose2>> trajectory() const;
+  // Called on the filter thread after every step with the MapState's stamp (ns)
+  // and mean pose; nothing is kept here (slam_estimator --out-dir streams them to
+  // trajectory.csv). Set before start(); it must not throw.
+  using StepObserver = std::function<void(std::uint64_t stamp_ns, const slam::Pose2& mean)>;
+  void set_step_observer(StepObserver observer) { step_observer_ = std::move(observer); }
 
  private:
   void filter_loop();
@@ -111,7 +114,7 @@ class EstimatorNode {
   std::uint64_t last_odometry_seq_ = 0;
   std::uint64_t last_observation_seq_ = 0;
   msg::MapState map_state_;
-  std::vector<std::pair<std::uint64_t, slam::Pose2>> trajectory_;
+  StepObserver step_observer_;
   EstimatorCounters counters_;
   std::optional<slam::MapCheckpoint> checkpoint_;  // read at start, used by create_filter()
   std::uint64_t last_checkpoint_ns_ = 0;

@@ -44,10 +44,6 @@ struct EstimatorOptions {
   double status_period_s = 10.0;         // counters to the log every so often (0: never)
   CheckpointOptions checkpoint;          // `estimator.checkpoint`
   dds::DdsOptions dds;                   // `dds:`
-  // Not a YAML key (slam_estimator --out-dir sets it): keep every step's mean
-  // pose for EstimatorNode::trajectory(), 32 bytes a step (about 6 MB an hour
-  // at 50 Hz). Off, a robot that runs for days holds no growing history.
-  bool keep_trajectory = false;
 };
 
 // The `estimator:` keys: range, unit, default, help.
