@@ -131,6 +131,7 @@ TEST(LoggerOptions, ErrorsNameTheFileAndTheKey) {
       {"logger:\n  rotate_size_bytes: 1000\n", "key 'logger.rotate_size_bytes': value 1000 is too small"},
       {"logger:\n  rotate_size_bytes: -1\n", "key 'logger.rotate_size_bytes'"},
       {"logger:\n  rotate_period_s: 0.5\n", "key 'logger.rotate_period_s'"},
+      {"logger:\n  keep_files: 3\n", "key 'logger.keep_files': value 3 needs rotation"},
       {"logger:\n  compression: gzip\n", "key 'logger.compression': value 'gzip' is not one of"},
       {"logger:\n  flush_period_s: -1\n", "key 'logger.flush_period_s': value -1 is out of range"},
       {"logger:\n  chunk_size_bytes: 10\n", "key 'logger.chunk_size_bytes'"},
@@ -658,6 +659,47 @@ TEST(LoggerNode, RotatesBySizeIntoCompleteFiles) {
     // Not far beyond it: + the summary, which repeats every topic's schema (8 IDL texts, ~16 KiB).
     EXPECT_LE(size, options.rotate_size_bytes + 20480) << files[i];
   }
+  remove_rotated(base.path());
+}
+
+// A station that records for weeks: with keep_files only the newest files stay
+// on disk, complete, holding the end of the run; the counters list the deleted ones.
+TEST(LoggerNode, KeepsOnlyTheNewestRotatedFiles) {
+  const TempFile base("test_logger_keep_files");
+  remove_rotated(base.path());
+  LoggerOptions options = node_options(base.path());
+  options.topics = {"pixyslam/odometry"};
+  options.rotate_size_bytes = 65536;
+  options.keep_files = 2;
+  options.compression = mcap::McapCompression::kNone;
+  LoggerNode node(options);
+  node.start();
+  dds::Participant robot(loopback_options(), "test_robot");
+  dds::Writer<msg::Odometry> writer(robot);
+  ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(10)));
+  constexpr int kCount = 3000;
+  for (int i = 0; i < kCount; ++i) {
+    msg::Odometry m = test::sample_odometry(i);
+    ASSERT_TRUE(writer.publish(m));
+  }
+  ASSERT_TRUE(wait_until([&] { return received(node, "pixyslam/odometry") == kCount; }, std::chrono::seconds(20)))
+      << node.counters_text();
+  node.stop();
+  const LoggerCounters c = node.counters();
+  ASSERT_GE(c.files.size(), 4u);
+  std::vector<std::uint64_t> seqs;
+  for (std::size_t i = 0; i < c.files.size(); ++i) {
+    const bool kept = i + 2 >= c.files.size();
+    EXPECT_EQ(c.files[i].removed, !kept) << i;
+    EXPECT_EQ(std::filesystem::exists(c.files[i].path), kept) << c.files[i].path;
+    if (!kept) continue;
+    const mcap::McapReader reader(c.files[i].path);
+    EXPECT_TRUE(reader.clean()) << c.files[i].path << ":\n" << reader.diagnostics_text();
+    for (const mcap::McapMessage& m : reader.messages()) seqs.push_back(m.sequence);
+  }
+  ASSERT_FALSE(seqs.empty());
+  EXPECT_EQ(seqs.back(), static_cast<std::uint64_t>(kCount));  // the end of the run
+  EXPECT_TRUE(std::is_sorted(seqs.begin(), seqs.end()));
   remove_rotated(base.path());
 }
 

@@ -176,8 +176,30 @@ void LoggerNode::rotate() {
     file_given_up_ = true;  // listed; open_file() clears it
   }
   open_file(file_index_ + 1);
+  remove_old_files();
   std::lock_guard<std::mutex> lock(mutex_);
   update_file_counters();
+}
+
+void LoggerNode::remove_old_files() {
+  if (options_.keep_files == 0) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::size_t on_disk = 1;  // the open file
+  for (const LoggedFile& f : closed_files_) on_disk += f.removed ? 0 : 1;
+  for (LoggedFile& f : closed_files_) {
+    if (on_disk <= options_.keep_files) break;
+    if (f.removed) continue;
+    std::error_code error;
+    std::filesystem::remove(f.path, error);
+    f.removed = true;
+    --on_disk;
+    if (error) {
+      std::fprintf(stderr, "logger: WARN: cannot delete %s (keep_files %zu): %s\n", f.path.c_str(),
+                   options_.keep_files, error.message().c_str());
+    } else {
+      std::fprintf(stderr, "logger: deleted %s (keep_files %zu)\n", f.path.c_str(), options_.keep_files);
+    }
+  }
 }
 
 bool LoggerNode::size_limit_reached() const {
@@ -412,6 +434,7 @@ void LoggerNode::reopen_after_failure() {
     return;
   }
   std::fprintf(stderr, "logger: recording again, to %s\n", path.c_str());
+  remove_old_files();
   std::lock_guard<std::mutex> lock(mutex_);
   update_file_counters();
 }

@@ -44,6 +44,9 @@ const parameters::Table<LoggerOptions>& logger_parameters() {
                                    [](O& o) -> std::uint64_t& { return o.rotate_size_bytes; }),
       P::real<O>("rotate_period_s", 0.0, 7 * 86400.0, "s", "a new file after this long (0: never, else >= 1)",
                  [](O& o) -> double& { return o.rotate_period_s; }),
+      P::integer<O, std::size_t>("keep_files", 0, 1000000, "",
+                                 "with rotation, this run's newest files kept; older ones deleted (0: all)",
+                                 [](O& o) -> std::size_t& { return o.keep_files; }),
       P::integer<O, std::size_t>("chunk_size_bytes", 4096, std::size_t{1} << 28, "B",
                                  "uncompressed bytes per MCAP chunk",
                                  [](O& o) -> std::size_t& { return o.chunk_size_bytes; }),
@@ -75,6 +78,11 @@ void validate(const LoggerOptions& o) {
     throw parameters::RuleError("logger", "rotate_period_s",
                                 "value " + parameters::number_text(o.rotate_period_s) +
                                     " is too small: 0 (off) or at least 1");
+  }
+  if (o.keep_files > 0 && !rotation_enabled(o)) {
+    throw parameters::RuleError("logger", "keep_files",
+                                "value " + std::to_string(o.keep_files) +
+                                    " needs rotation (rotate_size_bytes or rotate_period_s): one file is never deleted");
   }
   if (!mcap::mcap_compression_available(o.compression)) {
     const std::string name = compression_name(o.compression);

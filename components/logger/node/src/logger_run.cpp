@@ -35,8 +35,9 @@ void print_counters(const LoggerOptions& options, const LoggerCounters& c, const
                  u(t.reader.malformed), u(t.reader.seq_jumps));
   }
   for (const LoggedFile& f : c.files) {
-    std::fprintf(stderr, "%s: file %s: %llu messages, %llu chunks, %llu bytes\n", tool, f.path.c_str(),
-                 u(f.counters.messages), u(f.counters.chunks), u(f.counters.bytes_written));
+    std::fprintf(stderr, "%s: file %s: %llu messages, %llu chunks, %llu bytes%s\n", tool, f.path.c_str(),
+                 u(f.counters.messages), u(f.counters.chunks), u(f.counters.bytes_written),
+                 f.removed ? " (deleted: keep_files)" : "");
   }
   std::fprintf(stderr,
                "%s: %s: %zu file(s), %llu messages, %llu chunks, %llu bytes; queue peak %zu messages / %zu bytes\n",

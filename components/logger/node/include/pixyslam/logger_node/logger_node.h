@@ -45,6 +45,7 @@ struct LoggedFile {
   std::string path;
   mcap::McapWriterCounters counters;  // final once the file is closed
   bool closed = false;                  // summary and footer written
+  bool removed = false;                 // deleted for LoggerOptions::keep_files
 };
 
 struct LoggerCounters {
@@ -135,6 +136,8 @@ class LoggerNode {
   void reopen_after_failure();
   // Closes the current file and opens the next one. Writer thread only.
   void rotate();
+  // Deletes this run's oldest closed files beyond LoggerOptions::keep_files.
+  void remove_old_files();
   bool size_limit_reached() const;
   // Copies the writer's counters into totals_ (mutex_ held).
   void update_file_counters();

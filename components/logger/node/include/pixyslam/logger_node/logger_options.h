@@ -33,6 +33,10 @@ struct LoggerOptions {
   std::uint64_t rotate_size_bytes = 0;
   // `logger.rotate_period_s`: start a new file after this long (0 = never).
   double rotate_period_s = 0.0;
+  // `logger.keep_files`: with rotation, at most this many of this run's files
+  // stay on disk: after a new file opens the oldest are deleted (0 = all), so
+  // a station that records for weeks does not fill its disk.
+  std::size_t keep_files = 0;
   // `logger.chunk_size_bytes`: uncompressed bytes per MCAP chunk before it is written.
   std::size_t chunk_size_bytes = std::size_t{1} << 20;
   // `logger.compression`: none | zstd | lz4 (chunk compression).
