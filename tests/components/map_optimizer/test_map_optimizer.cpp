@@ -402,6 +402,49 @@ TEST(MapOptimizer, SnapshotSolvedElsewhereMatchesASolveAndCarriesNewerData) {
   EXPECT_GT((there.keyframes()[n0 - 1].pose - last_before).norm(), 1e-3);  // the solve did move it
 }
 
+// A landmark carried over from an earlier problem enters with its Gaussian
+// prior: alone it stays at the prior's mean with the prior's covariance (in
+// this problem and in a snapshot solved elsewhere), a sighting joins it, and
+// what is not a Gaussian is refused.
+TEST(MapOptimizer, ALandmarkPriorHoldsItsMeanAndCovarianceAndTakesNewSightings) {
+  const ExactRun run = exact_circle(100);
+  MapOptimizer opt(exact_options(), run.truth.front(), 50.0);
+  Eigen::Matrix2d cov;
+  cov << 0.04, 0.01, 0.01, 0.09;
+  const Eigen::Vector2d far(8.0, -6.0);  // never seen in the run
+  EXPECT_TRUE(opt.add_landmark_prior(9, far, cov, 12));
+  EXPECT_TRUE(opt.add_landmark_prior(1, run.landmarks[0] + Eigen::Vector2d(0.3, -0.2), 100.0 * cov, 3));
+  EXPECT_FALSE(opt.add_landmark_prior(9, far, cov, 1));  // already in the problem
+  EXPECT_FALSE(opt.add_landmark_prior(10, far, -cov, 1));
+  EXPECT_FALSE(opt.add_landmark_prior(11, Eigen::Vector2d(kNan, 0.0), cov, 1));
+  EXPECT_FALSE(opt.add_landmark_prior(12, Eigen::Vector2d(2e6, 0.0), cov, 1));
+  for (std::size_t i = 0; i < run.odometry.size(); ++i) {
+    opt.add_odometry(run.odometry[i]);
+    opt.add_frame(run.frames[i], run.truth[i]);
+  }
+  const WholeProblem problem = opt.snapshot();
+  EXPECT_EQ(problem.landmark_priors.size(), 2u);
+  EXPECT_TRUE(opt.solve().converged);
+  ASSERT_TRUE(opt.compute_landmark_covariances());
+  const WholeSolution elsewhere = solve_whole_problem(problem, true);
+  for (const LandmarkSolution& lm : opt.landmarks()) {
+    if (lm.id == 9) {
+      EXPECT_NEAR((lm.mean - far).norm(), 0.0, 1e-9);
+      EXPECT_NEAR((lm.cov - cov).norm(), 0.0, 1e-9) << lm.cov;
+      EXPECT_EQ(lm.observations, 12u);
+    } else if (lm.id == 1) {
+      // Exact sightings outweigh the prior 0.3 m off with sd 2-3 m.
+      EXPECT_LT((lm.mean - run.landmarks[0]).norm(), 0.01) << lm.mean.transpose();
+      EXPECT_GT(lm.observations, 3u);
+    }
+  }
+  const auto at = std::find(elsewhere.landmark_ids.begin(), elsewhere.landmark_ids.end(), 9);
+  ASSERT_NE(at, elsewhere.landmark_ids.end());
+  const auto k = static_cast<std::size_t>(at - elsewhere.landmark_ids.begin());
+  EXPECT_NEAR(elsewhere.landmarks[k][0], far.x(), 1e-9);
+  EXPECT_NEAR((elsewhere.landmark_covs[k] - cov).norm(), 0.0, 1e-9);
+}
+
 TEST(MapOptimizer, LandmarkCovariancesShrinkWithMoreObservations) {
   MapOptimizerOptions o;  // the default noise
   auto covariance_trace = [&](int samples) {

@@ -44,6 +44,29 @@ bool wait_for_malformed(const OptimizerNode& node, std::uint64_t target) {
   return node.counters().malformed >= target;
 }
 
+// The simulated run in stamp order, paced (an estimator answers every message
+// with a MapState), until every sample is acknowledged.
+void feed(const sim::WorldRun& run, std::uint64_t base_ns, dds::Writer<msg::Odometry>& odometry_writer,
+          dds::Writer<msg::LandmarkObservation>& observation_writer) {
+  std::size_t o = 0, f = 0;
+  const double period = run.odometry[1].t_s - run.odometry[0].t_s;
+  while (o < run.odometry.size() || f < run.frames.size()) {
+    if (f == run.frames.size() || (o < run.odometry.size() && run.odometry[o].t_s + period <= run.frames[f].t_s)) {
+      const slam::OdometrySample& s = run.odometry[o++];
+      msg::Odometry m = test_support::odometry_msg(s, period, slam_node::to_stamp_ns(s.t_s, base_ns));
+      ASSERT_TRUE(odometry_writer.publish(m));
+    } else {
+      const slam::ObservationFrame& frame = run.frames[f++];
+      msg::LandmarkObservation m =
+          test_support::observation_msg(frame, slam_node::to_stamp_ns(frame.t_s, base_ns));
+      ASSERT_TRUE(observation_writer.publish(m));
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(1500));
+  }
+  ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(observation_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+}
+
 TEST(OptimizerNode, OptimisesBesideTheEstimatorFromDdsInput) {
   sim::WorldOptions world;
   world.duration_s = 60.0;
@@ -76,24 +99,7 @@ TEST(OptimizerNode, OptimisesBesideTheEstimatorFromDdsInput) {
   ASSERT_TRUE(odometry_writer.wait_for_readers(2, std::chrono::seconds(10)));
   ASSERT_TRUE(observation_writer.wait_for_readers(2, std::chrono::seconds(10)));
 
-  // In stamp order, paced (the estimator answers every message with a MapState).
-  std::size_t o = 0, f = 0;
-  const double period = run.odometry[1].t_s - run.odometry[0].t_s;
-  while (o < run.odometry.size() || f < run.frames.size()) {
-    if (f == run.frames.size() || (o < run.odometry.size() && run.odometry[o].t_s + period <= run.frames[f].t_s)) {
-      const slam::OdometrySample& s = run.odometry[o++];
-      msg::Odometry m = test_support::odometry_msg(s, period, slam_node::to_stamp_ns(s.t_s, base_ns));
-      ASSERT_TRUE(odometry_writer.publish(m));
-    } else {
-      const slam::ObservationFrame& frame = run.frames[f++];
-      msg::LandmarkObservation m =
-          test_support::observation_msg(frame, slam_node::to_stamp_ns(frame.t_s, base_ns));
-      ASSERT_TRUE(observation_writer.publish(m));
-    }
-    std::this_thread::sleep_for(std::chrono::microseconds(1500));
-  }
-  ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
-  ASSERT_TRUE(observation_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
+  feed(run, base_ns, odometry_writer, observation_writer);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   estimator.stop();
   node.stop();
@@ -150,6 +156,55 @@ TEST(OptimizerNode, OptimisesBesideTheEstimatorFromDdsInput) {
   EXPECT_EQ(maps.back().header().seq(), c.maps_published);
   EXPECT_EQ(c.maps_published, c.whole_solves + c.window_solves);
   EXPECT_EQ(map_reader.lost(), 0u);
+}
+
+// A station that runs for days: at optimizer.max_keyframes the problem starts
+// anew from the current pose with the landmarks as priors; it stays bounded,
+// the map keeps every landmark near the truth, and the pose goes on.
+TEST(OptimizerNode, AProblemAtItsKeyframeLimitStartsAnewWithItsLandmarksAsPriors) {
+  sim::WorldOptions world;
+  world.duration_s = 60.0;
+  world.camera_rate_hz = 10.0;
+  world.max_range_m = 4.0;
+  const sim::WorldRun run = sim::simulate(world);
+  const std::uint64_t base_ns = dds::now_ns();
+  OptimizerNodeOptions options = test_options();
+  options.initial_pose = run.initial_pose;
+  options.max_keyframes = 150;  // 10 Hz frames: a new problem every ~15 s
+  OptimizerNode node(options);
+  node.start();
+  dds::Participant sensors(options.dds, "test_sensors");
+  dds::Writer<msg::Odometry> odometry_writer(sensors);
+  dds::Writer<msg::LandmarkObservation> observation_writer(sensors);
+  ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  feed(run, base_ns, odometry_writer, observation_writer);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  node.stop();
+
+  const OptimizerNodeCounters c = node.counters();
+  EXPECT_EQ(c.odometry_received, run.odometry.size());
+  EXPECT_GE(c.segments, 3u);
+  const msg::OptimisedMap last = node.latest_map();
+  EXPECT_LE(last.keyframe_count(), options.max_keyframes);
+  std::set<int> seen;
+  for (const slam::ObservationFrame& frame : run.frames) {
+    for (const slam::RangeBearing& rb : frame.detections) seen.insert(rb.landmark_id);
+  }
+  EXPECT_EQ(last.landmarks().size(), seen.size());  // the earlier problems' landmarks carried on
+  std::vector<eval::LandmarkPoint> truth, optimised;
+  for (const sim::Pole& p : run.poles) truth.push_back({p.id, p.x_m, p.y_m});
+  for (const msg::OptimisedLandmark& l : last.landmarks()) optimised.push_back({l.landmark_id(), l.x_m(), l.y_m()});
+  const eval::LandmarkErrors errors = eval::compare_landmarks(optimised, truth);
+  std::printf("landmark RMSE after %llu new problems: %.3f m\n", static_cast<unsigned long long>(c.segments),
+              errors.rmse_m);
+  EXPECT_LT(errors.rmse_m, 0.15);
+  std::vector<eval::TimedPose> keyframes;
+  for (const msg::OptimisedKeyframe& k : last.keyframes()) {
+    keyframes.push_back({static_cast<double>(k.stamp_ns() - base_ns) * 1e-9, k.pose().x_m(), k.pose().y_m(),
+                         k.pose().theta_rad()});
+  }
+  EXPECT_LT(eval::compare_trajectory(keyframes, run.truth).ate_rmse_m, 0.15);
 }
 
 // Any participant can send any bytes: what does not decode is counted and dropped.

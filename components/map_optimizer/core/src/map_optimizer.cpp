@@ -114,6 +114,26 @@ struct RangeBearingResidual {
   }
 };
 
+// A landmark's Gaussian prior: sqrt_information (m - mean).
+struct LandmarkPriorResidual {
+  Eigen::Vector2d mean;
+  Eigen::Matrix2d sqrt_information;
+
+  template <typename T>
+  bool operator()(const T* landmark, T* residual) const {
+    const Eigen::Matrix<T, 2, 1> e(landmark[0] - T(mean.x()), landmark[1] - T(mean.y()));
+    Eigen::Map<Eigen::Matrix<T, 2, 1>> r(residual);
+    r = sqrt_information.cast<T>() * e;
+    return true;
+  }
+};
+
+void add_landmark_prior_factor(ceres::Problem& problem, const LandmarkPrior& prior, double* landmark) {
+  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LandmarkPriorResidual, 2, 2>(
+                               new LandmarkPriorResidual{prior.mean, prior.sqrt_information}),
+                           nullptr, landmark);
+}
+
 bool finite(const slam::Pose2& p) { return p.allFinite(); }
 
 bool scale_state(const MapOptimizerOptions& o) { return o.turn_scale_sigma > 0.0; }
@@ -436,6 +456,27 @@ void MapOptimizer::set_landmark_guess(int id, const Eigen::Vector2d& position) {
   landmark_guesses_[id] = position;
 }
 
+bool MapOptimizer::add_landmark_prior(int id, const Eigen::Vector2d& mean, const Eigen::Matrix2d& cov,
+                                      std::size_t observations) {
+  if (landmarks_.count(id) != 0 || landmarks_.size() >= static_cast<std::size_t>(options_.max_landmarks)) return false;
+  if (!mean.allFinite() || mean.cwiseAbs().maxCoeff() > 1e6 || !cov.allFinite()) return false;
+  const Eigen::LLT<Eigen::Matrix2d> llt(0.5 * (cov + cov.transpose()));
+  if (llt.info() != Eigen::Success) return false;
+  LandmarkPrior prior;
+  prior.mean = mean;
+  prior.sqrt_information = llt.matrixL().solve(Eigen::Matrix2d::Identity());
+  if (!prior.sqrt_information.allFinite()) return false;
+  LandmarkBlock& lm = landmarks_[id];
+  lm.xy = {mean.x(), mean.y()};
+  lm.cov = cov;
+  lm.observations = observations;
+  lm.last_keyframe = 0;
+  problem_->AddParameterBlock(lm.xy.data(), 2);
+  add_landmark_prior_factor(*problem_, prior, lm.xy.data());
+  prior_records_.push_back({id, prior});
+  return true;
+}
+
 SolveSummary MapOptimizer::solve(std::optional<std::size_t> window_keyframes) {
   SolveSummary out;
   const std::size_t n = pose_blocks_.size();
@@ -484,6 +525,11 @@ WholeProblem MapOptimizer::snapshot() const {
     f.landmark = index.at(r.landmark_id);
     p.observations.push_back(f);
   }
+  for (const PriorRecord& r : prior_records_) {
+    LandmarkPrior prior = r.prior;
+    prior.landmark = index.at(r.landmark_id);
+    p.landmark_priors.push_back(prior);
+  }
   return p;
 }
 
@@ -512,6 +558,9 @@ WholeSolution solve_whole_problem(const WholeProblem& problem, bool covariances)
   }
   for (const ObservationFactor& f : problem.observations) {
     p.AddResidualBlock(observation_cost(f), &loss, out.poses.at(f.keyframe).data(), out.landmarks.at(f.landmark).data());
+  }
+  for (const LandmarkPrior& prior : problem.landmark_priors) {
+    add_landmark_prior_factor(p, prior, out.landmarks.at(prior.landmark).data());
   }
   out.summary.keyframes_free = out.poses.empty() ? 0 : out.poses.size() - 1;
   out.summary.landmarks_free = out.landmarks.size();

@@ -100,8 +100,7 @@ diagnostics::Snapshot OptimizerNode::diagnostics_snapshot() const {
   const OptimizerNodeCounters c = counters();
   const slam::SensorQueueCounters queue = inbox_.queue_counters();
   std::lock_guard<std::mutex> lock(state_mutex_);
-  const map_optimizer::OptimizerCounters o =
-      optimizer_ ? optimizer_->counters() : map_optimizer::OptimizerCounters{};
+  const map_optimizer::OptimizerCounters o = optimizer_counters();
   diagnostics::Snapshot s;
   s.counters = {{"odometry_received", c.odometry_received, false},
                 {"observations_received", c.observations_received, false},
@@ -120,7 +119,8 @@ diagnostics::Snapshot OptimizerNode::diagnostics_snapshot() const {
                 {"observations", o.observations, false},
                 {"window_solves", c.window_solves, false},
                 {"whole_solves", c.whole_solves, false},
-                {"maps_published", c.maps_published, false}};
+                {"maps_published", c.maps_published, false},
+                {"segments", c.segments, false}};
   return s;
 }
 
@@ -162,6 +162,10 @@ void OptimizerNode::step(const slam::SensorInput& input) {
   if (const auto* odometry = std::get_if<slam::OdometryInput>(&input)) {
     optimizer_->add_odometry(odometry->sample);
     last_odometry_seq_ = odometry->seq;
+    // At an odometry sample, so that the new problem holds its control from the start.
+    if (options_.max_keyframes > 0 && optimizer_->keyframes().size() >= options_.max_keyframes) {
+      start_segment(odometry->sample);
+    }
   } else {
     const auto& observation = std::get<slam::ObservationInput>(input);
     std::optional<slam::Pose2> guess;
@@ -200,6 +204,47 @@ void OptimizerNode::step(const slam::SensorInput& input) {
   } else if (due == map_optimizer::SolveKind::kWindow) {
     solve(false);
   }
+}
+
+void OptimizerNode::start_segment(const slam::OdometrySample& odometry) {
+  collect_whole(true);
+  solve(true);  // a last whole solve, with covariances, published
+  const slam::Pose2 pose = optimizer_->current_pose();
+  const std::vector<map_optimizer::LandmarkSolution> landmarks = optimizer_->landmarks();
+  const std::size_t keyframes = optimizer_->keyframes().size();
+  earlier_segments_ = optimizer_counters();
+  optimizer_ = std::make_unique<map_optimizer::MapOptimizer>(options_.optimizer, pose, odometry.t_s);
+  optimizer_->add_odometry(odometry);  // its control, held from now on
+  std::size_t priors = 0;
+  for (const map_optimizer::LandmarkSolution& l : landmarks) {
+    if (optimizer_->add_landmark_prior(l.id, l.mean, l.cov, l.observations)) {
+      ++priors;
+    } else {
+      optimizer_->set_landmark_guess(l.id, l.mean);  // no covariance: a first estimate only
+    }
+  }
+  schedule_.emplace(options_.schedule, odometry.t_s);
+  ++counters_.segments;
+  std::fprintf(stderr,
+               "map_optimizer: %zu keyframes (optimizer.max_keyframes): a new problem from the current pose, %zu of %zu "
+               "landmarks as priors\n",
+               keyframes, priors, landmarks.size());
+}
+
+map_optimizer::OptimizerCounters OptimizerNode::optimizer_counters() const {
+  map_optimizer::OptimizerCounters c = earlier_segments_;
+  if (!optimizer_) return c;
+  const map_optimizer::OptimizerCounters& n = optimizer_->counters();
+  c.odometry += n.odometry;
+  c.odometry_dropped += n.odometry_dropped;
+  c.frames += n.frames;
+  c.frames_dropped += n.frames_dropped;
+  c.observations += n.observations;
+  c.observations_invalid += n.observations_invalid;
+  c.observations_over_map_limit += n.observations_over_map_limit;
+  c.keyframes += n.keyframes;
+  c.solves += n.solves;
+  return c;
 }
 
 void OptimizerNode::collect_whole(bool wait) {
@@ -279,16 +324,17 @@ void OptimizerNode::publish(const map_optimizer::SolveSummary& s, bool whole) {
 void OptimizerNode::log_status() const {
   const OptimizerNodeCounters c = counters();
   std::lock_guard<std::mutex> lock(state_mutex_);
-  const map_optimizer::OptimizerCounters o =
-      optimizer_ ? optimizer_->counters() : map_optimizer::OptimizerCounters{};
+  const map_optimizer::OptimizerCounters o = optimizer_counters();
   std::fprintf(stderr,
-               "map_optimizer: odometry %llu, observations %llu, map states %llu, malformed %llu; keyframes %zu, "
+               "map_optimizer: odometry %llu, observations %llu, map states %llu, malformed %llu; keyframes %zu (in the "
+               "problem %zu, problems begun anew %llu), "
                "factors from %zu observations (%zu invalid), %llu keyframes started at the filter's pose; solves %llu "
                "window / %llu whole, published %llu; CPU %.2f s (Ceres %.2f s)\n",
                static_cast<unsigned long long>(c.odometry_received),
                static_cast<unsigned long long>(c.observations_received),
                static_cast<unsigned long long>(c.map_states_received), static_cast<unsigned long long>(c.malformed),
-               o.keyframes, o.observations, o.observations_invalid,
+               o.keyframes, optimizer_ ? optimizer_->keyframes().size() : std::size_t{0},
+               static_cast<unsigned long long>(c.segments), o.observations, o.observations_invalid,
                static_cast<unsigned long long>(c.guesses_from_filter), static_cast<unsigned long long>(c.window_solves),
                static_cast<unsigned long long>(c.whole_solves), static_cast<unsigned long long>(c.maps_published),
                c.cpu_time_s, c.solve_time_s);

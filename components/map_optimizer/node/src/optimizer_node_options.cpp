@@ -22,6 +22,10 @@ const parameters::Table<OptimizerNodeOptions>& optimizer_node_parameters() {
                  [](O& o) -> double& { return o.schedule.whole_max_duty; }),
       P::integer<O, int>("published_keyframes", 2, 8192, "", "OptimisedMap keyframes at most",
                          [](O& o) -> int& { return o.published_keyframes; }),
+      P::integer<O, std::size_t>("max_keyframes", 0, 100000000, "",
+                                 "a problem this large starts anew at the current pose, its landmarks as priors "
+                                 "(0: unbounded; ~13 KB a keyframe)",
+                                 [](O& o) -> std::size_t& { return o.max_keyframes; }),
       P::real<O>("status_period_s", 0.0, 3600.0, "s", "counters to the log every so often (0: never)",
                  [](O& o) -> double& { return o.status_period_s; }),
   };

@@ -143,6 +143,13 @@ struct ObservationFactor {
   double range_sigma_m = 1.0;
   double bearing_sigma_rad = 1.0;
 };
+// A landmark known before the problem began (MapOptimizer::add_landmark_prior):
+// a Gaussian prior on its position, whitened (sqrt_information = L^-1 for cov = L L^T).
+struct LandmarkPrior {
+  std::size_t landmark = 0;  // index into WholeProblem::landmark_ids
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d sqrt_information = Eigen::Matrix2d::Identity();
+};
 struct WholeProblem {
   MapOptimizerOptions options;
   std::vector<std::array<double, 3>> poses;  // keyframes; the first held fixed
@@ -151,6 +158,7 @@ struct WholeProblem {
   std::vector<std::array<double, 2>> landmarks;
   std::vector<OdometryFactor> odometry;
   std::vector<ObservationFactor> observations;
+  std::vector<LandmarkPrior> landmark_priors;
 };
 struct WholeSolution {
   std::vector<std::array<double, 3>> poses;
@@ -182,6 +190,12 @@ class MapOptimizer {
   void add_frame(const slam::ObservationFrame& frame, const std::optional<slam::Pose2>& guess = std::nullopt);
   // The initial value of a landmark not in the problem yet (e.g. the filter's map).
   void set_landmark_guess(int id, const Eigen::Vector2d& position);
+  // A landmark known before this problem began (the previous segment of a run
+  // too long for one problem): it enters now with the Gaussian prior N(mean,
+  // cov) and `observations` earlier sightings. False, and nothing added, for an
+  // id already in the problem, a mean that is not finite or beyond 1e6 m, a
+  // covariance that is not positive definite, or past max_landmarks.
+  bool add_landmark_prior(int id, const Eigen::Vector2d& mean, const Eigen::Matrix2d& cov, std::size_t observations);
 
   // Solves for every keyframe and landmark, or, with window_keyframes, for the
   // newest that many keyframes and the landmarks they see (the rest held).
@@ -236,6 +250,11 @@ class MapOptimizer {
     ObservationFactor factor;  // its landmark index is set by snapshot()
   };
   std::vector<ObservationRecord> observation_records_;
+  struct PriorRecord {
+    int landmark_id;
+    LandmarkPrior prior;  // its landmark index is set by snapshot()
+  };
+  std::vector<PriorRecord> prior_records_;
   std::map<int, Eigen::Vector2d> landmark_guesses_;
   slam::ComposedMotion open_motion_;  // odometry since the newest keyframe
   double last_time_s_ = 0.0;

@@ -30,6 +30,11 @@ struct OptimizerNodeOptions {
   bool use_detection_sigmas = true;              // as the estimator
   map_optimizer::SolveScheduleOptions schedule;  // window and whole-problem solves as the data come
   int published_keyframes = 2000;                // OptimisedMap.keyframes at most (<= 8192)
+  // `optimizer.max_keyframes`: a problem that reaches this many keyframes is
+  // solved a last time and replaced by a new one that starts at the current
+  // pose with every landmark as a Gaussian prior (its marginal), so a station
+  // that runs for days holds a bounded problem (~13 KB a keyframe). 0: unbounded.
+  std::size_t max_keyframes = 20000;
   double status_period_s = 10.0;                 // counters to the log every so often (0: never)
   dds::DdsOptions dds;
 };
@@ -62,6 +67,7 @@ struct OptimizerNodeCounters {
   std::uint64_t maps_published = 0;
   std::uint64_t guesses_from_filter = 0;  // keyframes started from the filter's pose
   std::uint64_t step_errors = 0;          // inputs the optimiser threw on: dropped
+  std::uint64_t segments = 0;             // problems begun anew at max_keyframes
   double cpu_time_s = 0.0;                // the optimiser thread's CPU time
   double solve_time_s = 0.0;              // Ceres' time over all solves
 };
@@ -99,6 +105,11 @@ class OptimizerNode {
   // The background whole solve, if one is running: adopted and published when
   // done (or, with `wait`, once done).
   void collect_whole(bool wait);
+  // At max_keyframes: the whole problem solved and published a last time, then
+  // a new one from the current pose at `odometry`'s time, the landmarks as priors.
+  void start_segment(const slam::OdometrySample& odometry);
+  // The core's counters over every segment.
+  map_optimizer::OptimizerCounters optimizer_counters() const;
   void publish(const map_optimizer::SolveSummary& s, bool whole);
   void log_status() const;
   diagnostics::Snapshot diagnostics_snapshot() const;
@@ -124,6 +135,7 @@ class OptimizerNode {
   // Loop state (read by others under state_mutex_).
   mutable std::mutex state_mutex_;
   std::unique_ptr<map_optimizer::MapOptimizer> optimizer_;
+  map_optimizer::OptimizerCounters earlier_segments_;  // the counters of the problems before optimizer_
   std::uint64_t epoch_ns_ = 0;  // the inbox's, from the first input on
   double last_t_s_ = 0.0;
   std::optional<map_optimizer::SolveSchedule> schedule_;  // from the first input's time
