@@ -293,9 +293,41 @@ void FastSlam2::add_odometry(const OdometrySample& sample) {
 }
 
 std::uint32_t FastSlam2::slot_for(int landmark_id) {
-  auto [it, inserted] = slot_of_id_.emplace(landmark_id, static_cast<std::uint32_t>(id_of_slot_.size()));
-  if (inserted) id_of_slot_.push_back(landmark_id);
-  return it->second;
+  if (const auto it = slot_of_id_.find(landmark_id); it != slot_of_id_.end()) return it->second;
+  std::uint32_t slot = static_cast<std::uint32_t>(id_of_slot_.size());
+  if (free_slots_.empty()) {
+    id_of_slot_.push_back(landmark_id);
+  } else {
+    // A recycled slot starts as new: no sighting, no spread.
+    slot = free_slots_.back();
+    free_slots_.pop_back();
+    id_of_slot_[slot] = landmark_id;
+    if (slot < last_sighting_s_.size()) last_sighting_s_[slot] = std::numeric_limits<double>::quiet_NaN();
+    if (slot < mapped_spread_.size()) {
+      mapped_spread_[slot] = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
+    }
+  }
+  slot_of_id_.emplace(landmark_id, slot);
+  return slot;
+}
+
+void FastSlam2::recycle_slots() {
+  std::vector<char> held(id_of_slot_.size(), 0);
+  for (const std::uint32_t s : free_slots_) held[s] = 1;  // free already
+  for (const Particle& p : particles_) {
+    p.map.for_each([&held](std::uint32_t slot, const Landmark&) { held[slot] = 1; });
+    if (p.joint.active()) {
+      for (const std::uint32_t slot : p.joint->slots) held[slot] = 1;
+    }
+  }
+  for (const Anchor& a : anchors_) held[a.slot] = 1;
+  for (std::uint32_t s = 0; s < held.size(); ++s) {
+    if (held[s] != 0) continue;
+    slot_of_id_.erase(id_of_slot_[s]);
+    id_of_slot_[s] = kFreeSlot;
+    free_slots_.push_back(s);
+    ++counters_.landmark_slots_recycled;
+  }
 }
 
 void FastSlam2::add_observations(const ObservationFrame& frame) {
@@ -358,10 +390,13 @@ void FastSlam2::update_with_frame(const ObservationFrame& frame) {
     new_log_likelihood_[k] = 0.0;  // associate() sets it per particle
   }
   // With maximum likelihood every detection of the frame may start a landmark.
-  if (options_.association == Association::kMaximumLikelihood &&
-      id_of_slot_.size() + valid.size() > static_cast<std::size_t>(options_.max_map_landmarks)) {
-    counters_.observations_over_map_limit += valid.size();
-    valid.clear();
+  const auto max_slots = static_cast<std::size_t>(options_.max_map_landmarks);
+  if (options_.association == Association::kMaximumLikelihood && slots_in_use() + valid.size() > max_slots) {
+    recycle_slots();
+    if (slots_in_use() + valid.size() > max_slots) {
+      counters_.observations_over_map_limit += valid.size();
+      valid.clear();
+    }
   }
   if (valid.empty()) {
     if (joint_motion_.empty()) return;

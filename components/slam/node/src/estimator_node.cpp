@@ -136,6 +136,7 @@ diagnostics::Snapshot EstimatorNode::diagnostics_snapshot() const {
                 {"observations_gated", f.observations_gated, true},
                 {"observations_invalid", f.observations_invalid, true},
                 {"observations_over_map_limit", f.observations_over_map_limit, true},
+                {"landmark_slots_recycled", f.landmark_slots_recycled, false},
                 {"resamples", f.resamples, false},
                 {"landmarks", map_state_.landmarks().size(), false},
                 {"checkpoints_written", c.checkpoints_written, false},

@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <unordered_map>
 #include <vector>
@@ -62,6 +63,7 @@ struct FilterCounters {
   std::uint64_t observations_gated = 0;
   std::uint64_t observations_invalid = 0;
   std::uint64_t observations_over_map_limit = 0;  // would start a landmark beyond max_map_landmarks: dropped
+  std::uint64_t landmark_slots_recycled = 0;  // maximum likelihood: landmarks no particle held any more, freed
   std::uint64_t resamples = 0;
   std::uint64_t delayed_sampling_starts = 0;  // particle-frames that began a joint state
   std::uint64_t joint_breakdowns = 0;  // joint-state updates refused as numerically broken
@@ -273,7 +275,14 @@ class FastSlam2 {
   double control_time_s_ = 0.0;
 
   std::unordered_map<int, std::uint32_t> slot_of_id_;
-  std::vector<int> id_of_slot_;
+  static constexpr int kFreeSlot = std::numeric_limits<int>::min();
+  std::vector<int> id_of_slot_;  // kFreeSlot: free (free_slots_)
+  std::vector<std::uint32_t> free_slots_;
+  std::size_t slots_in_use() const { return id_of_slot_.size() - free_slots_.size(); }
+  // Association::kMaximumLikelihood: frees the slots no particle holds any more
+  // (a landmark some particles started, all of them since resampled away), so
+  // a run of days does not run out of max_map_landmarks. Between frames only.
+  void recycle_slots();
   // FilterOptions::error_correlation_s: per slot the time of its last sighting
   // (NaN: never), and the factor on R of a sighting after it.
   std::vector<double> last_sighting_s_;

@@ -99,8 +99,9 @@ struct FilterOptions {
   double max_range_m = 50.0;
   // Landmarks the map may hold (a MapState carries up to 4096): detections that
   // would start more are dropped and counted (observations_over_map_limit); with
-  // maximum likelihood, where any detection may start one, a frame that could
-  // pass the limit is dropped whole.
+  // maximum likelihood, where any detection may start one, the landmarks no
+  // particle holds any more are freed first (landmark_slots_recycled), and a
+  // frame that could still pass the limit is dropped whole.
   int max_map_landmarks = 4096;
 
   // Mahalanobis gate on observations of mapped landmarks, per particle.
