@@ -167,9 +167,9 @@ class LaunchSession {
     }
     for (const launcher::ProcessSpec& spec : plan_.after_run) {
       if (skipped()) break;
-      group_.start(spec);
-      while (group_.running(group_.size() - 1) && !skipped()) group_.poll(std::chrono::milliseconds(100));
-      if (group_.running(group_.size() - 1)) group_.stop_all(std::chrono::seconds(5));
+      const std::size_t step = group_.start(spec);
+      while (group_.running(step) && !skipped()) group_.poll(std::chrono::milliseconds(100));
+      if (group_.running(step)) group_.stop_all(std::chrono::seconds(5));
     }
   }
 
@@ -179,10 +179,15 @@ class LaunchSession {
     for (std::size_t i = 0; i < group_.size(); ++i) {
       const launcher::ExitStatus& status = group_.status(i);
       const launcher::ProcessSpec& spec = group_.spec(i);
-      std::printf("[launch]   %-16s %s%s%s  (%s)\n", spec.name.c_str(), status.describe().c_str(),
+      // A restarted process shows its last run; its earlier failures still count.
+      const auto failures = failures_.find(spec.name);
+      const int failed_before = failures == failures_.end() ? 0 : failures->second;
+      const std::string restarts =
+          failed_before > 0 ? ", failed " + std::to_string(failed_before) + " time(s) before and restarted" : "";
+      std::printf("[launch]   %-16s %s%s%s  (%s%s)\n", spec.name.c_str(), status.describe().c_str(),
                   status.ok() ? "" : "  <- FAILED", spec.optional && !status.ok() ? " (optional)" : "",
-                  status.resources().c_str());
-      if (!status.ok()) ++bad;
+                  status.resources().c_str(), restarts.c_str());
+      if (!status.ok() || failed_before > 0) ++bad;
     }
     print_health();
     if (health_) std::printf("[launch] health: %d process(es) lost on the domain during the run\n", health_->lost());

@@ -202,6 +202,30 @@ TEST(ProcessGroup, ForwardsOutputWithPrefixAndReportsExitCodes) {
   EXPECT_NE(text.find("[ok] world\n"), std::string::npos) << text;
 }
 
+// An optional process in a crash loop is restarted every 30 s for days: each
+// restart takes the place of its ended run, so the group does not grow.
+TEST(ProcessGroup, ARestartTakesThePlaceOfTheEndedRun) {
+  std::FILE* out = std::tmpfile();
+  {
+    ProcessGroup group("", out);
+    EXPECT_EQ(group.start({"steady", {"/bin/sh", "-c", "sleep 5"}, 0.0, false, {}}), 0u);
+    for (int run = 1; run <= 3; ++run) {
+      const std::size_t i = group.start({"crashing", {"/bin/sh", "-c", "exit " + std::to_string(run)}, 0.0, false, {}});
+      EXPECT_EQ(i, 1u) << run;
+      const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (group.running(i) && std::chrono::steady_clock::now() < end) group.poll(std::chrono::milliseconds(20));
+      // The output pipe closes with the process; one more poll reads its end.
+      group.poll(std::chrono::milliseconds(20));
+      ASSERT_FALSE(group.running(i));
+      EXPECT_EQ(group.status(i).code, run);
+    }
+    EXPECT_EQ(group.size(), 2u);
+    EXPECT_TRUE(group.running(0));
+    group.stop_all(std::chrono::seconds(5));
+  }
+  std::fclose(out);
+}
+
 TEST(ProcessGroup, StopAllInterruptsAndEscalatesToKill) {
   std::FILE* out = std::tmpfile();
   ProcessGroup group("", out);

@@ -113,7 +113,7 @@ std::string ProcessGroup::resolve(const std::string& program) const {
   throw std::runtime_error("program '" + program + "' not found in " + bin_dir_ + " or PATH");
 }
 
-void ProcessGroup::start(const ProcessSpec& spec) {
+std::size_t ProcessGroup::start(const ProcessSpec& spec) {
   auto child = std::make_unique<Child>();
   child->spec = spec;
   const std::string program = resolve(spec.command.front());
@@ -156,7 +156,15 @@ void ProcessGroup::start(const ProcessSpec& spec) {
   child->running = true;
   std::fprintf(out_, "[launch] started %s (pid %d): %s\n", spec.name.c_str(), pid, program.c_str());
   std::fflush(out_);
+  for (std::size_t i = 0; i < children_.size(); ++i) {
+    Child& ended = *children_[i];
+    if (!ended.running && ended.output_fd < 0 && ended.spec.name == spec.name) {
+      children_[i] = std::move(child);
+      return i;
+    }
+  }
   children_.push_back(std::move(child));
+  return children_.size() - 1;
 }
 
 void ProcessGroup::drain(Child& child, bool final) {

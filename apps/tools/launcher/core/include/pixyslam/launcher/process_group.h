@@ -41,8 +41,10 @@ class ProcessGroup {
   ProcessGroup(const ProcessGroup&) = delete;
   ProcessGroup& operator=(const ProcessGroup&) = delete;
 
-  // Starts a child; throws std::runtime_error if the program is not found.
-  void start(const ProcessSpec& spec);
+  // Starts a child and returns its index; throws std::runtime_error if the
+  // program is not found. A child started again under the name of one that
+  // ended (a restart) takes its index: a crash loop does not grow the group.
+  std::size_t start(const ProcessSpec& spec);
   // Forwards output and reaps children for up to `timeout`; returns the indices
   // of children that ended during the call.
   std::vector<std::size_t> poll(std::chrono::milliseconds timeout);
