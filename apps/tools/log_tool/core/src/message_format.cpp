@@ -590,29 +590,39 @@ std::vector<std::string> compare_values(const Value& a, const Value& b, const st
   return comparison.lines;
 }
 
-GapStats gap_stats(const std::vector<double>& arrivals_s) {
+void GapAccumulator::add(double t_s) {
+  if (messages_++ > 0) {
+    const double gap = t_s - last_s_;
+    const auto n = static_cast<double>(messages_ - 1);  // gaps so far, this one included
+    if (messages_ == 2) {
+      min_s_ = max_s_ = gap;
+    } else {
+      min_s_ = std::min(min_s_, gap);
+      max_s_ = std::max(max_s_, gap);
+    }
+    const double delta = gap - mean_s_;
+    mean_s_ += delta / n;
+    m2_ += delta * (gap - mean_s_);
+  }
+  last_s_ = t_s;
+}
+
+GapStats GapAccumulator::stats() const {
   GapStats s;
-  s.messages = arrivals_s.size();
-  if (arrivals_s.size() < 2) return s;
-  const std::size_t n = arrivals_s.size() - 1;
-  double sum = 0.0;
-  s.min_s = arrivals_s[1] - arrivals_s[0];
-  s.max_s = s.min_s;
-  for (std::size_t i = 1; i < arrivals_s.size(); ++i) {
-    const double gap = arrivals_s[i] - arrivals_s[i - 1];
-    sum += gap;
-    s.min_s = std::min(s.min_s, gap);
-    s.max_s = std::max(s.max_s, gap);
-  }
-  s.mean_s = sum / static_cast<double>(n);
-  double squares = 0.0;
-  for (std::size_t i = 1; i < arrivals_s.size(); ++i) {
-    const double d = arrivals_s[i] - arrivals_s[i - 1] - s.mean_s;
-    squares += d * d;
-  }
-  s.std_s = std::sqrt(squares / static_cast<double>(n));
+  s.messages = messages_;
+  if (messages_ < 2) return s;
+  s.mean_s = mean_s_;
+  s.min_s = min_s_;
+  s.max_s = max_s_;
+  s.std_s = std::sqrt(std::max(0.0, m2_ / static_cast<double>(messages_ - 1)));
   s.rate_hz = s.mean_s > 0.0 ? 1.0 / s.mean_s : 0.0;
   return s;
+}
+
+GapStats gap_stats(const std::vector<double>& arrivals_s) {
+  GapAccumulator a;
+  for (const double t : arrivals_s) a.add(t);
+  return a.stats();
 }
 
 }  // namespace pixyslam::log_tool

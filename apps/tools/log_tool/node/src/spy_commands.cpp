@@ -451,15 +451,14 @@ int run_hz(const dds::DdsOptions& options, const std::string& topic, double seco
   return with_topic_type(topic, [&](auto tag) {
     using Message = decltype(tag);
     std::mutex mutex;
-    std::vector<double> arrivals_s;
-    std::vector<double> stamps_s;
+    GapAccumulator arrivals, stamps;  // constant memory however long it listens
     const auto start = Clock::now();
     dds::Participant participant(options, "pixyslam_spy");
     dds::Reader<Message> reader(participant, [&](const Message& m) {
       const double t = std::chrono::duration<double>(Clock::now() - start).count();
       std::lock_guard<std::mutex> lock(mutex);
-      arrivals_s.push_back(t);
-      stamps_s.push_back(static_cast<double>(m.header().stamp_ns()) * 1e-9);
+      arrivals.add(t);
+      stamps.add(static_cast<double>(m.header().stamp_ns()) * 1e-9);
     }, robot);
     // A line every second while listening (as ros2 topic hz): the rate over the
     // last second and over everything so far.
@@ -475,9 +474,9 @@ int run_hz(const dds::DdsOptions& options, const std::string& topic, double seco
         break;
       }
       std::lock_guard<std::mutex> lock(mutex);
-      const GapStats so_far = gap_stats(arrivals_s);
-      const std::size_t last_second = arrivals_s.size() - reported;
-      reported = arrivals_s.size();
+      const GapStats so_far = arrivals.stats();
+      const std::size_t last_second = so_far.messages - reported;
+      reported = so_far.messages;
       const double rate_hz = so_far.messages >= 2 ? so_far.rate_hz : 0.0;
       if (json) {
         out << to_json_line(Value::structure()
@@ -494,8 +493,8 @@ int run_hz(const dds::DdsOptions& options, const std::string& topic, double seco
     }
     const double listened_s = std::chrono::duration<double>(Clock::now() - start).count();
     std::lock_guard<std::mutex> lock(mutex);
-    const GapStats arrival = gap_stats(arrivals_s);
-    const GapStats stamp = gap_stats(stamps_s);  // not sorted: a reordering shows as a negative min
+    const GapStats arrival = arrivals.stats();
+    const GapStats stamp = stamps.stats();  // not sorted: a reordering shows as a negative min
     if (json) {
       Value summary = Value::structure()
                           .add("topic", Value::string(topic))

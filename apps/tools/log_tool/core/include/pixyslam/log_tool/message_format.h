@@ -118,4 +118,18 @@ struct GapStats {
 // `arrivals_s` in arrival order (non-decreasing).
 GapStats gap_stats(const std::vector<double>& arrivals_s);
 
+// The same statistics kept as the times come (Welford's running mean and
+// variance of the gaps), in constant memory: `pixyslam_spy hz` listens for days.
+class GapAccumulator {
+ public:
+  void add(double t_s);
+  GapStats stats() const;
+
+ private:
+  std::size_t messages_ = 0;
+  double last_s_ = 0.0;
+  double min_s_ = 0.0, max_s_ = 0.0;
+  double mean_s_ = 0.0, m2_ = 0.0;  // of the gaps
+};
+
 }  // namespace pixyslam::log_tool
