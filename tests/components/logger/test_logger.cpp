@@ -627,6 +627,21 @@ void expect_complete_rotation(const std::vector<std::string>& files, const Logge
   EXPECT_EQ(c.file.messages, count);
 }
 
+// Odometry seq 1..count from a writer of the test's, as fast as it goes, until
+// the logger has received every sample.
+void publish_odometry_until_received(const LoggerNode& node, int count) {
+  dds::Participant robot(loopback_options(), "test_robot");
+  dds::Writer<msg::Odometry> writer(robot);
+  ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(10)));
+  for (int i = 0; i < count; ++i) {
+    msg::Odometry m = test::sample_odometry(i);
+    ASSERT_TRUE(writer.publish(m));
+  }
+  ASSERT_TRUE(wait_until([&] { return received(node, "pixyslam/odometry") == static_cast<std::uint64_t>(count); },
+                         std::chrono::seconds(20)))
+      << node.counters_text();
+}
+
 TEST(LoggerNode, RotatesBySizeIntoCompleteFiles) {
   const TempFile base("test_logger_rotate_size");
   remove_rotated(base.path());
@@ -636,16 +651,8 @@ TEST(LoggerNode, RotatesBySizeIntoCompleteFiles) {
   options.compression = mcap::McapCompression::kNone;  // sizes as written
   LoggerNode node(options);
   node.start();
-  dds::Participant robot(loopback_options(), "test_robot");
-  dds::Writer<msg::Odometry> writer(robot);
-  ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(10)));
   constexpr int kCount = 2000;
-  for (int i = 0; i < kCount; ++i) {
-    msg::Odometry m = test::sample_odometry(i);
-    ASSERT_TRUE(writer.publish(m));
-  }
-  ASSERT_TRUE(wait_until([&] { return received(node, "pixyslam/odometry") == kCount; }, std::chrono::seconds(20)))
-      << node.counters_text();
+  publish_odometry_until_received(node, kCount);
   node.stop();
   EXPECT_FALSE(std::filesystem::exists(base.path()));  // only the indexed names
   const std::vector<std::string> files = rotated_files(base.path());
@@ -674,16 +681,8 @@ TEST(LoggerNode, KeepsOnlyTheNewestRotatedFiles) {
   options.compression = mcap::McapCompression::kNone;
   LoggerNode node(options);
   node.start();
-  dds::Participant robot(loopback_options(), "test_robot");
-  dds::Writer<msg::Odometry> writer(robot);
-  ASSERT_TRUE(writer.wait_for_readers(1, std::chrono::seconds(10)));
   constexpr int kCount = 3000;
-  for (int i = 0; i < kCount; ++i) {
-    msg::Odometry m = test::sample_odometry(i);
-    ASSERT_TRUE(writer.publish(m));
-  }
-  ASSERT_TRUE(wait_until([&] { return received(node, "pixyslam/odometry") == kCount; }, std::chrono::seconds(20)))
-      << node.counters_text();
+  publish_odometry_until_received(node, kCount);
   node.stop();
   const LoggerCounters c = node.counters();
   ASSERT_GE(c.files.size(), 4u);

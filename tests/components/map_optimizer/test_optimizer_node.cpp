@@ -44,6 +44,15 @@ bool wait_for_malformed(const OptimizerNode& node, std::uint64_t target) {
   return node.counters().malformed >= target;
 }
 
+// 60 s of the simulated world, a camera frame every 0.1 s seeing poles within 4 m.
+sim::WorldRun simulated_minute() {
+  sim::WorldOptions world;
+  world.duration_s = 60.0;
+  world.camera_rate_hz = 10.0;
+  world.max_range_m = 4.0;
+  return sim::simulate(world);
+}
+
 // The simulated run in stamp order, paced (an estimator answers every message
 // with a MapState), until every sample is acknowledged.
 void feed(const sim::WorldRun& run, std::uint64_t base_ns, dds::Writer<msg::Odometry>& odometry_writer,
@@ -68,11 +77,7 @@ void feed(const sim::WorldRun& run, std::uint64_t base_ns, dds::Writer<msg::Odom
 }
 
 TEST(OptimizerNode, OptimisesBesideTheEstimatorFromDdsInput) {
-  sim::WorldOptions world;
-  world.duration_s = 60.0;
-  world.camera_rate_hz = 10.0;
-  world.max_range_m = 4.0;
-  const sim::WorldRun run = sim::simulate(world);
+  const sim::WorldRun run = simulated_minute();
   const std::uint64_t base_ns = dds::now_ns();
 
   slam_node::EstimatorOptions estimator_options =
@@ -162,11 +167,7 @@ TEST(OptimizerNode, OptimisesBesideTheEstimatorFromDdsInput) {
 // anew from the current pose with the landmarks as priors; it stays bounded,
 // the map keeps every landmark near the truth, and the pose goes on.
 TEST(OptimizerNode, AProblemAtItsKeyframeLimitStartsAnewWithItsLandmarksAsPriors) {
-  sim::WorldOptions world;
-  world.duration_s = 60.0;
-  world.camera_rate_hz = 10.0;
-  world.max_range_m = 4.0;
-  const sim::WorldRun run = sim::simulate(world);
+  const sim::WorldRun run = simulated_minute();
   const std::uint64_t base_ns = dds::now_ns();
   OptimizerNodeOptions options = test_options();
   options.initial_pose = run.initial_pose;
