@@ -10,7 +10,8 @@ namespace pixyslam::bridge {
 namespace {
 std::string seconds_text(std::uint64_t now_ns, std::uint64_t since_ns) {
   char text[32];
-  std::snprintf(text, sizeof text, "%.1f", static_cast<double>(now_ns - since_ns) * 1e-9);
+  const std::uint64_t elapsed_ns = now_ns > since_ns ? now_ns - since_ns : 0;  // the host clock may step back
+  std::snprintf(text, sizeof text, "%.1f", static_cast<double>(elapsed_ns) * 1e-9);
   return text;
 }
 }  // namespace
@@ -183,7 +184,9 @@ void DeviceReader::loop() {
         counters_.bytes += result.bytes;
         was_silent = std::exchange(counters_.silent, false);
       }
-      if (was_silent) log_("serial device '" + device_name_ + "' sends again after " + seconds_text(now_ns, last_bytes_ns) + " s");
+      if (was_silent) {
+        log_("serial device '" + device_name_ + "' sends again after " + seconds_text(now_ns, last_bytes_ns) + " s");
+      }
       last_bytes_ns = now_ns;
       if (handlers_.on_bytes) {
         run_handler("on_bytes", [&] { handlers_.on_bytes(buffer.data(), result.bytes, now_ns); });

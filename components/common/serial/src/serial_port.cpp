@@ -2,7 +2,6 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
-#include <sys/ioctl.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -135,16 +134,17 @@ void SerialPort::open(const std::string& path, long baud) {
     throw detail::os_error(err, name + ": open failed" + hint);
   }
   // One reader per device: two would each get part of the bytes. flock() holds
-  // against another bridge (root too); TIOCEXCL against a terminal program.
+  // against another bridge (root too) and ends with the descriptor, also when
+  // the process is killed. (Not TIOCEXCL: on a pty whose other side stays open,
+  // a killed bridge would leave it set and lock its own restart out.)
   if (::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) {
     const int err = errno;
     if (err == EWOULDBLOCK) {
-      throw detail::os_error(EBUSY, name + ": in use by another process (another bridge, or a terminal program)");
+      throw detail::os_error(EBUSY, name + ": in use by another process (another bridge?)");
     }
     throw detail::os_error(err, name + ": flock");
   }
   detail::make_raw(fd.get(), speed, name);
-  if (::ioctl(fd.get(), TIOCEXCL) != 0) throw detail::os_error(errno, name + ": TIOCEXCL");
   // Bytes that arrived before this open are stale.
   if (::tcflush(fd.get(), TCIFLUSH) != 0) throw detail::os_error(errno, name + ": tcflush");
   fd_ = fd.release();
@@ -153,8 +153,6 @@ void SerialPort::open(const std::string& path, long baud) {
 }
 
 void SerialPort::close() noexcept {
-  // Exclusive mode outlives this descriptor while others hold the tty open (a pty's other side).
-  if (fd_ >= 0) ::ioctl(fd_, TIOCNXCL);
   detail::close_fd(fd_);
   fd_ = -1;
 }

@@ -32,8 +32,8 @@ bool is_supported_baud(long baud);
 // cfmakeraw, 8 data bits, no parity, 1 stop bit, CLOCAL | CREAD, no hardware or
 // software flow control, VMIN = VTIME = 0, opened O_NOCTTY | O_CLOEXEC |
 // O_NONBLOCK. Input already queued when the port opens is discarded (it is
-// stale). The device is held exclusively while open (flock and TIOCEXCL): a
-// second SerialPort, bridge or terminal program cannot open it (EBUSY). Reads wait in poll() with a timeout; a hang-up is reported as
+// stale). The device is held exclusively while open (flock): a second
+// SerialPort or bridge cannot open it (EBUSY). Reads wait in poll() with a timeout; a hang-up is reported as
 // ReadStatus::kHangup, not thrown, so a node can reopen the device. Errors throw
 // std::system_error (open, termios, read and write failures; the message names
 // the device path and the errno text) or std::invalid_argument (a rate not in
