@@ -102,8 +102,9 @@ int main(int argc, char** argv) {
                  options.dds.domain_id, options.dds.profiles_file.c_str());
     if (verbose) app::print_effective_configuration("slam_estimator", slam_node::to_yaml(options));
 
-    slam_node::EstimatorNode node(options);
+    // Before the node: its filter thread writes here until the node is destroyed.
     std::optional<TrajectoryOutput> trajectory;
+    slam_node::EstimatorNode node(options);
     if (!out_dir.empty()) {
       trajectory.emplace(out_dir);  // a folder that cannot be written fails now, not at the end
       node.set_step_observer([&trajectory](std::uint64_t stamp_ns, const slam::Pose2& pose) {

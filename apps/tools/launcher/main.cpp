@@ -179,11 +179,11 @@ class LaunchSession {
     for (std::size_t i = 0; i < group_.size(); ++i) {
       const launcher::ExitStatus& status = group_.status(i);
       const launcher::ProcessSpec& spec = group_.spec(i);
-      // A restarted process shows its last run; its earlier failures still count.
+      // A restarted process shows its last run; every failure still counts.
       const auto failures = failures_.find(spec.name);
       const int failed_before = failures == failures_.end() ? 0 : failures->second;
       const std::string restarts =
-          failed_before > 0 ? ", failed " + std::to_string(failed_before) + " time(s) before and restarted" : "";
+          failed_before > 0 ? ", " + std::to_string(failed_before) + " failure(s) in all, restarted after each" : "";
       std::printf("[launch]   %-16s %s%s%s  (%s%s)\n", spec.name.c_str(), status.describe().c_str(),
                   status.ok() ? "" : "  <- FAILED", spec.optional && !status.ok() ? " (optional)" : "",
                   status.resources().c_str(), restarts.c_str());

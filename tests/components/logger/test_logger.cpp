@@ -13,6 +13,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -47,6 +48,17 @@ TEST(RotatedFileName, IndexGoesBeforeTheExtension) {
   EXPECT_EQ(rotated_file_name("/tmp/a.b/run", 1), "/tmp/a.b/run_001");
   EXPECT_EQ(rotated_file_name("dir/.hidden", 2), "dir/.hidden_002");
   EXPECT_EQ(rotated_file_name("dir/run.x.mcap", 3), "dir/run.x_003.mcap");
+}
+
+TEST(RotatedFileName, TheIndexIsReadBackOnlyFromItsOwnNames) {
+  EXPECT_EQ(rotated_file_index("run.mcap", "run_000.mcap"), std::optional<std::size_t>(0));
+  EXPECT_EQ(rotated_file_index("run.mcap", "run_1234.mcap"), std::optional<std::size_t>(1234));
+  EXPECT_EQ(rotated_file_index("dir/run.x.mcap", "dir/run.x_003.mcap"), std::optional<std::size_t>(3));
+  EXPECT_EQ(rotated_file_index("/tmp/a.b/run", "/tmp/a.b/run_001"), std::optional<std::size_t>(1));
+  for (const char* other : {"run.mcap", "run_01.mcap", "run_0012.mcap", "run_abc.mcap", "run_001.mcap.tmp",
+                            "walk_001.mcap", "run_001.txt", "run__001.mcap"}) {
+    EXPECT_FALSE(rotated_file_index("run.mcap", other).has_value()) << other;
+  }
 }
 
 // ---------------------------------------------------------------- options
@@ -699,7 +711,22 @@ TEST(LoggerNode, KeepsOnlyTheNewestRotatedFiles) {
   ASSERT_FALSE(seqs.empty());
   EXPECT_EQ(seqs.back(), static_cast<std::uint64_t>(kCount));  // the end of the run
   EXPECT_TRUE(std::is_sorted(seqs.begin(), seqs.end()));
-  remove_rotated(base.path());
+
+  // A restarted logger (the same base) goes on after the newest file of the
+  // run before, though its lowest indexes are free: nothing is overwritten.
+  const std::string newest = c.files.back().path;
+  const auto newest_size = std::filesystem::file_size(newest);
+  LoggerNode again(options);
+  again.start();
+  publish_odometry_until_received(again, 10);
+  again.stop();
+  const LoggerCounters c2 = again.counters();
+  ASSERT_FALSE(c2.files.empty());
+  EXPECT_EQ(rotated_file_index(base.path(), c2.files.front().path),
+            std::optional<std::size_t>(*rotated_file_index(base.path(), newest) + 1));
+  EXPECT_EQ(std::filesystem::file_size(newest), newest_size);
+  for (const LoggedFile& f : c2.files) std::filesystem::remove(f.path);
+  for (const LoggedFile& f : c.files) std::filesystem::remove(f.path);
 }
 
 TEST(LoggerNode, RotatesByPeriod) {

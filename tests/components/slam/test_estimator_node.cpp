@@ -108,9 +108,10 @@ TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
 
   EstimatorOptions options = test_options();
   options.initial_pose = run.initial_pose;
-  EstimatorNode node(options);
-  // The mean pose after every step, as slam_estimator --out-dir streams it.
+  // The mean pose after every step, as slam_estimator --out-dir streams it
+  // (declared before the node, whose thread writes it until it is destroyed).
   std::vector<eval::TimedPose> estimate;
+  EstimatorNode node(options);
   node.set_step_observer([&](std::uint64_t stamp_ns, const slam::Pose2& pose) {
     estimate.push_back({static_cast<double>(stamp_ns - base_ns) * 1e-9, pose.x(), pose.y(), pose.z()});
   });

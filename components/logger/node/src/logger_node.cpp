@@ -129,8 +129,18 @@ void LoggerNode::open_first_file() {
     open_file(0);
     return;
   }
+  // After the highest index that holds a recording: with keep_files the lowest
+  // ones of an earlier run are gone, and its newest must not be overwritten.
   std::size_t index = rotating ? 0 : 1;
-  while (holds_data(rotated_file_name(options_.output_file, index))) ++index;
+  const std::filesystem::path base(options_.output_file);
+  const std::filesystem::path folder = base.has_parent_path() ? base.parent_path() : std::filesystem::path(".");
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+    const std::string name =
+        base.has_parent_path() ? (folder / entry.path().filename()).string() : entry.path().filename().string();
+    const std::optional<std::size_t> taken = rotated_file_index(options_.output_file, name);
+    if (taken && holds_data(name)) index = std::max(index, *taken + 1);
+  }
   const std::string path = rotated_file_name(options_.output_file, index);
   if (!rotating || index > 0) {
     std::fprintf(stderr, "logger: WARN: %s already holds a recording: writing %s\n",

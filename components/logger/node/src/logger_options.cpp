@@ -1,7 +1,9 @@
 #include "pixyslam/logger_node/logger_options.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <sstream>
+#include <utility>
 
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/config/parameters_yaml.h"
@@ -124,15 +126,37 @@ std::string to_yaml(const LoggerOptions& o) {
   return parameters::to_yaml(o, logger_parameters(), "logger") + "  topics: [" + topics + "]\n" + dds::to_yaml(o.dds);
 }
 
-std::string rotated_file_name(const std::string& base, std::size_t index) {
+namespace {
+// "dir/run.mcap" -> {"dir/run", ".mcap"}; "dir/.hidden" -> {"dir/.hidden", ""}.
+std::pair<std::string, std::string> stem_and_extension(const std::string& base) {
   const std::size_t slash = base.find_last_of('/');
   const std::size_t dot = base.find_last_of('.');
   const bool has_extension = dot != std::string::npos && (slash == std::string::npos || dot > slash + 1);
-  const std::string stem = has_extension ? base.substr(0, dot) : base;
-  const std::string extension = has_extension ? base.substr(dot) : "";
+  return {has_extension ? base.substr(0, dot) : base, has_extension ? base.substr(dot) : ""};
+}
+}  // namespace
+
+std::string rotated_file_name(const std::string& base, std::size_t index) {
+  const auto [stem, extension] = stem_and_extension(base);
   char number[32];
   std::snprintf(number, sizeof(number), "_%03zu", index);
   return stem + number + extension;
+}
+
+std::optional<std::size_t> rotated_file_index(const std::string& base, const std::string& name) {
+  const auto [stem, extension] = stem_and_extension(base);
+  const std::size_t prefix = stem.size() + 1;
+  if (name.size() < prefix + 3 + extension.size() || name.compare(0, stem.size(), stem) != 0 ||
+      name[stem.size()] != '_' || name.compare(name.size() - extension.size(), extension.size(), extension) != 0) {
+    return std::nullopt;
+  }
+  const std::string digits = name.substr(prefix, name.size() - prefix - extension.size());
+  if (digits.size() > 18 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    return std::nullopt;
+  }
+  const std::size_t index = std::stoull(digits);
+  if (rotated_file_name(base, index) != name) return std::nullopt;  // "run_0012" is not index 12's name
+  return index;
 }
 
 }  // namespace pixyslam::logger_node

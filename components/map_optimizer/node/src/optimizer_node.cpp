@@ -160,10 +160,13 @@ void OptimizerNode::step(const slam::SensorInput& input) {
     for (const auto& [id, position] : filter_landmarks_) optimizer_->set_landmark_guess(id, position);
   }
   if (const auto* odometry = std::get_if<slam::OdometryInput>(&input)) {
+    const std::size_t taken_before = optimizer_->counters().odometry;
     optimizer_->add_odometry(odometry->sample);
     last_odometry_seq_ = odometry->seq;
-    // At an odometry sample, so that the new problem holds its control from the start.
-    if (options_.max_keyframes > 0 && optimizer_->keyframes().size() >= options_.max_keyframes) {
+    // At a measured sample the problem took (not a late one), so that the new
+    // problem starts at its time and holds its control from there.
+    if (options_.max_keyframes > 0 && optimizer_->keyframes().size() >= options_.max_keyframes &&
+        odometry->sample.measured && optimizer_->counters().odometry > taken_before) {
       start_segment(odometry->sample);
     }
   } else {
@@ -213,6 +216,7 @@ void OptimizerNode::start_segment(const slam::OdometrySample& odometry) {
   const std::vector<map_optimizer::LandmarkSolution> landmarks = optimizer_->landmarks();
   const std::size_t keyframes = optimizer_->keyframes().size();
   earlier_segments_ = optimizer_counters();
+  --earlier_segments_.odometry;  // the boundary sample goes to both problems: counted once
   optimizer_ = std::make_unique<map_optimizer::MapOptimizer>(options_.optimizer, pose, odometry.t_s);
   optimizer_->add_odometry(odometry);  // its control, held from now on
   std::size_t priors = 0;
@@ -225,6 +229,12 @@ void OptimizerNode::start_segment(const slam::OdometrySample& odometry) {
   }
   schedule_.emplace(options_.schedule, odometry.t_s);
   ++counters_.segments;
+  if (priors < landmarks.size()) {
+    std::fprintf(stderr,
+                 "map_optimizer: WARN: %zu landmarks had no covariance (a rank-deficient last solve): they start "
+                 "from their position only and leave the map until seen again\n",
+                 landmarks.size() - priors);
+  }
   std::fprintf(stderr,
                "map_optimizer: %zu keyframes (optimizer.max_keyframes): a new problem from the current pose, %zu of %zu "
                "landmarks as priors\n",

@@ -692,18 +692,27 @@ TEST(MsgConversion, TrajectoryDecimation) {
   EXPECT_DOUBLE_EQ(path[1].x_m, 0.11);
 }
 
-// A live view that runs for days: past the limit every other point goes, the
-// first and the newest stay, and the path never holds more than the limit.
-TEST(MsgConversion, APathKeepsAtMostItsLimitWithItsEnds) {
+// A live view that runs for days: the path never holds more than its limit,
+// keeps its start and its newest point, and old and new parts are thinned
+// alike (appending halves the whole run, not again and again its old part).
+TEST(MsgConversion, AThinnedPathKeepsItsLimitItsEndsAndAnEvenDensity) {
   std::vector<Point2> path;
-  for (int i = 0; i < 1000; ++i) {
-    append_point(path, {0.01 * i, 0.0}, 0.0, 100);
-    ASSERT_LE(path.size(), 100u) << i;
+  PathThinning thinning(0.0, 100);
+  for (int i = 0; i < 100000; ++i) {
+    thinning.append(path, {0.01 * i, 0.0});
+    ASSERT_LE(path.size(), 101u) << i;  // the limit, and the newest point standing in
   }
   EXPECT_GE(path.size(), 50u);
   EXPECT_DOUBLE_EQ(path.front().x_m, 0.0);
-  EXPECT_DOUBLE_EQ(path.back().x_m, 9.99);
-  for (std::size_t i = 1; i < path.size(); ++i) EXPECT_LT(path[i - 1].x_m, path[i].x_m) << i;
+  EXPECT_DOUBLE_EQ(path.back().x_m, 999.99);
+  double min_gap = 1e9, max_gap = 0.0;
+  for (std::size_t i = 1; i + 1 < path.size(); ++i) {  // the last gap ends at the newest point
+    const double gap = path[i].x_m - path[i - 1].x_m;
+    min_gap = std::min(min_gap, gap);
+    max_gap = std::max(max_gap, gap);
+  }
+  EXPECT_GT(min_gap, 0.0);
+  EXPECT_LE(max_gap, 2.0 * min_gap + 1e-9) << "gaps from " << min_gap << " to " << max_gap;
 }
 
 // ---- MCAP logs -----------------------------------------------------------

@@ -69,7 +69,7 @@ bool MapViewBuilder::add(const msg::MapState& m) {
   state_.particles.clear();
   for (const msg::Pose2D& p : m.particle_poses()) state_.particles.push_back(to_pose(p));
   state_.current_pose = to_pose(m.mean_pose());
-  append_point(state_.mean_trajectory, {m.mean_pose().x_m(), m.mean_pose().y_m()}, min_step_m_);
+  mean_path_.append(state_.mean_trajectory, {m.mean_pose().x_m(), m.mean_pose().y_m()});
   state_.landmarks = to_landmarks(m);
 
   CaptionInfo info;
@@ -86,7 +86,7 @@ void MapViewBuilder::add(const msg::GroundTruth& g) {
   note_stamp(g.header().stamp_ns());
   ++ground_truths_;
   state_.true_pose = to_pose(g.pose());
-  append_point(state_.true_trajectory, {g.pose().x_m(), g.pose().y_m()}, min_step_m_);
+  true_path_.append(state_.true_trajectory, {g.pose().x_m(), g.pose().y_m()});
   if (!g.landmarks().empty() || state_.true_landmarks.empty()) state_.true_landmarks = to_true_landmarks(g);
 }
 

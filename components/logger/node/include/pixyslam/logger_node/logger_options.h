@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -86,5 +87,7 @@ std::string to_yaml(const LoggerOptions& options);
 // The name of rotated file `index` for `base`: "run.mcap", 3 -> "run_003.mcap"
 // (at least three digits; "dir/run" -> "dir/run_003"). Pure.
 std::string rotated_file_name(const std::string& base, std::size_t index);
+// The index of `name` if it is a rotated file name of `base` (its inverse), else none.
+std::optional<std::size_t> rotated_file_index(const std::string& base, const std::string& name);
 
 }  // namespace pixyslam::logger_node

@@ -61,14 +61,32 @@ struct MapViewState {
   std::vector<MapViewState> other_robots;
 };
 
+// Appends `p` to `path` unless it is closer than `min_step_m` to the last point
+// kept (a cheap decimation for long runs; 0 keeps every point). Non-finite
+// points are dropped.
+void append_point(std::vector<Point2>& path, Point2 p, double min_step_m);
+
 // Most points a drawn path keeps (320 KB): a live view runs for days.
 inline constexpr std::size_t kMaxPathPoints = 20000;
 
-// Appends `p` to `path` unless it is closer than `min_step_m` to the last point
-// kept (a cheap decimation for long runs; 0 keeps every point). Past
-// `max_points` every other point is dropped (the newest kept), so the whole run
-// stays drawn at half the density. Non-finite points are dropped.
-void append_point(std::vector<Point2>& path, Point2 p, double min_step_m, std::size_t max_points = kMaxPathPoints);
+// A path that grows for days at an even density: append_point(), and past
+// max_points every other point is dropped and from then on only every second
+// new point stays (the stride doubles each time), so old and new parts of the
+// run are thinned alike. The newest point is always the path's last.
+class PathThinning {
+ public:
+  explicit PathThinning(double min_step_m = 0.0, std::size_t max_points = kMaxPathPoints);
+  void append(std::vector<Point2>& path, Point2 p);
+  // For a path built again from its start (the optimiser's whole solution).
+  void reset();
+
+ private:
+  double min_step_m_;
+  std::size_t max_points_;
+  std::size_t stride_ = 1;    // one point kept in this many
+  std::size_t appended_ = 0;  // points taken since the stride last changed
+  bool provisional_ = false;  // the last point is the newest, not one that stays
+};
 
 // What the caption reports about one estimator state.
 struct CaptionInfo {

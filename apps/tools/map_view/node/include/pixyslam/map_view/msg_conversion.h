@@ -34,7 +34,8 @@ std::vector<LandmarkView> to_landmarks(const msg::FleetMap& map);   // times_obs
 // Thread-compatible (the live view guards it with a mutex).
 class MapViewBuilder {
  public:
-  explicit MapViewBuilder(double trajectory_min_step_m = 0.0) : min_step_m_(trajectory_min_step_m) {}
+  explicit MapViewBuilder(double trajectory_min_step_m = 0.0)
+      : min_step_m_(trajectory_min_step_m), mean_path_(min_step_m_), true_path_(min_step_m_) {}
 
   // False if the message was ignored (older than the last MapState).
   bool add(const msg::MapState& state);
@@ -51,6 +52,7 @@ class MapViewBuilder {
   void note_stamp(std::uint64_t stamp_ns);
 
   double min_step_m_;
+  PathThinning mean_path_, true_path_;
   MapViewState state_;
   std::size_t map_states_ = 0;
   std::size_t ground_truths_ = 0;
