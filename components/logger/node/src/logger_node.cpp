@@ -119,7 +119,7 @@ diagnostics::Snapshot LoggerNode::diagnostics_snapshot() const {
 
 void LoggerNode::open_first_file() {
   // An existing recording is never overwritten (a restarted logger, a reused
-  // run folder): the first free indexed name is taken instead.
+  // run folder): the indexed name after the highest one holding data is taken instead.
   const auto holds_data = [](const std::string& path) {
     std::error_code error;
     return std::filesystem::is_regular_file(path, error) && std::filesystem::file_size(path, error) > 0;

@@ -36,7 +36,7 @@ const parameters::Table<LoggerOptions>& logger_parameters() {
   using C = mcap::McapCompression;
   namespace P = parameters;
   static const P::Table<O> table = {
-      P::text<O>("output_file", "the MCAP file (kept if it holds data: the next free indexed name is used)",
+      P::text<O>("output_file", "the MCAP file (kept if it holds data: the name after the highest indexed one is used)",
                  [](O& o) -> std::string& { return o.output_file; },
                  [](const std::string& v) {
                    if (v.empty()) throw std::invalid_argument("empty");

@@ -18,8 +18,8 @@ mcap::McapCompression default_compression();
 // Everything the logger process is configured with (config/logger.yaml).
 struct LoggerOptions {
   // `logger.output_file`: the MCAP file, created; if it already holds data (a
-  // restarted logger, a reused folder) it is kept and the first free indexed
-  // name (run_001.mcap, ...) is written instead. A relative path is relative
+  // restarted logger, a reused folder) it is kept and the indexed name after
+  // the highest one holding a recording (run_001.mcap, ...) is written instead. A relative path is relative
   // to the working directory. `logger --out` overrides it. With
   // rotation on, the files are named rotated_file_name(output_file, 0, 1, ...):
   // run.mcap -> run_000.mcap, run_001.mcap, ...
