@@ -243,17 +243,7 @@ void OptimizerNode::start_segment(const slam::OdometrySample& odometry) {
 
 map_optimizer::OptimizerCounters OptimizerNode::optimizer_counters() const {
   map_optimizer::OptimizerCounters c = earlier_segments_;
-  if (!optimizer_) return c;
-  const map_optimizer::OptimizerCounters& n = optimizer_->counters();
-  c.odometry += n.odometry;
-  c.odometry_dropped += n.odometry_dropped;
-  c.frames += n.frames;
-  c.frames_dropped += n.frames_dropped;
-  c.observations += n.observations;
-  c.observations_invalid += n.observations_invalid;
-  c.observations_over_map_limit += n.observations_over_map_limit;
-  c.keyframes += n.keyframes;
-  c.solves += n.solves;
+  if (optimizer_) c += optimizer_->counters();
   return c;
 }
 

@@ -120,6 +120,20 @@ struct OptimizerCounters {
   std::size_t observations_over_map_limit = 0;  // a new id beyond max_landmarks: dropped
   std::size_t keyframes = 0;
   std::size_t solves = 0;
+
+  // Totals over several problems (a long run's segments).
+  OptimizerCounters& operator+=(const OptimizerCounters& o) {
+    odometry += o.odometry;
+    odometry_dropped += o.odometry_dropped;
+    frames += o.frames;
+    frames_dropped += o.frames_dropped;
+    observations += o.observations;
+    observations_invalid += o.observations_invalid;
+    observations_over_map_limit += o.observations_over_map_limit;
+    keyframes += o.keyframes;
+    solves += o.solves;
+    return *this;
+  }
 };
 
 // The whole problem copied out of a MapOptimizer (MapOptimizer::snapshot()):
