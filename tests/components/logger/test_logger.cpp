@@ -607,9 +607,23 @@ std::vector<std::string> rotated_files(const std::string& base) {
   return out;
 }
 
+// Every rotated file of base, also past a gap (keep_files deletes the lowest).
 void remove_rotated(const std::string& base) {
-  for (const std::string& f : rotated_files(base)) std::filesystem::remove(f);
+  for (std::size_t i = 0; i < 1000; ++i) std::filesystem::remove(rotated_file_name(base, i));
 }
+
+// Removes base's rotated files now and when the test ends, also when an
+// assertion ends it early.
+class RotatedFilesGuard {
+ public:
+  explicit RotatedFilesGuard(std::string base) : base_(std::move(base)) { remove_rotated(base_); }
+  ~RotatedFilesGuard() { remove_rotated(base_); }
+  RotatedFilesGuard(const RotatedFilesGuard&) = delete;
+  RotatedFilesGuard& operator=(const RotatedFilesGuard&) = delete;
+
+ private:
+  std::string base_;
+};
 
 // Each file complete and clean, with every selected channel; together, seq
 // 1..count of Odometry in order.
@@ -656,7 +670,7 @@ void publish_odometry_until_received(const LoggerNode& node, int count) {
 
 TEST(LoggerNode, RotatesBySizeIntoCompleteFiles) {
   const TempFile base("test_logger_rotate_size");
-  remove_rotated(base.path());
+  const RotatedFilesGuard rotated(base.path());
   LoggerOptions options = node_options(base.path());
   options.topics = {"pixyslam/*", "!pixyslam/ground_truth"};
   options.rotate_size_bytes = 65536;
@@ -678,14 +692,13 @@ TEST(LoggerNode, RotatesBySizeIntoCompleteFiles) {
     // Not far beyond it: + the summary, which repeats every topic's schema (8 IDL texts, ~16 KiB).
     EXPECT_LE(size, options.rotate_size_bytes + 20480) << files[i];
   }
-  remove_rotated(base.path());
 }
 
 // A station that records for weeks: with keep_files only the newest files stay
 // on disk, complete, holding the end of the run; the counters list the deleted ones.
 TEST(LoggerNode, KeepsOnlyTheNewestRotatedFiles) {
   const TempFile base("test_logger_keep_files");
-  remove_rotated(base.path());
+  const RotatedFilesGuard rotated(base.path());
   LoggerOptions options = node_options(base.path());
   options.topics = {"pixyslam/odometry"};
   options.rotate_size_bytes = 65536;
@@ -725,13 +738,11 @@ TEST(LoggerNode, KeepsOnlyTheNewestRotatedFiles) {
   EXPECT_EQ(rotated_file_index(base.path(), c2.files.front().path),
             std::optional<std::size_t>(*rotated_file_index(base.path(), newest) + 1));
   EXPECT_EQ(std::filesystem::file_size(newest), newest_size);
-  for (const LoggedFile& f : c2.files) std::filesystem::remove(f.path);
-  for (const LoggedFile& f : c.files) std::filesystem::remove(f.path);
 }
 
 TEST(LoggerNode, RotatesByPeriod) {
   const TempFile base("test_logger_rotate_period");
-  remove_rotated(base.path());
+  const RotatedFilesGuard rotated(base.path());
   LoggerOptions options = node_options(base.path());
   options.topics = {"pixyslam/odometry"};
   options.rotate_period_s = 1.0;
@@ -757,7 +768,6 @@ TEST(LoggerNode, RotatesByPeriod) {
   EXPECT_GE(files.size(), 3u);
   EXPECT_LE(files.size(), 4u);
   expect_complete_rotation(files, c, 1, kCount);
-  remove_rotated(base.path());
 }
 
 // A full disk, simulated per file with RLIMIT_FSIZE (a write past the limit
@@ -767,6 +777,7 @@ TEST(LoggerNode, RotatesByPeriod) {
 // file every retry_period_s alternating with fallback_dir, and never stops.
 TEST(LoggerNode, WriteFailuresKeepTheFileAndRecordingGoesOnInANewOne) {
   const TempFile base("test_logger_full_disk");
+  const RotatedFilesGuard rotated(base.path());
   const std::filesystem::path fallback =
       std::filesystem::temp_directory_path() / ("test_logger_fallback_" + std::to_string(getpid()));
   std::filesystem::remove_all(fallback);
@@ -835,8 +846,8 @@ TEST(LoggerNode, WriteFailuresKeepTheFileAndRecordingGoesOnInANewOne) {
 // folder: the recording already there is kept, the next free name written.
 TEST(LoggerNode, AnExistingRecordingIsNeverOverwritten) {
   const TempFile base("test_logger_existing");
+  const RotatedFilesGuard rotated(base.path());
   const std::string first_restart = rotated_file_name(base.path(), 1);
-  std::filesystem::remove(first_restart);
   { std::ofstream(base.path()) << "earlier recording"; }
   {
     LoggerOptions options = node_options(base.path());
@@ -851,7 +862,6 @@ TEST(LoggerNode, AnExistingRecordingIsNeverOverwritten) {
   std::getline(kept, text);
   EXPECT_EQ(text, "earlier recording");
   EXPECT_TRUE(mcap::McapReader(first_restart).clean());
-  std::filesystem::remove(first_restart);
 }
 
 TEST(LoggerNode, BadTopicPatternIsAnError) {
