@@ -2,10 +2,11 @@
 // LandmarkObservation and the estimator's MapState in, OptimisedMap out, until
 // SIGINT/SIGTERM. Optional: the robot runs without it; it can run on another host.
 //   map_optimizer --config config/map_optimizer.yaml [--out-dir DIR] [--set KEY=VALUE ...] [--domain N]
-// --out-dir writes DIR/trajectory.csv (the final solution's keyframes) and
+// --out-dir writes DIR/trajectory.csv (every keyframe of the final solution,
+// and of each earlier problem as it ends: optimizer.max_keyframes) and
 // DIR/landmarks.csv at exit, in slam_offline's formats.
 #include <cstdio>
-#include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,25 +14,20 @@
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/eval/csv_io.h"
+#include "pixyslam/eval/trajectory_output.h"
 #include "pixyslam/map_optimizer_node/optimizer_node.h"
 
 namespace {
 
-void write_outputs(const std::string& dir, const pixyslam::msg::OptimisedMap& map) {
+// DIR/landmarks.csv: the last solution's landmarks.
+void write_landmarks(const std::string& dir, const pixyslam::msg::OptimisedMap& map) {
   using namespace pixyslam;
-  std::filesystem::create_directories(dir);
-  std::vector<eval::TimedPose> poses;
-  for (const msg::OptimisedKeyframe& k : map.keyframes()) {
-    poses.push_back({static_cast<double>(k.stamp_ns()) * 1e-9, k.pose().x_m(), k.pose().y_m(), k.pose().theta_rad()});
-  }
-  eval::write_trajectory_csv(dir + "/trajectory.csv", poses);
   std::vector<eval::LandmarkRow> rows;
   for (const msg::OptimisedLandmark& l : map.landmarks()) {
     rows.push_back({l.landmark_id(), l.x_m(), l.y_m(), l.cov_xx_m2(), l.cov_xy_m2(), l.cov_yy_m2()});
   }
   eval::write_landmarks_csv(dir + "/landmarks.csv", rows);
-  std::fprintf(stderr, "map_optimizer: wrote %s/trajectory.csv (%zu keyframes), %s/landmarks.csv (%zu)\n",
-               dir.c_str(), poses.size(), dir.c_str(), rows.size());
+  std::fprintf(stderr, "map_optimizer: wrote %s/landmarks.csv (%zu)\n", dir.c_str(), rows.size());
 }
 
 }  // namespace
@@ -46,7 +42,7 @@ int main(int argc, char** argv) {
   app::add_config(cli, config,
                   "config/map_optimizer.yaml: filter_config (the estimator's file: its noise, limits and start pose), "
                   "optimizer:, dds:");
-  cli.option("--out-dir", out_dir, "at exit, DIR/trajectory.csv (final keyframes) and DIR/landmarks.csv")
+  cli.option("--out-dir", out_dir, "DIR/trajectory.csv (every keyframe, solved; a segment's when it ends, the rest at exit) and at exit DIR/landmarks.csv")
       .type("DIR");
   std::vector<std::string> domain;
   app::add_set(cli, overrides, "optimizer.window_keyframes=50");
@@ -66,7 +62,15 @@ int main(int argc, char** argv) {
                  "every %.1f s; DDS domain %d, profiles '%s'\n",
                  options.optimizer.keyframe_interval_s, options.schedule.window_keyframes, options.schedule.window_period_s,
                  options.schedule.whole_period_s, options.dds.domain_id, options.dds.profiles_file.c_str());
+    // Before the node: its thread writes here until the node is destroyed.
+    std::optional<eval::TrajectoryOutput> trajectory;
     map_optimizer_node::OptimizerNode node(options);
+    if (!out_dir.empty()) {
+      trajectory.emplace(out_dir, "map_optimizer");  // a folder that cannot be written fails now, not at the end
+      node.set_keyframe_sink([&trajectory](std::uint64_t stamp_ns, const slam::Pose2& pose) {
+        trajectory->add(stamp_ns, pose.x(), pose.y(), pose.z());
+      });
+    }
     node.start();
     while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {
     }
@@ -75,7 +79,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "map_optimizer: %llu window and %llu whole-problem solves, CPU %.3f s (Ceres %.3f s)\n",
                  static_cast<unsigned long long>(c.window_solves), static_cast<unsigned long long>(c.whole_solves),
                  c.cpu_time_s, c.solve_time_s);
-    if (!out_dir.empty()) write_outputs(out_dir, node.latest_map());
+    if (trajectory) {
+      const std::size_t rows = trajectory->finish();
+      std::fprintf(stderr, "map_optimizer: wrote %s (%zu keyframes)\n", trajectory->path().c_str(), rows);
+      write_landmarks(out_dir, node.latest_map());
+    }
     return 0;
   });
 }

@@ -6,7 +6,6 @@
 // period and resumes from the file at start when it is fresh (a restart).
 // --out-dir writes DIR/trajectory.csv (the mean pose after every filter step, as it goes) and DIR/landmarks.csv at exit.
 #include <cstdio>
-#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,40 +16,9 @@
 #include "pixyslam/slam/slam_options.h"
 #include "pixyslam/slam_node/estimator_node.h"
 #include "pixyslam/eval/csv_io.h"
+#include "pixyslam/eval/trajectory_output.h"
 
 namespace {
-
-// DIR/trajectory.csv, written as the steps come (t in seconds of the stamps'
-// clock): a station that runs for days holds no trajectory in memory. A write
-// failure (disk full) is reported once; the filter goes on.
-class TrajectoryOutput {
- public:
-  explicit TrajectoryOutput(const std::string& dir) : writer_(prepare(dir) + "/trajectory.csv") {}
-
-  void add(std::uint64_t stamp_ns, const pixyslam::slam::Pose2& pose) {
-    if (failed_) return;
-    try {
-      writer_.append({static_cast<double>(stamp_ns) * 1e-9, pose.x(), pose.y(), pose.z()});
-    } catch (const std::exception& e) {
-      failed_ = true;
-      std::fprintf(stderr, "slam_estimator: ERROR: %s; the trajectory file ends here, the filter goes on\n", e.what());
-    }
-  }
-  // Flushes; the number of rows written.
-  std::size_t finish() {
-    if (!failed_) writer_.flush();
-    return writer_.rows();
-  }
-  const std::string& path() const { return writer_.path(); }
-
- private:
-  static std::string prepare(const std::string& dir) {
-    std::filesystem::create_directories(dir);
-    return dir;
-  }
-  pixyslam::eval::TrajectoryCsvWriter writer_;
-  bool failed_ = false;
-};
 
 // DIR/landmarks.csv: the last MapState's landmarks.
 void write_landmarks(const std::string& dir, const pixyslam::slam_node::EstimatorNode& node) {
@@ -103,12 +71,12 @@ int main(int argc, char** argv) {
     if (verbose) app::print_effective_configuration("slam_estimator", slam_node::to_yaml(options));
 
     // Before the node: its filter thread writes here until the node is destroyed.
-    std::optional<TrajectoryOutput> trajectory;
+    std::optional<eval::TrajectoryOutput> trajectory;
     slam_node::EstimatorNode node(options);
     if (!out_dir.empty()) {
-      trajectory.emplace(out_dir);  // a folder that cannot be written fails now, not at the end
+      trajectory.emplace(out_dir, "slam_estimator");  // a folder that cannot be written fails now, not at the end
       node.set_step_observer([&trajectory](std::uint64_t stamp_ns, const slam::Pose2& pose) {
-        trajectory->add(stamp_ns, pose);
+        trajectory->add(stamp_ns, pose.x(), pose.y(), pose.z());
       });
     }
     node.start();

@@ -173,6 +173,10 @@ TEST(OptimizerNode, AProblemAtItsKeyframeLimitStartsAnewWithItsLandmarksAsPriors
   options.initial_pose = run.initial_pose;
   options.max_keyframes = 150;  // 10 Hz frames: a new problem every ~15 s
   OptimizerNode node(options);
+  std::vector<eval::TimedPose> emitted;  // what map_optimizer --out-dir writes
+  node.set_keyframe_sink([&](std::uint64_t stamp_ns, const slam::Pose2& pose) {
+    emitted.push_back({static_cast<double>(stamp_ns - base_ns) * 1e-9, pose.x(), pose.y(), pose.z()});
+  });
   node.start();
   dds::Participant sensors(options.dds, "test_sensors");
   dds::Writer<msg::Odometry> odometry_writer(sensors);
@@ -206,6 +210,14 @@ TEST(OptimizerNode, AProblemAtItsKeyframeLimitStartsAnewWithItsLandmarksAsPriors
                          k.pose().theta_rad()});
   }
   EXPECT_LT(eval::compare_trajectory(keyframes, run.truth).ate_rmse_m, 0.15);
+
+  // The sink got every problem's keyframes, once, in time order: the whole run.
+  ASSERT_FALSE(emitted.empty());
+  EXPECT_GE(emitted.size(), c.segments * (options.max_keyframes - 1) + last.keyframe_count() - 1);
+  for (std::size_t i = 1; i < emitted.size(); ++i) ASSERT_LT(emitted[i - 1].t_s, emitted[i].t_s) << i;
+  EXPECT_LT(emitted.front().t_s, run.odometry.front().t_s + 1.0);
+  EXPECT_NEAR(emitted.back().t_s, keyframes.back().t_s, 1e-6);
+  EXPECT_LT(eval::compare_trajectory(emitted, run.truth).ate_rmse_m, 0.15);
 }
 
 // Any participant can send any bytes: what does not decode is counted and dropped.

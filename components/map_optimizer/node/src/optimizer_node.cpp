@@ -137,6 +137,7 @@ void OptimizerNode::loop() {
       std::lock_guard<std::mutex> state_lock(state_mutex_);
       collect_whole(true);
       if (optimizer_ && dirty_) solve(true);
+      if (optimizer_) emit_keyframes();
     }
     if (options_.status_period_s > 0.0 && Clock::now() >= next_status) {
       log_status();
@@ -212,6 +213,7 @@ void OptimizerNode::step(const slam::SensorInput& input) {
 void OptimizerNode::start_segment(const slam::OdometrySample& odometry) {
   collect_whole(true);
   solve(true);  // a last whole solve, with covariances, published
+  emit_keyframes();
   const slam::Pose2 pose = optimizer_->current_pose();
   const std::vector<map_optimizer::LandmarkSolution> landmarks = optimizer_->landmarks();
   const std::size_t keyframes = optimizer_->keyframes().size();
@@ -239,6 +241,16 @@ void OptimizerNode::start_segment(const slam::OdometrySample& odometry) {
                "map_optimizer: %zu keyframes (optimizer.max_keyframes): a new problem from the current pose, %zu of %zu "
                "landmarks as priors\n",
                keyframes, priors, landmarks.size());
+}
+
+void OptimizerNode::emit_keyframes() {
+  if (!keyframe_sink_) return;
+  for (const map_optimizer::Keyframe& k : optimizer_->keyframes()) {
+    const std::uint64_t stamp = slam_node::to_stamp_ns(k.t_s, epoch_ns_);
+    if (last_emitted_ns_ && stamp <= *last_emitted_ns_) continue;
+    keyframe_sink_(stamp, k.pose);
+    last_emitted_ns_ = stamp;
+  }
 }
 
 map_optimizer::OptimizerCounters OptimizerNode::optimizer_counters() const {

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <future>
 #include <memory>
 #include <mutex>
@@ -95,7 +96,14 @@ class OptimizerNode {
   void stop();
 
   OptimizerNodeCounters counters() const;
+  // The last published map: its keyframes thinned to published_keyframes.
   msg::OptimisedMap latest_map() const;
+
+  // Every keyframe of a finished problem, in time order, once, on the node's
+  // thread: those of a segment when the next begins (max_keyframes), the last
+  // problem's at stop() after its final solve. Set before start().
+  using KeyframeSink = std::function<void(std::uint64_t stamp_ns, const slam::Pose2& pose)>;
+  void set_keyframe_sink(KeyframeSink sink) { keyframe_sink_ = std::move(sink); }
 
  private:
   void on_map_state(const msg::MapState& m);
@@ -108,6 +116,9 @@ class OptimizerNode {
   // At max_keyframes: the whole problem solved and published a last time, then
   // a new one from the current pose at `odometry`'s time, the landmarks as priors.
   void start_segment(const slam::OdometrySample& odometry);
+  // The current problem's keyframes after the last emitted to the sink (a new
+  // problem begins with a keyframe at the time the last one ended).
+  void emit_keyframes();
   // The core's counters over every segment.
   map_optimizer::OptimizerCounters optimizer_counters() const;
   void publish(const map_optimizer::SolveSummary& s, bool whole);
@@ -135,6 +146,8 @@ class OptimizerNode {
   // Loop state (read by others under state_mutex_).
   mutable std::mutex state_mutex_;
   std::unique_ptr<map_optimizer::MapOptimizer> optimizer_;
+  KeyframeSink keyframe_sink_;
+  std::optional<std::uint64_t> last_emitted_ns_;
   map_optimizer::OptimizerCounters earlier_segments_;  // the counters of the problems before optimizer_
   std::uint64_t epoch_ns_ = 0;  // the inbox's, from the first input on
   double last_t_s_ = 0.0;
