@@ -170,5 +170,29 @@ TEST(FuseMaps, BrokenCovariancesAreSkippedAndBadInputRefused) {
   EXPECT_TRUE(fuse_maps({}).landmarks.empty());
 }
 
+// What no estimator of a real map sends (a hostile or broken participant):
+// far-off positions, vanishing or enormous variances. Each is skipped; the
+// fused map of the honest robots stays where it is, finite.
+TEST(FuseMaps, ImplausibleLandmarksAreSkippedAndCannotSpoilTheFusion) {
+  std::mt19937 prng(5);
+  const std::vector<Eigen::Vector3d> truth = truth_grid();
+  const RobotMap a = noisy_map("robot1", truth, 0.05, prng);
+  const RobotMap b = noisy_map("robot2", truth, 0.05, prng);
+  const double honest = rmse(fuse_maps({a, b}), truth);
+  for (const auto& [x, sigma] : std::vector<std::pair<double, double>>{{1e200, 1e-75}, {1e300, 1.0}, {1e7, 0.1},
+                                                                         {3.0, 1e-9}, {3.0, 1e4}}) {
+    RobotMap hostile{"intruder", 0, {}};
+    for (const Eigen::Vector3d& t : truth) hostile.landmarks.push_back(landmark(static_cast<int>(t.x()), t.y(), t.z(), 0.05));
+    hostile.landmarks.push_back(landmark(static_cast<int>(truth.front().x()), x, 0.0, sigma));
+    hostile.landmarks.erase(hostile.landmarks.begin());  // the implausible one instead of the first
+    const FleetMap f = fuse_maps({a, b, hostile});
+    for (const FusedLandmark& l : f.landmarks) {
+      EXPECT_TRUE(l.mean.allFinite()) << x << " " << sigma;
+      EXPECT_LT(l.mean.norm(), 100.0) << x << " " << sigma;
+    }
+    EXPECT_LT(rmse(f, truth), 2.0 * honest + 0.05) << x << " " << sigma;
+  }
+}
+
 }  // namespace
 }  // namespace pixyslam::fleet_map

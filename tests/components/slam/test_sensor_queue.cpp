@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <random>
 #include <variant>
 #include <vector>
@@ -43,6 +44,20 @@ TEST(SensorQueue, FrameWaitsForTheOdometryThatCoversIt) {
   ASSERT_EQ(out.size(), 2u);
   EXPECT_DOUBLE_EQ(stamp_of(out[0]), 10.1);
   EXPECT_DOUBLE_EQ(stamp_of(out[1]), 10.15);
+}
+
+// A period from the wire that is infinite or absurd does not make the
+// odometry known far ahead: a frame still waits for the odometry covering it.
+TEST(SensorQueue, AnInfiniteOrHugeOdometryPeriodDoesNotReleaseFramesEarly) {
+  for (const double period : {std::numeric_limits<double>::infinity(), 1e300,
+                              std::numeric_limits<double>::quiet_NaN(), -1.0}) {
+    SensorQueue queue(SensorQueueOptions{});
+    queue.push(odometry(10.0, period), 10.0);
+    queue.push(frame(30.0), 10.01);  // 20 s on: beyond max_stamp_jump_s (10 s) of odometry
+    const std::vector<SensorInput> out = queue.pop_ready(10.02);
+    ASSERT_EQ(out.size(), 1u) << period;
+    EXPECT_TRUE(std::holds_alternative<OdometryInput>(out[0])) << period;
+  }
 }
 
 // One stamp a year ahead (a hostile sender, a clock set wrong) is held and

@@ -6,6 +6,7 @@
 #include <set>
 #include <stdexcept>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
@@ -71,10 +72,20 @@ double f_quantile(double probability, int d1, int d2) {
 
 namespace {
 
+// Positions and variances no estimator of a real map makes: within 1000 km of
+// the origin, standard deviations from 1 um to 1 km. Anything beyond (a hostile
+// or broken sender) would swamp the fusion: 1e200 m with a tiny covariance
+// makes every fused landmark NaN, and the maps are kept while the robot is.
+constexpr double kMaxCoordinate = 1e6;       // m
+constexpr double kMinVariance = 1e-12;       // m^2
+constexpr double kMaxVariance = 1e6;         // m^2
+
 bool usable(const LandmarkEstimate& l) {
   if (!l.mean.allFinite() || !l.cov.allFinite()) return false;
+  if (l.mean.cwiseAbs().maxCoeff() > kMaxCoordinate) return false;
   if (std::abs(l.cov(0, 1) - l.cov(1, 0)) > 1e-9 * (std::abs(l.cov(0, 0)) + std::abs(l.cov(1, 1)))) return false;
-  return l.cov(0, 0) > 0.0 && l.cov.determinant() > 0.0;
+  const Eigen::Vector2d variances = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(l.cov).eigenvalues();
+  return variances.minCoeff() >= kMinVariance && variances.maxCoeff() <= kMaxVariance;
 }
 
 // Information-form sums of one landmark.

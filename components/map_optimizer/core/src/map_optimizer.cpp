@@ -227,6 +227,8 @@ MapOptimizerOptions MapOptimizerOptions::from_filter(const slam::FilterOptions& 
   MapOptimizerOptions o;
   o.motion = filter.motion;
   o.control_timeout_s = filter.control_timeout_s;
+  o.max_speed_mps = filter.max_speed_mps;
+  o.max_turn_rate_radps = filter.max_turn_rate_radps;
   o.range_sigma_m = filter.range_sigma_m;
   o.range_sigma_per_m = filter.range_sigma_per_m;
   o.bearing_sigma_rad = filter.bearing_sigma_rad;
@@ -371,7 +373,8 @@ void MapOptimizer::close_keyframe(double t_s, const std::optional<slam::Pose2>& 
 
 void MapOptimizer::add_odometry(const slam::OdometrySample& sample) {
   if (!std::isfinite(sample.t_s) || sample.t_s < last_time_s_ ||
-      (sample.measured && (!std::isfinite(sample.v_mps) || !std::isfinite(sample.w_radps)))) {
+      (sample.measured && !(std::abs(sample.v_mps) <= options_.max_speed_mps &&
+                            std::abs(sample.w_radps) <= options_.max_turn_rate_radps))) {
     ++counters_.odometry_dropped;
     return;
   }

@@ -1,6 +1,7 @@
 #include "pixyslam/slam/sensor_queue.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace pixyslam::slam {
@@ -39,7 +40,13 @@ bool SensorQueue::push(const OdometryInput& odometry, double arrival_s) {
   if (!admit()) return false;
   ++counters_.odometry_in;
   odometry_arrival_s_ = std::max(odometry_arrival_s_, arrival_s);
-  const double end = stamp(odometry) + std::max(0.0, odometry.period_s);
+  // A period from the wire that is not finite or longer than a stamp may jump
+  // (max_stamp_jump_s; the encoder bridge's longest is 10 s) would make the stream
+  // known far ahead and release frames before the odometry that covers them.
+  const double period = std::isfinite(odometry.period_s)
+                            ? std::clamp(odometry.period_s, 0.0, options_.max_stamp_jump_s)
+                            : 0.0;
+  const double end = stamp(odometry) + period;
   note_arrival(end, arrival_s, options_.odometry_max_delay_s);
   odometry_known_until_s_ = has_odometry_ ? std::max(odometry_known_until_s_, end) : end;
   has_odometry_ = true;

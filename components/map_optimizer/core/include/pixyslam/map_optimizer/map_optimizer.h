@@ -57,6 +57,10 @@ namespace pixyslam::map_optimizer {
 struct MapOptimizerOptions {
   slam::MotionNoise motion;
   double control_timeout_s = 5.0;
+  // Odometry beyond these is dropped (counted), as the filter does: one sample
+  // with a huge speed would overflow the motion noise of every later solve.
+  double max_speed_mps = 10.0;
+  double max_turn_rate_radps = 20.0;
   double range_sigma_m = 0.07;
   double range_sigma_per_m = 0.0;
   double bearing_sigma_rad = 0.027;
