@@ -49,7 +49,7 @@ const parameters::Table<DdsOptions>& dds_parameters() {
     P::Table<O> t = {
         P::integer<O, int>("domain_id", 0, 232, "", "DDS domain: processes meet only on the same one",
                            [](O& o) -> int& { return o.domain_id; }),
-        P::text<O>("profiles_file", "Fast DDS XML profiles (relative: to the YAML file's folder)",
+        P::text<O>("profiles_file", "Fast DDS XML profiles (relative: to the YAML file's folder; none: the checkout's, or the installed, config/dds/profiles.xml)",
                    [](O& o) -> std::string& { return o.profiles_file; }),
         P::text<O>("participant_profile", "loopback | lan_multicast | lan_peers | discovery_client | secure",
                    [](O& o) -> std::string& { return o.participant_profile; },
@@ -136,13 +136,17 @@ DdsOptions read_dds_options(config::YamlReader& reader, const std::string& confi
   DdsOptions o;
   config::read_parameters(reader, dds_parameters(), o);
   reader.finish();
-  o.profiles_file = resolve(o.profiles_file, config_dir);
+  o.profiles_file = o.profiles_file.empty() ? default_profiles_file() : resolve(o.profiles_file, config_dir);
   o.security_dir = resolve(o.security_dir, config_dir);
   return o;
 }
 
 DdsOptions read_dds_section(config::YamlReader& root, const std::string& config_dir, const DdsOptions& fallback) {
-  if (!root.has("dds")) return fallback;
+  if (!root.has("dds")) {
+    DdsOptions o = fallback;
+    if (o.profiles_file.empty()) o.profiles_file = default_profiles_file();
+    return o;
+  }
   config::YamlReader dds = root.child("dds");
   return read_dds_options(dds, config_dir);
 }

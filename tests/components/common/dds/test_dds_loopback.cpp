@@ -2,6 +2,7 @@
 // message arrives, in order, with the header filled by the writer.
 #include <chrono>
 #include <condition_variable>
+#include <filesystem>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -228,6 +229,17 @@ TEST(DdsOptions, ReadsKeysAndResolvesTheProfilesPath) {
   EXPECT_EQ(o.domain_id, 7);
   EXPECT_EQ(o.profiles_file, "/etc/pixyslam/dds/profiles.xml");
   EXPECT_EQ(o.robot_id, "r2");
+}
+
+// A user's own YAML without the key (or without `dds:`) gets the profiles
+// every shipped config names, not a participant that fails for want of one.
+TEST(DdsOptions, WithoutAProfilesFileTheDefaultOneIsUsed) {
+  auto reader = config::YamlReader::from_string("dds:\n  domain_id: 7\n", "test.yaml");
+  auto dds = reader.child("dds");
+  EXPECT_EQ(read_dds_options(dds, "/etc/pixyslam").profiles_file, default_profiles_file());
+  auto root = config::YamlReader::from_string("other: 1\n", "test.yaml");
+  EXPECT_EQ(read_dds_section(root, "/etc/pixyslam").profiles_file, default_profiles_file());
+  EXPECT_TRUE(std::filesystem::exists(default_profiles_file()));
 }
 
 TEST(DdsOptions, OutOfRangeDomainNamesTheKey) {

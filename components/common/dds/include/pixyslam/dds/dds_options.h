@@ -53,11 +53,12 @@ const parameters::Table<DdsOptions>& dds_parameters();
 bool announces_identity(const DdsOptions& options, bool secure);
 
 // Reads a `dds:` mapping (all keys optional) and calls reader.finish().
-// `config_dir` resolves a relative profiles_file and security_dir. Throws config::ConfigError.
+// `config_dir` resolves a relative profiles_file and security_dir; without a
+// profiles_file, default_profiles_file(). Throws config::ConfigError.
 DdsOptions read_dds_options(config::YamlReader& reader, const std::string& config_dir);
 
 // The optional `dds:` mapping of a config file's `root` (read_dds_options), or
-// `fallback` when the file has none.
+// `fallback` when the file has none (its profiles_file, if empty, default_profiles_file()).
 DdsOptions read_dds_section(config::YamlReader& root, const std::string& config_dir, const DdsOptions& fallback = {});
 
 // The profiles file a tool uses without --config: for a program in its build
