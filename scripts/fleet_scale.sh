@@ -5,7 +5,7 @@
 # multicast: no traffic leaves it; root needed), with simple multicast
 # discovery or through a `fastdds discovery` server. The bridges' devices do not
 # exist (they retry), so what flows is discovery and the 1 Hz diagnostics.
-# With --sim, once every reader matched, a robot_sim per robot (world.seed =
+# With --sim, once every reader matched, a robot_sim per robot (hardware.seed =
 # the robot's number, ground truth on DDS: 4N participants) drives SETTLE_S
 # simulated seconds in real time (measured from 10 s after they started):
 # then the sensor data flows too, and each
@@ -109,7 +109,7 @@ if ((sim)); then
   for r in $(seq "$n"); do
     ip netns exec "$ns" env "${env_common[@]}" "$bin/robot_sim" --config "$root/config/robot_sim.yaml" \
       --duration $((warmup_s + settle + 60)) --arduino-link "$work/arduino$r" --pixy-link "$work/pixy$r" \
-      --set "world.seed=$r" --set "dds.robot_id=robot$r" > "$work/sim$r.log" 2>&1 &
+      --set "hardware.seed=$r" --set "dds.robot_id=robot$r" > "$work/sim$r.log" 2>&1 &
     pids+=($!); kind_of[$!]=robot_sim; sims+=($!)
   done
   sleep "$warmup_s"

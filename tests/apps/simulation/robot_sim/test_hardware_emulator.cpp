@@ -602,6 +602,15 @@ TEST(RobotSimConfig, ShippedFilesLoadAndShareOneTruth) {
     load_robot_sim_config(dir + "/pixy_bridge.yaml", dir + "/pixy_bridge.yaml", dir + "/encoder_bridge.yaml");
   });
   EXPECT_NE(err.find("world"), std::string::npos) << err;
+  // The emulator makes its own sensor noise (hardware:): a world key of the
+  // offline simulator's sensors would do nothing here, so it is refused.
+  for (const char* key : {"seed: 3", "camera_rate_hz: 30", "range_sigma_m: 0.1", "duration_s: 60"}) {
+    config::YamlReader root = config::YamlReader::from_string(std::string("world:\n  ") + key + "\nhardware: {}\n",
+                                                              "sim.yaml");
+    const std::string e = error_of(
+        [&] { read_robot_sim_config(root, dir + "/pixy_bridge.yaml", dir + "/encoder_bridge.yaml"); });
+    EXPECT_NE(e.find(std::string(key).substr(0, std::string(key).find(':'))), std::string::npos) << e;
+  }
 }
 
 }  // namespace

@@ -21,7 +21,7 @@ RobotSimConfig read_robot_sim_config(config::YamlReader& sim_root, const std::st
   RobotSimConfig c;
   {
     config::YamlReader world = sim_root.child("world");
-    c.world = sim::read_world_options(world);
+    c.world = sim::read_world_options(world, sim::world_layout_parameters());
     config::YamlReader hardware = sim_root.child("hardware");
     c.hardware = read_hardware_options(hardware);
   }

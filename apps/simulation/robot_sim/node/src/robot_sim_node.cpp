@@ -79,7 +79,7 @@ RobotSimProcessConfig read_robot_sim_process_config(const std::string& sim_yaml,
 void apply_overrides(RobotSimProcessConfig& c, const std::vector<std::string>& assignments) {
   std::vector<std::string> rest = assignments;
   for (const std::string& a : parameters::take_section(rest, "world")) {
-    parameters::apply_override(c.sim.world, sim::world_parameters(), "world", a);
+    parameters::apply_override(c.sim.world, sim::world_layout_parameters(), "world", a);
   }
   sim::validate(c.sim.world);
   for (const std::string& a : parameters::take_section(rest, "hardware")) {
@@ -94,7 +94,8 @@ void apply_overrides(RobotSimProcessConfig& c, const std::vector<std::string>& a
 }
 
 std::string help_text() {
-  return "world (world:):\n" + parameters::help_text(sim::world_parameters(), "world") +
+  return "world (world:; the path and poles, and also path:, poles:, initial_pose: lists as in slam_sim.yaml):\n" +
+         parameters::help_text(sim::world_layout_parameters(), "world") +
          "hardware (hardware:):\n" + parameters::help_text(hardware_parameters(), "hardware") +
          "the process (run:):\n" + parameters::help_text(run_parameters(), "run") +
          "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <random>
+#include <set>
+#include <string>
 
 #include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/slam/motion_model.h"
@@ -57,6 +59,20 @@ const parameters::Table<WorldOptions>& world_parameters() {
   return table;
 }
 
+const parameters::Table<WorldOptions>& world_layout_parameters() {
+  static const parameters::Table<WorldOptions> table = [] {
+    const std::set<std::string> layout = {"length_m",      "width_m",           "corner_radius_m",
+                                          "speed_mps",     "poles_per_long_side", "poles_per_short_side",
+                                          "pole_offset_m", "inner_poles",       "first_landmark_id"};
+    parameters::Table<WorldOptions> t;
+    for (const auto& p : world_parameters()) {
+      if (layout.count(p.path) != 0) t.push_back(p);
+    }
+    return t;
+  }();
+  return table;
+}
+
 void validate(const WorldOptions& o) {
   parameters::check_ranges(o, world_parameters(), "world");
   if (o.max_range_m <= o.min_range_m) {
@@ -64,9 +80,9 @@ void validate(const WorldOptions& o) {
   }
 }
 
-WorldOptions read_world_options(config::YamlReader& w) {
+WorldOptions read_world_options(config::YamlReader& w, const parameters::Table<WorldOptions>& table) {
   WorldOptions o;
-  config::read_parameters(w, world_parameters(), o);
+  config::read_parameters(w, table, o);
   config::check_rules(w, [&] { validate(o); });
   if (w.has("path")) {
     for (config::YamlReader& leg : w.mapping_list("path")) {

@@ -75,11 +75,17 @@ struct WorldOptions {
 // The scalar keys of `world:` (path, poles and initial_pose are lists and a
 // mapping, read by read_world_options).
 const parameters::Table<WorldOptions>& world_parameters();
+// Of those, the ones that lay out the world (the path and the poles), without
+// the sensors, seed and duration of simulate(): what robot_sim, which emulates
+// the sensors itself (its hardware: keys), takes.
+const parameters::Table<WorldOptions>& world_layout_parameters();
 // Ranges and rules (max_range_m > min_range_m); std::invalid_argument naming the key.
 void validate(const WorldOptions& options);
 
-// Reads a `world:` mapping; unknown keys and bad values throw config::ConfigError.
-WorldOptions read_world_options(config::YamlReader& world);
+// Reads a `world:` mapping with the keys of `table`; unknown keys and bad
+// values throw config::ConfigError.
+WorldOptions read_world_options(config::YamlReader& world,
+                                const parameters::Table<WorldOptions>& table = world_parameters());
 
 struct WorldRun {
   slam::Pose2 initial_pose = slam::Pose2::Zero();
