@@ -24,7 +24,7 @@ while [[ $# -gt 0 ]]; do
 done
 if [[ ${#names[@]} -eq 0 ]]; then
   names=(encoder_bridge pixy_bridge slam_estimator map_optimizer logger robot_sim sim_evaluator map_view
-         pixyslam_play pixyslam_spy pixyslam_launch)
+         pixyslam_play pixyslam_spy pixyslam_launch foxglove_bridge fleet_map dataset_bridge)
 fi
 [[ $domains =~ ^([0-9]+)-([0-9]+)$ ]] || { echo "--domains must be MIN-MAX, got '$domains'" >&2; exit 2; }
 domain_min=${BASH_REMATCH[1]} domain_max=${BASH_REMATCH[2]}

@@ -12,13 +12,16 @@ cat <<'TEXT'
 
 What each program prints for `--help` (exit 0, nothing started: ctest `help_all_executables` checks
 that for every executable of the build, and that an unknown flag exits 2). Exit codes everywhere:
-0 ok, 1 runtime failure (or a check that failed: `sim_evaluator`, `mrclam_eval`, `paper_experiments
---check`, `pixyslam_spy check`), 2 usage or configuration error;
-the evaluations and benchmarks on the MRCLAM data set (`mrclam_eval`, `bench_mrclam_frame`,
-`bench_map_optimizer`) exit 77 when it is absent (skipped), `slam_offline mrclam` 1.
+0 ok; 1 runtime failure, also an input (a recording, a data set) that is missing or does not
+read, or a check that failed (`sim_evaluator`, `mrclam_eval`, `paper_experiments --check`,
+`pixyslam_spy check`); 2 usage or configuration error (a bad flag or value, a config file that is
+missing or wrong); the evaluations and benchmarks on the MRCLAM data set (`mrclam_eval`,
+`bench_mrclam_frame`, `bench_map_optimizer`) exit 77 when it is absent (skipped).
 Flags mean the same everywhere: `--config FILE` (the process's YAML; for the inspection tools one
 with a `dds:` mapping), `--domain N`, `--set KEY=VALUE` (a parameter of the config, listed under
-`--help`), `--out FILE`, `--out-dir DIR`, `--duration S`, `--json`, `--verbose`, `--rate R` (a
+`--help`), `--out FILE`, `--out-dir DIR`, `--duration S` (how long: wall seconds for a live tool,
+recorded or simulated seconds for one that plays or simulates: `pixyslam_play`, `dataset_bridge`,
+`robot_sim`, `slam_offline`), `--json`, `--verbose`, `--rate R` (a
 speed factor: recorded seconds per wall or video second), `--rate-hz HZ` (messages per second),
 `--robot N` (an MRCLAM robot number), `--robot-id ID` (a `dds.robot_id`).
 `pixyslam_log` is `pixyslam_spy` under its old name. Regenerate with

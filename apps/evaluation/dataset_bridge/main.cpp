@@ -57,17 +57,15 @@ int main(int argc, char** argv) {
     if (rate >= 0.0) overrides.push_back("dataset_bridge.rate=" + std::to_string(rate));
     overrides.insert(overrides.end(), domain.begin(), domain.end());  // --domain last: it wins
     dataset_bridge_node::apply_overrides(options, overrides);
-    for (int r : options.robots) {
-      try {
-        streams.push_back(dataset_bridge::make_robot_stream(mrclam::load_robot(dataset, r), options.sensor_model));
-        dataset_bridge::keep_first_seconds(streams.back(), duration_s);
-      } catch (const std::runtime_error& e) {
-        throw std::invalid_argument(e.what());  // a data set that does not read is the user's input
-      }
-    }
   });
   if (bad) return *bad;
   return app::run_main("dataset_bridge", [&] {
+    // An input that is missing or does not read is a runtime failure (1), as in
+    // slam_offline, pixyslam_calibrate and pixyslam_spy.
+    for (int r : options.robots) {
+      streams.push_back(dataset_bridge::make_robot_stream(mrclam::load_robot(dataset, r), options.sensor_model));
+      dataset_bridge::keep_first_seconds(streams.back(), duration_s);
+    }
     for (const dataset_bridge::RobotStream& s : streams) {
       std::fprintf(stderr, "dataset_bridge: %s: %zu odometry, %zu frames, %zu ground truth, %zu robot sightings\n",
                    s.robot_id.c_str(), s.input.odometry.size(), s.input.frames.size(), s.input.truth.size(),

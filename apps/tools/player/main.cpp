@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
   std::string topics;
   bool quiet = false;
   app::Cli cli{"pixyslam_play", "Replays MCAP logs written by the logger onto DDS, with the recorded timing."};
-  cli.option("logs", o.files, "the MCAP files, played in the order given (a rotated log: LOG_000.mcap LOG_001.mcap ...)")
+  cli.option("logs", o.files, "the MCAP files, merged by log time (a rotated log: LOG_000.mcap LOG_001.mcap ..., in any order)")
       .required()
       .input_file()
       .type("LOG.mcap");
