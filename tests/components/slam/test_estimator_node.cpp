@@ -465,6 +465,8 @@ TEST(EstimatorNode, MalformedSamplesAreCountedAndTheFilterGoesOn) {
   EXPECT_GE(c.steps, 5u);
 }
 
+constexpr std::uint64_t kYearNs = 365ull * 86400ull * 1000000000ull;
+
 // Samples that decode fine but are stamped years ahead (a hostile sender, a
 // clock set wrong), the first two before any real one: dropped and counted,
 // and neither the filter's clock nor its time are taken from them.
@@ -475,7 +477,7 @@ TEST(EstimatorNode, SamplesStampedYearsAheadAreDroppedAndTheFilterGoesOn) {
   SensorWriters sensors(options.dds);
   ASSERT_TRUE(sensors.matched());
   const std::uint64_t base_ns = dds::now_ns();
-  const std::uint64_t year_ns = 365ull * 86400ull * 1000000000ull;
+  const std::uint64_t year_ns = kYearNs;
   slam::OdometrySample s;
   s.v_mps = 0.1;
   msg::Odometry ahead_odometry = test_support::odometry_msg(s, 0.1, base_ns + year_ns);
@@ -502,6 +504,47 @@ TEST(EstimatorNode, SamplesStampedYearsAheadAreDroppedAndTheFilterGoesOn) {
   const std::uint64_t last = node.latest_map_state().header().stamp_ns();
   EXPECT_GE(last, base_ns);
   EXPECT_LE(last, base_ns + 2'000'000'000ull);
+}
+
+// A consistent pair stamped a year ahead (a hostile sender copying the robot's
+// id; a clock that then steps back) moves the time, and every real sample
+// after it would be late for good: once only such samples came for a second,
+// the time goes back to theirs and the filter goes on from its estimate.
+TEST(EstimatorNode, AHostilePairOfFutureStampsDoesNotStopTheFilterForGood) {
+  EstimatorOptions options = test_options();
+  EstimatorNode node(options);
+  node.start();
+  SensorWriters sensors(options.dds);
+  ASSERT_TRUE(sensors.matched());
+  slam::OdometrySample s;
+  s.v_mps = 0.2;
+  const std::uint64_t base_ns = dds::now_ns();
+  const auto publish_at = [&](double t_s) {
+    s.t_s = t_s;
+    msg::Odometry m = test_support::odometry_msg(s, 0.1, to_stamp_ns(t_s, base_ns));
+    ASSERT_TRUE(sensors.odometry.publish(m));
+  };
+  for (int i = 0; i < 5; ++i) publish_at(0.1 * i);
+  for (int i = 0; i < 2; ++i) {
+    msg::Odometry m = test_support::odometry_msg(s, 0.1, base_ns + kYearNs + 100'000'000ull * i);
+    ASSERT_TRUE(sensors.odometry.publish(m));
+  }
+  // Then the robot's own odometry, paced: 3 s at 10 Hz.
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 5; i < 35; ++i) {
+    std::this_thread::sleep_until(start + std::chrono::milliseconds(100 * (i - 5)));
+    publish_at(0.1 * i);
+  }
+  ASSERT_TRUE(sensors.odometry.wait_for_acknowledgments(std::chrono::seconds(10)));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  node.stop();
+  const EstimatorCounters c = node.counters();
+  EXPECT_EQ(c.time_rebases, 1u);
+  const msg::MapState last = node.latest_map_state();
+  EXPECT_GE(last.header().stamp_ns(), base_ns + 2'000'000'000ull);  // the real time, and it went on
+  EXPECT_LE(last.header().stamp_ns(), base_ns + 4'000'000'000ull);
+  // It drove on after the rebase: 0.2 m/s for most of the 3 s.
+  EXPECT_GT(last.mean_pose().x_m(), 0.3) << last.mean_pose().x_m();
 }
 
 // The start pose from the ground truth: a GroundTruth that is not a pose (NaN)

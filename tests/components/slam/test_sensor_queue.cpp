@@ -91,6 +91,46 @@ TEST(StampGate, AJumpGoesOnOnlyWhenItsStreamsNextSampleConfirmsIt) {
   EXPECT_EQ(gate.dropped(), 4u);
 }
 
+// Two consistent samples a year ahead (a hostile pair, or a clock that then
+// steps back) move the time; the samples that follow at the real time do not
+// stop it for good: after max_hold of nothing but such samples (three at
+// least) the time goes back to theirs. A backlog older than the jump while
+// current samples still come does not.
+TEST(StampGate, TheTimeGoesBackWhenOnlySamplesFarBehindItKeepComing) {
+  const std::uint64_t s = 1'000'000'000ull;
+  const std::uint64_t year = 365ull * 86400ull * s;
+  StampGate<int> gate(2, 10.0, 1.0);
+  EXPECT_TRUE(gate.offer(1, 0, 100 * s, 0).empty());
+  EXPECT_EQ(gate.offer(2, 0, 100 * s + s / 10, s / 10), (std::vector<int>{1, 2}));
+  EXPECT_TRUE(gate.offer(3, 1, 100 * s + year, s / 5).empty());
+  EXPECT_EQ(gate.offer(4, 1, 100 * s + year + s / 10, s / 5 + 1), (std::vector<int>{3, 4}));  // the pair moves it
+  // A backlog from long ago, with current samples between: no rebase.
+  for (int i = 0; i < 30; ++i) {
+    const std::uint64_t arrival = s + static_cast<std::uint64_t>(i) * s / 10;
+    gate.offer(100 + i, 0, 50 * s + static_cast<std::uint64_t>(i) * s / 10, arrival);
+    if (i % 5 == 0 || i == 29) gate.offer(200 + i, 1, 100 * s + year + s + static_cast<std::uint64_t>(i) * s / 10, arrival + 1);
+  }
+  EXPECT_FALSE(gate.take_rebased());
+  // Now only the real time comes (the pair's sender has stopped).
+  bool rebased = false;
+  std::uint64_t arrival = 5 * s;
+  for (int i = 0; i < 15 && !rebased; ++i) {
+    arrival += s / 10;
+    const std::vector<int> out = gate.offer(300 + i, i % 2, 103 * s + static_cast<std::uint64_t>(i) * s / 10, arrival);
+    rebased = gate.take_rebased();
+    if (rebased) {
+      EXPECT_EQ(out, (std::vector<int>{300 + i}));
+      EXPECT_GE(arrival - 5 * s, s);  // after max_hold of them
+    }
+  }
+  ASSERT_TRUE(rebased);
+  EXPECT_EQ(gate.rebases(), 1u);
+  // At the real time again: its samples go on, a stamp a year ahead is held again.
+  EXPECT_EQ(gate.offer(400, 0, 105 * s, arrival + 1), (std::vector<int>{400}));
+  EXPECT_TRUE(gate.offer(401, 1, 105 * s + year, arrival + 2).empty());
+  EXPECT_FALSE(gate.take_rebased());
+}
+
 TEST(StampGate, AFirstSampleFromAWrongClockDoesNotSetTheTime) {
   const std::uint64_t s = 1'000'000'000ull;
   StampGate<int> gate(2, 10.0);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <ctime>
 #include <future>
+#include <limits>
 
 #include "pixyslam/slam_node/map_state_conversions.h"
 
@@ -131,6 +132,7 @@ void OptimizerNode::loop() {
   for (;;) {
     const slam_node::SensorInbox::Ready ready = inbox_.wait_ready();
     const bool stopping = ready.stopping;
+    if (ready.rebased) restart_at_new_time();
     slam_node::step_each(ready.inputs, [this](const slam::SensorInput& input) { step(input); }, "map_optimizer",
                          state_mutex_, counters_.step_errors);
     if (stopping) {
@@ -151,7 +153,9 @@ void OptimizerNode::loop() {
 void OptimizerNode::step(const slam::SensorInput& input) {
   std::lock_guard<std::mutex> lock(state_mutex_);
   const double t = slam::input_time(input);
-  if (!optimizer_) {
+  if (!optimizer_ && counters_.segments > 0) {
+    begin_problem(t);  // after a rebase: the last problem's pose and landmarks at the new time
+  } else if (!optimizer_) {
     epoch_ns_ = inbox_.epoch_ns();
     optimizer_ = std::make_unique<map_optimizer::MapOptimizer>(options_.optimizer, options_.initial_pose, t);
     schedule_.emplace(options_.schedule, t);
@@ -211,36 +215,57 @@ void OptimizerNode::step(const slam::SensorInput& input) {
 }
 
 void OptimizerNode::start_segment(const slam::OdometrySample& odometry) {
+  const std::size_t keyframes = optimizer_->keyframes().size();
+  end_problem();
+  begin_problem(odometry.t_s);
+  optimizer_->add_odometry(odometry);  // its control, held from now on
+  --earlier_segments_.odometry;        // the boundary sample goes to both problems: counted once
+  std::fprintf(stderr,
+               "map_optimizer: %zu keyframes (optimizer.max_keyframes): a new problem from the current pose, %zu of %zu "
+               "landmarks as priors\n",
+               keyframes, next_priors_, next_landmarks_.size());
+}
+
+void OptimizerNode::end_problem() {
   collect_whole(true);
   solve(true);  // a last whole solve, with covariances, published
   emit_keyframes();
-  const slam::Pose2 pose = optimizer_->current_pose();
-  const std::vector<map_optimizer::LandmarkSolution> landmarks = optimizer_->landmarks();
-  const std::size_t keyframes = optimizer_->keyframes().size();
+  next_pose_ = optimizer_->current_pose();
+  next_landmarks_ = optimizer_->landmarks();
   earlier_segments_ = optimizer_counters();
-  --earlier_segments_.odometry;  // the boundary sample goes to both problems: counted once
-  optimizer_ = std::make_unique<map_optimizer::MapOptimizer>(options_.optimizer, pose, odometry.t_s);
-  optimizer_->add_odometry(odometry);  // its control, held from now on
-  std::size_t priors = 0;
-  for (const map_optimizer::LandmarkSolution& l : landmarks) {
+  optimizer_.reset();
+  ++counters_.segments;
+}
+
+void OptimizerNode::begin_problem(double t_s) {
+  optimizer_ = std::make_unique<map_optimizer::MapOptimizer>(options_.optimizer, next_pose_, t_s);
+  next_priors_ = 0;
+  for (const map_optimizer::LandmarkSolution& l : next_landmarks_) {
     if (optimizer_->add_landmark_prior(l.id, l.mean, l.cov, l.observations)) {
-      ++priors;
+      ++next_priors_;
     } else {
       optimizer_->set_landmark_guess(l.id, l.mean);  // no covariance: a first estimate only
     }
   }
-  schedule_.emplace(options_.schedule, odometry.t_s);
-  ++counters_.segments;
-  if (priors < landmarks.size()) {
+  schedule_.emplace(options_.schedule, t_s);
+  if (next_priors_ < next_landmarks_.size()) {
     std::fprintf(stderr,
                  "map_optimizer: WARN: %zu landmarks had no covariance (a rank-deficient last solve): they start "
                  "from their position only and leave the map until seen again\n",
-                 landmarks.size() - priors);
+                 next_landmarks_.size() - next_priors_);
   }
+}
+
+void OptimizerNode::restart_at_new_time() {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  if (!optimizer_) return;
+  end_problem();
+  last_t_s_ = std::numeric_limits<double>::lowest();  // the next input's time, however far back
   std::fprintf(stderr,
-               "map_optimizer: %zu keyframes (optimizer.max_keyframes): a new problem from the current pose, %zu of %zu "
-               "landmarks as priors\n",
-               keyframes, priors, landmarks.size());
+               "map_optimizer: WARN: the samples' time went back (after a jump of over max_stamp_jump_s that their "
+               "stamps do not follow: a wrong clock or a hostile sender): a new problem from the current pose at their "
+               "time, %zu landmarks as priors\n",
+               next_landmarks_.size());
 }
 
 void OptimizerNode::emit_keyframes() {

@@ -28,6 +28,12 @@ bool insert_sorted(std::deque<T>& queue, const T& item) {
 
 SensorQueue::SensorQueue(const SensorQueueOptions& options) : options_(options) {}
 
+void SensorQueue::restart() {
+  const SensorQueueCounters kept = counters_;
+  *this = SensorQueue(options_);
+  counters_ = kept;
+}
+
 bool SensorQueue::admit() {
   if (size() >= options_.max_held) {
     ++counters_.overflow;

@@ -121,6 +121,7 @@ diagnostics::Snapshot EstimatorNode::diagnostics_snapshot() const {
                 {"samples_late", c.samples_late, false},
                 {"samples_reordered", c.samples_reordered, false},
                 {"samples_ahead", c.samples_ahead, true},
+                {"time_rebases", c.time_rebases, true},
                 {"samples_flood_dropped", c.samples_flood_dropped, true},
                 {"truth_invalid", c.truth_invalid, true},
                 {"step_errors", c.step_errors, true},
@@ -160,6 +161,7 @@ EstimatorCounters EstimatorNode::counters() const {
   c.samples_late = q.late;
   c.samples_reordered = q.reordered;
   c.samples_ahead = q.ahead;
+  c.time_rebases = q.rebases;
   c.truth_invalid = truth_invalid_.load();
   c.samples_flood_dropped = q.overflow;
   return c;
@@ -183,6 +185,7 @@ void EstimatorNode::filter_loop() {
   for (;;) {
     const SensorInbox::Ready ready = inbox_.wait_ready();
     const bool stopping = ready.stopping;
+    if (ready.rebased) restart_filter_at_new_time();
     step_each(ready.inputs, [this](const slam::SensorInput& input) { step(input); }, "slam_estimator", state_mutex_,
               counters_.step_errors);
 
@@ -296,6 +299,23 @@ void EstimatorNode::create_filter(double first_t_s) {
     checkpoint_.reset();
   }
   if (!filter_) filter_ = std::make_unique<slam::FastSlam2>(options_.filter, *start_pose_);
+}
+
+void EstimatorNode::restart_filter_at_new_time() {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  if (!filter_) return;
+  const CheckpointOptions& k = options_.checkpoint;
+  const slam::MapCheckpoint c = slam::checkpoint_of(*filter_, map_state_.header().stamp_ns(), options_.landmarks == "mixture");
+  filter_ = std::make_unique<slam::FastSlam2>(options_.filter,
+                                              slam::resume_pose(c, 0.0, k.max_speed_mps, k.max_turn_rate_radps));
+  filter_->set_prior_map(c.landmarks);
+  last_published_ns_ = 0;  // stamps of the abandoned time: publish and checkpoint at the new one
+  last_checkpoint_ns_ = 0;
+  std::fprintf(stderr,
+               "slam_estimator: WARN: the samples' time went back (after a jump of over max_stamp_jump_s that their "
+               "stamps do not follow: a wrong clock or a hostile sender): the filter goes on from its pose and %zu "
+               "landmarks at their time\n",
+               c.landmarks.size());
 }
 
 slam::Pose2 EstimatorNode::initial_pose() {

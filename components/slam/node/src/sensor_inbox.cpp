@@ -11,7 +11,9 @@
 namespace pixyslam::slam_node {
 
 SensorInbox::SensorInbox(const slam::SensorQueueOptions& queue, bool use_detection_sigmas)
-    : use_detection_sigmas_(use_detection_sigmas), max_pending_(queue.max_held), gate_(2, queue.max_stamp_jump_s),
+    : use_detection_sigmas_(use_detection_sigmas),
+      max_pending_(queue.max_held),
+      gate_(2, queue.max_stamp_jump_s),
       queue_(queue) {}
 
 void SensorInbox::push(const msg::Odometry& m) { enqueue(m); }
@@ -49,6 +51,7 @@ slam::SensorQueueCounters SensorInbox::queue_counters() const {
     std::lock_guard<std::mutex> lock(queue_mutex_);
     c = queue_.counters();
     c.ahead += gate_.dropped();
+    c.rebases = gate_.rebases();
   }
   std::lock_guard<std::mutex> lock(inbox_mutex_);
   c.overflow += overflow_;
@@ -89,7 +92,14 @@ SensorInbox::Ready SensorInbox::wait_ready() {
   for (Message& m : batch) {
     const std::uint64_t stamp = stamp_of(m);
     const std::size_t stream = m.index();
-    for (Message& p : gate_.offer(std::move(m), stream, stamp, steady_ns())) passed.push_back(std::move(p));
+    std::vector<Message> now = gate_.offer(std::move(m), stream, stamp, steady_ns());
+    if (gate_.take_rebased()) {
+      // What was passed or queued before is at the abandoned time.
+      passed.clear();
+      queue_.restart();
+      out.rebased = true;
+    }
+    for (Message& p : now) passed.push_back(std::move(p));
   }
   if (out.stopping) {
     for (Message& p : gate_.flush()) passed.push_back(std::move(p));

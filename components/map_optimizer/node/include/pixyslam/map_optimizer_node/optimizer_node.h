@@ -116,6 +116,13 @@ class OptimizerNode {
   // At max_keyframes: the whole problem solved and published a last time, then
   // a new one from the current pose at `odometry`'s time, the landmarks as priors.
   void start_segment(const slam::OdometrySample& odometry);
+  // The problem solved a last time, its keyframes emitted, its pose and
+  // landmarks kept for the next; optimizer_ empty.
+  void end_problem();
+  // A new problem at t_s from what end_problem() kept, the landmarks as priors.
+  void begin_problem(double t_s);
+  // After SensorInbox's rebase: the next input begins a new problem.
+  void restart_at_new_time();
   // The current problem's keyframes after the last emitted to the sink (a new
   // problem begins with a keyframe at the time the last one ended).
   void emit_keyframes();
@@ -147,6 +154,9 @@ class OptimizerNode {
   mutable std::mutex state_mutex_;
   std::unique_ptr<map_optimizer::MapOptimizer> optimizer_;
   KeyframeSink keyframe_sink_;
+  slam::Pose2 next_pose_ = slam::Pose2::Zero();                  // end_problem() -> begin_problem()
+  std::vector<map_optimizer::LandmarkSolution> next_landmarks_;
+  std::size_t next_priors_ = 0;
   std::optional<std::uint64_t> last_emitted_ns_;
   map_optimizer::OptimizerCounters earlier_segments_;  // the counters of the problems before optimizer_
   std::uint64_t epoch_ns_ = 0;  // the inbox's, from the first input on

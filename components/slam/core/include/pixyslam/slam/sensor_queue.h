@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <utility>
 #include <limits>
 #include <variant>
 #include <vector>
@@ -65,6 +66,7 @@ struct SensorQueueCounters {
                                 // filter applies a frame at its stamp, FastSlam2::frames_late)
   std::uint64_t ahead = 0;      // dropped: a jump past max_stamp_jump_s that no sample confirmed (StampGate)
   std::uint64_t overflow = 0;   // dropped: max_held samples were waiting already
+  std::uint64_t rebases = 0;    // the time went back to what the samples said (StampGate)
 };
 
 // Passes on samples in arrival order unless a stamp jumps more than
@@ -75,8 +77,12 @@ struct SensorQueueCounters {
 // stamp from a wrong clock or a hostile sender does not move the time. The
 // first sample of each stream is held the same way until the time is known,
 // so that none can set it alone. Two consistent samples of one stream do move
-// it. Stamps in ns on the stamps' clock, arrivals in ns on any steady clock.
-// Thread-compatible.
+// it; if that was wrong (a hostile sender's pair, a clock stepped back), every
+// sample after is more than max_jump_s behind: once only such samples came for
+// max_hold_s (at least three), the time goes back to theirs (rebased(): the
+// consumer restarts its clock-dependent state), so no pair of samples can stop
+// the time for good. Stamps in ns on the stamps' clock, arrivals in ns on any
+// steady clock. Thread-compatible.
 template <class T>
 class StampGate {
  public:
@@ -91,6 +97,28 @@ class StampGate {
       if (h.has && static_cast<double>(arrival_ns) - static_cast<double>(h.arrival_ns) > max_hold_ns_) drop(h);
     }
     Held& mine = held_[stream];
+    if (behind(stamp_ns)) {
+      if (!behind_run_) {
+        behind_run_ = true;
+        behind_since_ns_ = arrival_ns;
+        behind_count_ = 0;
+        behind_newest_ns_ = stamp_ns;
+      }
+      ++behind_count_;
+      behind_newest_ns_ = std::max(behind_newest_ns_, stamp_ns);
+      if (behind_count_ >= kRebaseSamples &&
+          static_cast<double>(arrival_ns) - static_cast<double>(behind_since_ns_) >= max_hold_ns_) {
+        reference_ns_ = behind_newest_ns_;
+        behind_run_ = false;
+        for (Held& h : held_) {
+          if (h.has) drop(h);
+        }
+        ++rebases_;
+        rebased_ = true;
+      }
+    } else if (known(stamp_ns)) {
+      behind_run_ = false;
+    }
     if (known(stamp_ns)) {
       reference_ns_ = std::max(reference_ns_, stamp_ns);
       if (mine.has) drop(mine);  // its stream goes on at the old time
@@ -130,14 +158,21 @@ class StampGate {
     return out;
   }
   std::uint64_t dropped() const { return dropped_; }
+  std::uint64_t rebases() const { return rebases_; }
+  // True once after an offer() that moved the time back (what it returned is at the new time).
+  bool take_rebased() { return std::exchange(rebased_, false); }
 
  private:
+  static constexpr std::uint64_t kRebaseSamples = 3;
   struct Held {
     bool has = false;
     T item{};
     std::uint64_t stamp_ns = 0;
     std::uint64_t arrival_ns = 0;
   };
+  bool behind(std::uint64_t stamp_ns) const {
+    return has_reference_ && static_cast<double>(reference_ns_) - static_cast<double>(stamp_ns) > max_jump_ns_;
+  }
   bool known(std::uint64_t stamp_ns) const {
     return has_reference_ && static_cast<double>(stamp_ns) - static_cast<double>(reference_ns_) <= max_jump_ns_;
   }
@@ -152,6 +187,12 @@ class StampGate {
   bool has_reference_ = false;
   std::uint64_t reference_ns_ = 0;
   std::uint64_t dropped_ = 0;
+  bool behind_run_ = false;  // only samples behind the time since behind_since_ns_ (arrival)
+  std::uint64_t behind_since_ns_ = 0;
+  std::uint64_t behind_count_ = 0;
+  std::uint64_t behind_newest_ns_ = 0;
+  std::uint64_t rebases_ = 0;
+  bool rebased_ = false;
 };
 
 // Merges the odometry and camera streams into one time-ordered sequence for
@@ -178,6 +219,9 @@ class SensorQueue {
   std::vector<SensorInput> pop_ready(double now_s);
   // Everything still held, oldest first (end of run).
   std::vector<SensorInput> pop_all();
+  // Drops what is held and forgets the streams' times (the time went back:
+  // StampGate::rebased()); the counters go on.
+  void restart();
 
   // Wall time at which a held sample becomes releasable without new input
   // (infinity if nothing is held).

@@ -39,6 +39,8 @@ struct EstimatorCounters {
   std::uint64_t samples_late = 0;
   std::uint64_t samples_reordered = 0;
   std::uint64_t samples_ahead = 0;          // dropped: a stamp jump (max_stamp_jump_s) no sample confirmed
+  std::uint64_t time_rebases = 0;           // the time went back to the samples' (a wrong jump undone):
+                                            // the filter restarted from its estimate
   std::uint64_t samples_flood_dropped = 0;  // dropped: max_held_samples were waiting
   std::uint64_t truth_invalid = 0;          // GroundTruth poses not finite or beyond 1e6 m: not a start pose
   std::uint64_t step_errors = 0;            // filter steps that threw: the sample is dropped
@@ -81,6 +83,9 @@ class EstimatorNode {
   void warn_if_late(const slam::SensorInput& input, double filter_time_s, const slam::FilterCounters& late_before);
   // The filter, from the checkpoint when there is a fresh one (state_mutex_ held).
   void create_filter(double first_t_s);
+  // After SensorInbox's rebase: the filter again from its pose and map, its
+  // time set by the next input.
+  void restart_filter_at_new_time();
   // The configured start pose, or the robot's first ground truth (estimator.initial_pose.source).
   slam::Pose2 initial_pose();
   void publish_map_state();  // state_mutex_ held

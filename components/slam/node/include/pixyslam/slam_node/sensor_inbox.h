@@ -34,6 +34,9 @@ class SensorInbox {
   struct Ready {
     std::vector<slam::SensorInput> inputs;  // in stamp order
     bool stopping = false;                  // stop() was called: this is the last batch
+    // The time went back (StampGate: a wrong jump undone): what was held is
+    // dropped, the inputs are at the new time, older than those before.
+    bool rebased = false;
   };
   // Waits for new input, for a held sample's release time, for stop() or at
   // most 0.1 s, then returns what may be consumed now.
