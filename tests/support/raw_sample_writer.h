@@ -78,6 +78,12 @@ class RawSampleWriter {
   eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
 };
 
+// The largest payload a sample of Message can have (its IDL bounds).
+template <class Message>
+std::uint32_t max_payload_size() {
+  return typename dds::MessageTraits<Message>::PubSubType().m_typeSize;
+}
+
 // `message` as the bytes DataWriter::write puts on the wire.
 template <class Message>
 std::vector<std::uint8_t> wire_bytes(Message message) {
@@ -89,8 +95,17 @@ std::vector<std::uint8_t> wire_bytes(Message message) {
 
 // Payloads of Message that no reader can decode, one of each kind the network
 // can deliver: `valid` is a correct serialised sample to damage.
-inline std::vector<std::vector<std::uint8_t>> malformed_payloads(const std::vector<std::uint8_t>& valid) {
+// Malformed variants of a valid payload; with `max_size` (max_payload_size<M>())
+// also the valid one padded past it: well-formed, but larger than any sample
+// of the type.
+inline std::vector<std::vector<std::uint8_t>> malformed_payloads(const std::vector<std::uint8_t>& valid,
+                                                                 std::uint32_t max_size = 0) {
   std::vector<std::vector<std::uint8_t>> out;
+  if (max_size > 0) {
+    std::vector<std::uint8_t> oversized = valid;
+    oversized.resize(std::size_t{max_size} + 64, 0);
+    out.push_back(oversized);
+  }
   std::vector<std::uint8_t> bad_encapsulation = valid;
   bad_encapsulation[0] = 0x07;  // first encapsulation byte must be 0
   out.push_back(bad_encapsulation);

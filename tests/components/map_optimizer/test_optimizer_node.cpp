@@ -239,8 +239,10 @@ TEST(OptimizerNode, MalformedSamplesAreCountedAndTheOptimiserGoesOn) {
   slam::OdometrySample good;
   good.v_mps = 0.1;
   const auto bad_o = test_support::malformed_payloads(
-      test_support::wire_bytes(test_support::odometry_msg(good, 0.1, base_ns)));
-  const auto bad_m = test_support::malformed_payloads(test_support::wire_bytes(msg::MapState()));
+      test_support::wire_bytes(test_support::odometry_msg(good, 0.1, base_ns)),
+      test_support::max_payload_size<msg::Odometry>());
+  const auto bad_m = test_support::malformed_payloads(test_support::wire_bytes(msg::MapState()),
+                                                      test_support::max_payload_size<msg::MapState>());
   for (const auto& b : bad_o) ASSERT_TRUE(bad_odometry.write(b));
   for (const auto& b : bad_m) ASSERT_TRUE(bad_maps.write(b));
   for (int i = 0; i < 30; ++i) {

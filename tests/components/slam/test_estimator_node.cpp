@@ -446,8 +446,10 @@ TEST(EstimatorNode, MalformedSamplesAreCountedAndTheFilterGoesOn) {
   slam::OdometrySample good;
   good.v_mps = 0.1;
   const auto bad_o = test_support::malformed_payloads(
-      test_support::wire_bytes(test_support::odometry_msg(good, 0.1, base_ns)));
-  const auto bad_f = test_support::malformed_payloads(test_support::wire_bytes(msg::LandmarkObservation()));
+      test_support::wire_bytes(test_support::odometry_msg(good, 0.1, base_ns)),
+      test_support::max_payload_size<msg::Odometry>());
+  const auto bad_f = test_support::malformed_payloads(test_support::wire_bytes(msg::LandmarkObservation()),
+                                                      test_support::max_payload_size<msg::LandmarkObservation>());
   for (const auto& b : bad_o) ASSERT_TRUE(bad_odometry.write(b));
   for (const auto& b : bad_f) ASSERT_TRUE(bad_frames.write(b));
   for (int i = 0; i < 5; ++i) {

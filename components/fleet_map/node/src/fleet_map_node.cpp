@@ -8,6 +8,7 @@
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/dds/participant.h"
+#include "pixyslam/dds/wire_text.h"
 #include "pixyslam/diagnostics/diagnostics_publisher.h"
 
 namespace pixyslam::fleet_map_node {
@@ -235,7 +236,7 @@ void FleetMapNode::fuse_and_publish() {
     std::fprintf(stderr,
                  "fleet_map: %s's frame %s with the others' (%zu shared landmarks, F %.1f / %.1f; offset %.2f m, "
                  "rotation %.1f deg, residual %.2f m)%s\n",
-                 c.robot_id.c_str(), verdict.c_str(), c.common, c.f_statistic, c.threshold, c.offset_m,
+                 dds::printable(c.robot_id).c_str(), verdict.c_str(), c.common, c.f_statistic, c.threshold, c.offset_m,
                  c.rotation_rad * 180.0 / M_PI, c.residual_m,
                  c.fused ? (c.verdict == fleet_map::FrameVerdict::kDisagrees &&
                                     options_.fusion.disagreement == fleet_map::FusionOptions::Disagreement::kAlign

@@ -16,6 +16,12 @@ namespace {
 // A numerical floor on an odometry factor's covariance (1 mm, 1 mrad): the
 // unicycle model gives no sideways noise, and a stationary robot none at all.
 constexpr double kOdometryCovarianceFloor = 1e-6;
+// A robot parked in view of poles adds every frame's sightings to the newest
+// keyframe: past this many it gets a new one (zero motion, the floor above), so
+// no keyframe holds an unbounded number of factors and max_keyframes bounds the
+// problem of a robot that stands for days. Far above a moving robot's (one
+// frame's detections, at most 64).
+constexpr std::size_t kMaxObservationsPerKeyframe = 256;
 
 template <typename T>
 T wrapped(const T& a) {
@@ -368,6 +374,7 @@ void MapOptimizer::close_keyframe(double t_s, const std::optional<slam::Pose2>& 
   keyframes_.push_back({t_s, initial});
   keyframe_due_s_ = t_s + options_.keyframe_interval_s;
   open_motion_.clear();
+  newest_observations_ = 0;
   ++counters_.keyframes;
 }
 
@@ -414,7 +421,7 @@ void MapOptimizer::add_frame(const slam::ObservationFrame& frame, const std::opt
   if (valid.empty()) return;
   // A keyframe at the frame time, unless the robot has not moved since the
   // newest one (it is there, or the robot stood still since).
-  if (!open_motion_.empty()) close_keyframe(frame.t_s, guess);
+  if (!open_motion_.empty() || newest_observations_ >= kMaxObservationsPerKeyframe) close_keyframe(frame.t_s, guess);
   const std::size_t k = keyframes_.size() - 1;
   double* const pose = pose_blocks_.back().data();
   const slam::Pose2 at(pose[0], pose[1], pose[2]);
@@ -446,6 +453,7 @@ void MapOptimizer::add_frame(const slam::ObservationFrame& frame, const std::opt
     ++lm.observations;
     lm.last_keyframe = k;
     ++counters_.observations;
+    ++newest_observations_;
   }
 }
 

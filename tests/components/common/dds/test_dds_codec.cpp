@@ -9,6 +9,7 @@
 #include "pixyslam/dds/cdr_payload.h"
 #include "pixyslam/dds/topic_selection.h"
 #include "pixyslam/dds/topics.h"
+#include "pixyslam/dds/wire_text.h"
 #include "sample_messages.h"
 
 namespace pixyslam::dds {
@@ -90,6 +91,15 @@ TEST(CdrPayload, KnownTopicsAreTheSystemsTopicsWithTheirDdsTypeNames) {
 }
 
 // ---------------------------------------------------------------- topic patterns
+
+// A robot_id or participant name from the network in a log line: no terminal
+// escape gets through, and a long one is cut.
+TEST(WireText, ControlBytesAreReplacedAndLongTextIsCut) {
+  EXPECT_EQ(printable("robot1"), "robot1");
+  EXPECT_EQ(printable(std::string("a\x1b[2Jb\n\x7f\0c", 10)), "a?[2Jb???c");
+  EXPECT_EQ(printable(std::string(100, 'x'), 10), std::string(10, 'x') + "...");
+  EXPECT_EQ(printable("caf\xc3\xa9"), "caf\xc3\xa9");  // UTF-8 kept
+}
 
 TEST(TopicSelection, GlobMatchesWholeNames) {
   EXPECT_TRUE(glob_match("pixyslam/*", "pixyslam/odometry"));

@@ -140,7 +140,8 @@ TEST(DdsLoopback, MalformedSamplesAreCountedAndDroppedAndTheReaderGoesOn) {
   test_support::RawSampleWriter<msg::Odometry> hostile(sender);
   ASSERT_TRUE(hostile.wait_for_readers(1, std::chrono::seconds(10)));
 
-  const std::vector<std::vector<std::uint8_t>> bad = test_support::malformed_payloads(odometry_bytes(1));
+  const std::vector<std::vector<std::uint8_t>> bad =
+      test_support::malformed_payloads(odometry_bytes(1), test_support::max_payload_size<msg::Odometry>());
   for (const auto& bytes : bad) ASSERT_TRUE(hostile.write(bytes));
   ASSERT_TRUE(hostile.write(odometry_bytes(1)));             // a valid one after them
   ASSERT_TRUE(hostile.write(odometry_bytes(1ull << 40)));   // hostile seq: a jump, not lost messages

@@ -7,6 +7,8 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
 
+#include "pixyslam/dds/wire_text.h"
+
 namespace pixyslam::launcher {
 
 namespace fdds = eprosima::fastdds::dds;
@@ -19,9 +21,10 @@ class HealthMonitor::Listener : public fdds::DomainParticipantListener {
     for (const auto& p : info.info.m_properties) properties[p.first()] = p.second();
     std::lock_guard<std::mutex> lock(mutex_);
     std::string& who = names_[info.info.m_guid.guidPrefix];
-    const std::string name = info.info.m_participantName.to_string();
+    const std::string name = dds::printable(info.info.m_participantName.to_string());
     if (properties.count("pixyslam.process") != 0) {
-      who = properties["pixyslam.process"] + "@" + properties["pixyslam.host"] + " pid " + properties["pixyslam.pid"];
+      who = dds::printable(properties["pixyslam.process"]) + "@" + dds::printable(properties["pixyslam.host"]) +
+            " pid " + dds::printable(properties["pixyslam.pid"], 12);
     } else if (who.empty() && name == "pixyslam") {
       who = "'pixyslam' (identity not announced: dds.announce_identity)";
     } else if (who.empty()) {

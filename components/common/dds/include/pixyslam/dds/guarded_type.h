@@ -15,8 +15,12 @@ namespace pixyslam::dds {
 // out of Fast CDR (bad encapsulation, a length past the payload, bad_alloc for
 // a huge sequence) would leave Fast DDS's take() and abort the process. A
 // sample that does not decode is counted and reported as not deserialisable
-// (false), so Fast DDS drops it. Every reader of the system decodes through
-// this type (type_support() below); so do the log tools.
+// (false), so Fast DDS drops it; so is one larger than the type's largest
+// sample (every sequence at its IDL bound, 255 bytes a string: no writer of
+// the system sends more), which decodes but would make a reader keep what a
+// sender chose (a 1 MB frame_id in each of thousands of queued samples).
+// Every reader of the system decodes through this type (type_support() below);
+// so do the log tools.
 template <class Message>
 class GuardedPubSubType : public MessageTraits<Message>::PubSubType {
  public:
@@ -25,7 +29,8 @@ class GuardedPubSubType : public MessageTraits<Message>::PubSubType {
   bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override {
     bool ok = false;
     try {
-      ok = payload != nullptr && payload->data != nullptr && payload->length >= 4 && Base::deserialize(payload, data);
+      ok = payload != nullptr && payload->data != nullptr && payload->length >= 4 &&
+           (this->m_typeSize == 0 || payload->length <= this->m_typeSize) && Base::deserialize(payload, data);
     } catch (...) {
       ok = false;
     }

@@ -275,6 +275,7 @@ class MapOptimizer {
   std::vector<PriorRecord> prior_records_;
   std::map<int, Eigen::Vector2d> landmark_guesses_;
   slam::ComposedMotion open_motion_;  // odometry since the newest keyframe
+  std::size_t newest_observations_ = 0;  // observation factors on the newest keyframe
   double last_time_s_ = 0.0;
   double last_measured_s_ = 0.0;
   double keyframe_due_s_ = 0.0;  // a keyframe at the latest then, unless standing still
