@@ -373,12 +373,19 @@ void keep_newest_per_writer(std::deque<PendingSample>& pending) {
 
 }  // namespace
 
+// Samples waiting for the output at most (echo) and reporters kept at most
+// (diagnostics): a flood, or output slower than the input (a paused pager),
+// must not grow the spy's memory without end.
+constexpr std::size_t kMaxPendingSamples = 10000;
+constexpr std::size_t kMaxReporters = 4096;
+
 int run_echo(const dds::DdsOptions& options, const EchoRequest& request, std::ostream& out) {
   return with_topic_type(request.topic, [&](auto tag) {
     using Message = decltype(tag);
     std::mutex mutex;
     std::condition_variable cv;
     std::deque<PendingSample> pending;
+    std::uint64_t overrun = 0;  // oldest pending samples dropped at kMaxPendingSamples
     Clock::time_point first_arrival{};
     dds::Participant participant(options, "pixyslam_spy");
     dds::Reader<Message> reader(participant, [&](const Message& m) {
@@ -386,6 +393,10 @@ int run_echo(const dds::DdsOptions& options, const EchoRequest& request, std::os
       std::string text = request.json ? to_json_line(value) + "\n" : to_yaml_document(value);
       std::lock_guard<std::mutex> lock(mutex);
       if (first_arrival == Clock::time_point{}) first_arrival = Clock::now();
+      if (pending.size() >= kMaxPendingSamples) {
+        pending.pop_front();
+        ++overrun;
+      }
       pending.push_back({std::move(text), writer_key(m)});
       cv.notify_all();
     }, request.robot);
@@ -413,6 +424,11 @@ int run_echo(const dds::DdsOptions& options, const EchoRequest& request, std::os
       std::fprintf(stderr, "pixyslam_spy: echo %s: %llu malformed samples dropped\n", request.topic.c_str(),
                    static_cast<unsigned long long>(malformed));
     }
+    std::lock_guard<std::mutex> lock(mutex);
+    if (overrun > 0) {
+      std::fprintf(stderr, "pixyslam_spy: echo %s: %llu samples dropped: the output was slower than the input\n",
+                   request.topic.c_str(), static_cast<unsigned long long>(overrun));
+    }
     if (request.count > 0 && printed < request.count) {
       std::fprintf(stderr, "pixyslam_spy: echo %s: %zu of %zu samples received\n", request.topic.c_str(), printed,
                    request.count);
@@ -428,7 +444,9 @@ int run_diagnostics(const dds::DdsOptions& options, double seconds, bool json, s
   dds::Participant participant(options, "pixyslam_spy");
   dds::Reader<msg::Diagnostics> reader(participant, [&](const msg::Diagnostics& m) {
     std::lock_guard<std::mutex> lock(mutex);
-    latest[{m.header().robot_id(), m.process(), m.pid()}] = m;
+    std::tuple<std::string, std::string, std::uint32_t> key{m.header().robot_id(), m.process(), m.pid()};
+    if (latest.size() >= kMaxReporters && latest.count(key) == 0) return;  // a flood of invented reporters
+    latest[std::move(key)] = m;
   });
   wait(seconds, [] { return false; });
   std::lock_guard<std::mutex> lock(mutex);
