@@ -1,7 +1,7 @@
 // map_optimizer: the map optimiser over DDS (components/map_optimizer): Odometry,
 // LandmarkObservation and the estimator's MapState in, OptimisedMap out, until
 // SIGINT/SIGTERM. Optional: the robot runs without it; it can run on another host.
-//   map_optimizer --config config/map_optimizer.yaml [--out-dir DIR] [--set KEY=VALUE ...] [--domain N]
+//   map_optimizer --config config/map_optimizer.yaml [--out-dir DIR] [--set KEY=VALUE ...] [--domain N] [--verbose]
 // --out-dir writes DIR/trajectory.csv (every keyframe of the final solution,
 // and of each earlier problem as it ends: optimizer.max_keyframes) and
 // DIR/landmarks.csv at exit, in slam_offline's formats.
@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   app::StopSignal::install();
   std::string config, out_dir;
   std::vector<std::string> overrides;
+  bool verbose = false;
   app::Cli cli{"map_optimizer", "The map optimiser over DDS: Odometry, LandmarkObservation and the estimator's MapState in, "
                "OptimisedMap out, until SIGINT/SIGTERM."};
   app::add_config(cli, config,
@@ -47,6 +48,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> domain;
   app::add_set(cli, overrides, "optimizer.window_keyframes=50");
   app::add_domain(cli, domain);
+  app::add_verbose(cli, verbose);
   cli.footer(map_optimizer_node::help_text());
   if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("map_optimizer", [&] {
@@ -62,6 +64,7 @@ int main(int argc, char** argv) {
                  "every %.1f s; DDS domain %d, profiles '%s'\n",
                  options.optimizer.keyframe_interval_s, options.schedule.window_keyframes, options.schedule.window_period_s,
                  options.schedule.whole_period_s, options.dds.domain_id, options.dds.profiles_file.c_str());
+    if (verbose) app::print_effective_configuration("map_optimizer", map_optimizer_node::to_yaml(options));
     // Before the node: its thread writes here until the node is destroyed.
     std::optional<eval::TrajectoryOutput> trajectory;
     map_optimizer_node::OptimizerNode node(options);

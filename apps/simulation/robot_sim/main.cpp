@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   app::StopSignal::install();
   std::string config, pixy_config, encoder_config, arduino_link, pixy_link, camera_video;
   double duration_s = 0.0;
+  bool verbose = false;
   std::vector<std::string> dds_overrides, overrides;
   app::Cli cli{"robot_sim",
                "The simulated robot's hardware: Arduino encoder lines and Pixy UART bytes into two pseudo-terminals "
@@ -37,6 +38,7 @@ int main(int argc, char** argv) {
   cli.option("--camera-video", camera_video, "also write the synthetic camera's frames to FIFO").type("FIFO");
   app::add_domain(cli, dds_overrides);
   app::add_set(cli, overrides, "world.speed_mps=0.3");
+  app::add_verbose(cli, verbose);
   cli.footer(robot_sim::help_text());
   if (const auto done = cli.parse(argc, argv)) return *done;
   robot_sim::RobotSimProcessConfig c;
@@ -56,6 +58,7 @@ int main(int argc, char** argv) {
       })) {
     return *failed;
   }
+  if (verbose) app::print_effective_configuration("robot_sim", robot_sim::to_yaml(c));
   return app::run_main("robot_sim", [&] {
     robot_sim::RobotSimNode node(c);
     node.run();

@@ -49,6 +49,13 @@ void apply_overrides(OptimizerNodeOptions& o, const std::vector<std::string>& as
   dds::resolve_settings(o.dds, dds);
 }
 
+std::string to_yaml(const OptimizerNodeOptions& o) {
+  std::string node = parameters::to_yaml(o, optimizer_node_parameters(), "optimizer");
+  node.erase(0, node.find('\n') + 1);  // the same section as the core's keys
+  return parameters::to_yaml(o.optimizer, map_optimizer::map_optimizer_parameters(), "optimizer") + node +
+         dds::to_yaml(o.dds);
+}
+
 std::string help_text() {
   return "optimizer parameters (optimizer:; the noise models come from filter_config):\n" +
          parameters::help_text(map_optimizer::map_optimizer_parameters(), "optimizer") +

@@ -93,6 +93,12 @@ void apply_overrides(RobotSimProcessConfig& c, const std::vector<std::string>& a
   dds::resolve_settings(c.dds, rest);  // dds.KEY=V; anything else is an error there
 }
 
+std::string to_yaml(const RobotSimProcessConfig& c) {
+  return parameters::to_yaml(c.sim.world, sim::world_layout_parameters(), "world") +
+         parameters::to_yaml(c.sim.hardware, hardware_parameters(), "hardware") +
+         parameters::to_yaml(c.run, run_parameters(), "run") + dds::to_yaml(c.dds);
+}
+
 std::string help_text() {
   return "world (world:; the path and poles, and also path:, poles:, initial_pose: lists as in slam_sim.yaml):\n" +
          parameters::help_text(sim::world_layout_parameters(), "world") +

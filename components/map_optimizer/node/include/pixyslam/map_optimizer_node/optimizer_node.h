@@ -50,6 +50,9 @@ void apply_overrides(OptimizerNodeOptions& options, const std::vector<std::strin
 
 // The `optimizer:` and `dds:` parameters, for --help.
 std::string help_text();
+// The `optimizer:` and `dds:` settings as YAML, for --verbose (the noise models
+// are the filter_config's).
+std::string to_yaml(const OptimizerNodeOptions& options);
 
 // Reads the file: `filter_config` (the estimator's config, relative to this
 // file: its `filter:` noise and limits, `estimator.initial_pose`, delays and

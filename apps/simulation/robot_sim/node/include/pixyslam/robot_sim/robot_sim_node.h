@@ -55,6 +55,8 @@ void apply_overrides(RobotSimProcessConfig& config, const std::vector<std::strin
 
 // Every parameter --set reaches, for --help.
 std::string help_text();
+// The simulator's own settings as YAML (world layout, hardware, run, dds), for --verbose.
+std::string to_yaml(const RobotSimProcessConfig& c);
 
 // The simulator process: runs the HardwareEmulator in real time, writes the
 // Arduino's lines and the Pixy's UART bytes into two pseudo-terminals (the
