@@ -69,7 +69,7 @@ if grep -q "name: map_optimizer" "$work/config/$launch"; then
   grep -E "map optimiser +[0-9]+ solutions" "$work/out.log" ||
     { echo "FAIL: no OptimisedMap reached the evaluator"; exit 1; }
   # --out-dir: every keyframe of the final solution (not the topic's thinned list).
-  keyframes=$(grep -oE 'keyframes [0-9]+ \(in the problem [0-9]+' "$work/out.log" | tail -1 | grep -oE '[0-9]+$')
+  keyframes=$(grep -oE 'keyframes [0-9]+ \(in the problem [0-9]+' "$work/out.log" | tail -1 | grep -oE '[0-9]+$' || true)
   rows=$(($(wc -l < "$work/run/optimised/trajectory.csv") - 1))
   if [[ -z "$keyframes" || "$rows" -ne "$keyframes" ]]; then
     echo "FAIL: the map optimiser's trajectory.csv has $rows rows, its problem ${keyframes:-?} keyframes"; exit 1

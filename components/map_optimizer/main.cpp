@@ -87,6 +87,6 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "map_optimizer: wrote %s (%zu keyframes)\n", trajectory->path().c_str(), rows);
       write_landmarks(out_dir, node.latest_map());
     }
-    return 0;
+    return trajectory && trajectory->failed() ? 1 : 0;  // the file ends early: the run's record is short
   });
 }

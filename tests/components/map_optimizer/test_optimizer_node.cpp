@@ -220,6 +220,53 @@ TEST(OptimizerNode, AProblemAtItsKeyframeLimitStartsAnewWithItsLandmarksAsPriors
   EXPECT_LT(eval::compare_trajectory(emitted, run.truth).ate_rmse_m, 0.15);
 }
 
+// Signed seconds from base to stamp (a stamp a few ns before base is not 2^64 ns after it).
+double seconds_after(std::uint64_t base_ns, std::uint64_t stamp_ns) {
+  return static_cast<double>(static_cast<std::int64_t>(stamp_ns - base_ns)) * 1e-9;
+}
+
+// A consistent pair of odometry samples a year ahead moves the time; the run's
+// own samples after it would all be dropped as late. Once only they came for a
+// second, the time goes back: a new problem from the newest keyframe before
+// the jump, and the written trajectory keeps to the run's time, in order.
+TEST(OptimizerNode, AfterAHostilePairOfFutureStampsTheOptimiserGoesOnAtTheRunsTime) {
+  const sim::WorldRun run = simulated_minute();
+  const std::uint64_t base_ns = dds::now_ns();
+  OptimizerNodeOptions options = test_options();
+  options.initial_pose = run.initial_pose;
+  OptimizerNode node(options);
+  std::vector<eval::TimedPose> emitted;
+  node.set_keyframe_sink([&](std::uint64_t stamp_ns, const slam::Pose2& pose) {
+    emitted.push_back({seconds_after(base_ns, stamp_ns), pose.x(), pose.y(), pose.z()});
+  });
+  node.start();
+  dds::Participant sensors(options.dds, "test_sensors");
+  dds::Writer<msg::Odometry> odometry_writer(sensors);
+  dds::Writer<msg::LandmarkObservation> observation_writer(sensors);
+  ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  const std::uint64_t year_ns = 365ull * 86400ull * 1000000000ull;
+  for (int i = 0; i < 2; ++i) {
+    msg::Odometry m = test_support::odometry_msg(run.odometry[0], 0.1, base_ns + year_ns + 100'000'000ull * i);
+    ASSERT_TRUE(odometry_writer.publish(m));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  feed(run, base_ns, odometry_writer, observation_writer);  // ~1.8 s of arrivals
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  node.stop();
+
+  const msg::OptimisedMap last = node.latest_map();
+  const double end_s = run.odometry.back().t_s + 1.0;
+  EXPECT_LT(seconds_after(base_ns, last.header().stamp_ns()), end_s);  // not a year on
+  ASSERT_FALSE(last.keyframes().empty());
+  EXPECT_LT(seconds_after(base_ns, last.keyframes().back().stamp_ns()), end_s);
+  EXPECT_GT(last.landmarks().size(), 0u);
+  ASSERT_FALSE(emitted.empty());
+  for (std::size_t i = 1; i < emitted.size(); ++i) ASSERT_LT(emitted[i - 1].t_s, emitted[i].t_s) << i;
+  EXPECT_LT(emitted.back().t_s, end_s);
+  EXPECT_GT(emitted.back().t_s, run.odometry.back().t_s - 2.0);  // the new problem's keyframes were written
+}
+
 // Any participant can send any bytes: what does not decode is counted and dropped.
 TEST(OptimizerNode, MalformedSamplesAreCountedAndTheOptimiserGoesOn) {
   OptimizerNodeOptions options = test_options();

@@ -121,7 +121,8 @@ diagnostics::Snapshot OptimizerNode::diagnostics_snapshot() const {
                 {"window_solves", c.window_solves, false},
                 {"whole_solves", c.whole_solves, false},
                 {"maps_published", c.maps_published, false},
-                {"segments", c.segments, false}};
+                {"segments", c.segments, false},
+                {"time_rebases", queue.rebases, true}};
   return s;
 }
 
@@ -153,8 +154,24 @@ void OptimizerNode::loop() {
 void OptimizerNode::step(const slam::SensorInput& input) {
   std::lock_guard<std::mutex> lock(state_mutex_);
   const double t = slam::input_time(input);
-  if (!optimizer_ && counters_.segments > 0) {
-    begin_problem(t);  // after a rebase: the last problem's pose and landmarks at the new time
+  if (!optimizer_ && rebase_pending_) {
+    // After a rebase: the keyframes before the new time stay (written out), the
+    // ones after it (the jump) go, and the new problem starts at the newest kept.
+    const std::uint64_t old_epoch_ns = epoch_ns_;
+    epoch_ns_ = inbox_.epoch_ns();  // the inbox's new one
+    const std::uint64_t now_ns = slam_node::to_stamp_ns(t, epoch_ns_);
+    next_pose_ = options_.initial_pose;
+    last_emitted_ns_.reset();
+    for (const map_optimizer::Keyframe& k : rebase_keyframes_) {
+      const std::uint64_t stamp = slam_node::to_stamp_ns(k.t_s, old_epoch_ns);
+      if (stamp >= now_ns) break;
+      next_pose_ = k.pose;
+      if (keyframe_sink_) keyframe_sink_(stamp, k.pose);
+      last_emitted_ns_ = stamp;
+    }
+    rebase_keyframes_.clear();
+    rebase_pending_ = false;
+    begin_problem(t);
   } else if (!optimizer_) {
     epoch_ns_ = inbox_.epoch_ns();
     optimizer_ = std::make_unique<map_optimizer::MapOptimizer>(options_.optimizer, options_.initial_pose, t);
@@ -226,10 +243,10 @@ void OptimizerNode::start_segment(const slam::OdometrySample& odometry) {
                keyframes, next_priors_, next_landmarks_.size());
 }
 
-void OptimizerNode::end_problem() {
+void OptimizerNode::end_problem(bool emit) {
   collect_whole(true);
   solve(true);  // a last whole solve, with covariances, published
-  emit_keyframes();
+  if (emit) emit_keyframes();
   next_pose_ = optimizer_->current_pose();
   next_landmarks_ = optimizer_->landmarks();
   earlier_segments_ = optimizer_counters();
@@ -259,7 +276,9 @@ void OptimizerNode::begin_problem(double t_s) {
 void OptimizerNode::restart_at_new_time() {
   std::lock_guard<std::mutex> lock(state_mutex_);
   if (!optimizer_) return;
-  end_problem();
+  rebase_keyframes_ = optimizer_->keyframes();  // kept to the new time by the next input (step())
+  end_problem(false);
+  rebase_pending_ = true;
   last_t_s_ = std::numeric_limits<double>::lowest();  // the next input's time, however far back
   std::fprintf(stderr,
                "map_optimizer: WARN: the samples' time went back (after a jump of over max_stamp_jump_s that their "

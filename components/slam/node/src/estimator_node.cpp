@@ -57,6 +57,7 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options)
     } else {
       try {
         checkpoint_ = slam::read_map_checkpoint(k.file);
+        checkpoint_source_ = k.file;
       } catch (const config::ConfigError& e) {
         std::fprintf(stderr, "slam_estimator: checkpoint unusable, starting from scratch: %s\n", e.what());
       }
@@ -185,7 +186,7 @@ void EstimatorNode::filter_loop() {
   for (;;) {
     const SensorInbox::Ready ready = inbox_.wait_ready();
     const bool stopping = ready.stopping;
-    if (ready.rebased) restart_filter_at_new_time();
+    if (ready.rebased) restart_filter_at_new_time(ready.rebased_to_ns);
     step_each(ready.inputs, [this](const slam::SensorInput& input) { step(input); }, "slam_estimator", state_mutex_,
               counters_.step_errors);
 
@@ -208,8 +209,12 @@ void EstimatorNode::step(const slam::SensorInput& input) {
   if (!filter_ && !start_pose_) start_pose_ = initial_pose();
   std::lock_guard<std::mutex> lock(state_mutex_);
   const auto begin = std::chrono::steady_clock::now();
-  if (!filter_) create_filter(slam::input_time(input));
+  const bool fresh = !filter_;  // its time is set by this input
+  if (fresh) create_filter(slam::input_time(input));
   const double filter_time_s = filter_->time_s();
+  if (!fresh && slam::input_time(input) > filter_time_s + options_.queue.max_stamp_jump_s) {
+    before_jump_ = slam::checkpoint_of(*filter_, map_state_.header().stamp_ns(), options_.landmarks == "mixture");
+  }
   const slam::FilterCounters late_before = filter_->counters();
   if (const auto* odometry = std::get_if<slam::OdometryInput>(&input)) {
     filter_->add_odometry(odometry->sample);
@@ -289,7 +294,7 @@ void EstimatorNode::create_filter(double first_t_s) {
       std::fprintf(stderr,
                    "slam_estimator: resumed from %s: %.1f s old, %zu landmarks, pose (%.3f, %.3f, %.3f) "
                    "sd %.2f m / %.2f rad\n",
-                   k.file.c_str(), gap_s, c.landmarks.size(), pose.mean.x(), pose.mean.y(), pose.mean.z(),
+                   checkpoint_source_.c_str(), gap_s, c.landmarks.size(), pose.mean.x(), pose.mean.y(), pose.mean.z(),
                    std::sqrt(std::max(pose.cov(0, 0), pose.cov(1, 1))), std::sqrt(pose.cov(2, 2)));
     } else {
       std::fprintf(stderr,
@@ -301,21 +306,27 @@ void EstimatorNode::create_filter(double first_t_s) {
   if (!filter_) filter_ = std::make_unique<slam::FastSlam2>(options_.filter, *start_pose_);
 }
 
-void EstimatorNode::restart_filter_at_new_time() {
+void EstimatorNode::restart_filter_at_new_time(std::uint64_t new_time_ns) {
   std::lock_guard<std::mutex> lock(state_mutex_);
   if (!filter_) return;
-  const CheckpointOptions& k = options_.checkpoint;
-  const slam::MapCheckpoint c = slam::checkpoint_of(*filter_, map_state_.header().stamp_ns(), options_.landmarks == "mixture");
-  filter_ = std::make_unique<slam::FastSlam2>(options_.filter,
-                                              slam::resume_pose(c, 0.0, k.max_speed_mps, k.max_turn_rate_radps));
-  filter_->set_prior_map(c.landmarks);
+  const auto jump_ns = static_cast<std::uint64_t>(options_.queue.max_stamp_jump_s * 1e9);
+  const bool stepped_into_future = map_state_.header().stamp_ns() > new_time_ns + jump_ns;
+  if (stepped_into_future && before_jump_) {
+    // What the filter did after the jump (the held control applied into the
+    // future) is dropped with it.
+    checkpoint_ = std::move(before_jump_);
+  } else {
+    checkpoint_ = slam::checkpoint_of(*filter_, new_time_ns, options_.landmarks == "mixture");
+  }
+  before_jump_.reset();
+  checkpoint_source_ = stepped_into_future ? "the state before the time jump" : "the state at the time jump";
+  filter_.reset();
   last_published_ns_ = 0;  // stamps of the abandoned time: publish and checkpoint at the new one
   last_checkpoint_ns_ = 0;
   std::fprintf(stderr,
                "slam_estimator: WARN: the samples' time went back (after a jump of over max_stamp_jump_s that their "
-               "stamps do not follow: a wrong clock or a hostile sender): the filter goes on from its pose and %zu "
-               "landmarks at their time\n",
-               c.landmarks.size());
+               "stamps do not follow: a wrong clock or a hostile sender): the filter goes on from %s\n",
+               checkpoint_source_.c_str());
 }
 
 slam::Pose2 EstimatorNode::initial_pose() {

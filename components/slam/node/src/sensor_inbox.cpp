@@ -94,10 +94,16 @@ SensorInbox::Ready SensorInbox::wait_ready() {
     const std::size_t stream = m.index();
     std::vector<Message> now = gate_.offer(std::move(m), stream, stamp, steady_ns());
     if (gate_.take_rebased()) {
-      // What was passed or queued before is at the abandoned time.
-      passed.clear();
+      // What the queue holds, and what this batch passed before, is kept only
+      // when it is at the new time (the queue's behind samples were late at the
+      // old one and are dropped with it).
+      passed.erase(std::remove_if(passed.begin(), passed.end(),
+                                  [&](const Message& p) { return !gate_.current(stamp_of(p)); }),
+                   passed.end());
       queue_.restart();
+      has_epoch_ = false;  // the next sample passed on sets it: times near 0 again
       out.rebased = true;
+      out.rebased_to_ns = gate_.reference_ns();
     }
     for (Message& p : now) passed.push_back(std::move(p));
   }

@@ -412,11 +412,16 @@ int run_echo(const dds::DdsOptions& options, const EchoRequest& request, std::os
         keep_newest_per_writer(pending);
         history_done = true;
       }
-      while (!pending.empty() && (request.count == 0 || printed < request.count)) {
-        out << pending.front().text;
+      // Written without the lock: a slow reader of the output (a paused pager)
+      // must not block the DDS thread, which then drops the oldest instead.
+      std::deque<PendingSample> batch;
+      while (!pending.empty() && (request.count == 0 || printed + batch.size() < request.count)) {
+        batch.push_back(std::move(pending.front()));
         pending.pop_front();
-        ++printed;
       }
+      lock.unlock();
+      for (const PendingSample& p : batch) out << p.text;
+      printed += batch.size();
       out.flush();
     }
     const std::uint64_t malformed = reader.malformed() + reader.callback_errors();

@@ -119,9 +119,9 @@ class OptimizerNode {
   // At max_keyframes: the whole problem solved and published a last time, then
   // a new one from the current pose at `odometry`'s time, the landmarks as priors.
   void start_segment(const slam::OdometrySample& odometry);
-  // The problem solved a last time, its keyframes emitted, its pose and
-  // landmarks kept for the next; optimizer_ empty.
-  void end_problem();
+  // The problem solved a last time, its keyframes emitted (if `emit`), its pose
+  // and landmarks kept for the next; optimizer_ empty.
+  void end_problem(bool emit = true);
   // A new problem at t_s from what end_problem() kept, the landmarks as priors.
   void begin_problem(double t_s);
   // After SensorInbox's rebase: the next input begins a new problem.
@@ -160,6 +160,8 @@ class OptimizerNode {
   slam::Pose2 next_pose_ = slam::Pose2::Zero();                  // end_problem() -> begin_problem()
   std::vector<map_optimizer::LandmarkSolution> next_landmarks_;
   std::size_t next_priors_ = 0;
+  bool rebase_pending_ = false;                              // restart_at_new_time() -> step()
+  std::vector<map_optimizer::Keyframe> rebase_keyframes_;     // the ended problem's, to the new time
   std::optional<std::uint64_t> last_emitted_ns_;
   map_optimizer::OptimizerCounters earlier_segments_;  // the counters of the problems before optimizer_
   std::uint64_t epoch_ns_ = 0;  // the inbox's, from the first input on

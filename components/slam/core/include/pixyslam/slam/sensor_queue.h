@@ -161,6 +161,10 @@ class StampGate {
   std::uint64_t rebases() const { return rebases_; }
   // True once after an offer() that moved the time back (what it returned is at the new time).
   bool take_rebased() { return std::exchange(rebased_, false); }
+  // The time (the newest stamp passed on, or the one a rebase went back to).
+  std::uint64_t reference_ns() const { return reference_ns_; }
+  // Within max_jump_s of the time either way.
+  bool current(std::uint64_t stamp_ns) const { return known(stamp_ns) && !behind(stamp_ns); }
 
  private:
   static constexpr std::uint64_t kRebaseSamples = 3;

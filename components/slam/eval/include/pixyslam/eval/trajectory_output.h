@@ -20,6 +20,8 @@ class TrajectoryOutput {
   void add(std::uint64_t stamp_ns, double x_m, double y_m, double theta_rad);
   // Flushes; the number of rows written.
   std::size_t finish();
+  // A write failed (reported once): the file ends early.
+  bool failed() const { return failed_; }
   const std::string& path() const { return writer_.path(); }
 
  private:

@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
 #include <utility>
 #include <variant>
@@ -83,9 +84,11 @@ class EstimatorNode {
   void warn_if_late(const slam::SensorInput& input, double filter_time_s, const slam::FilterCounters& late_before);
   // The filter, from the checkpoint when there is a fresh one (state_mutex_ held).
   void create_filter(double first_t_s);
-  // After SensorInbox's rebase: the filter again from its pose and map, its
-  // time set by the next input.
-  void restart_filter_at_new_time();
+  // After SensorInbox's rebase to new_time_ns: the filter again, its time set
+  // by the next input, from its state before the jump when it had stepped into
+  // the future (its pose moved on by the time since, as a checkpoint resume),
+  // else from its state now (the jump never reached it).
+  void restart_filter_at_new_time(std::uint64_t new_time_ns);
   // The configured start pose, or the robot's first ground truth (estimator.initial_pose.source).
   slam::Pose2 initial_pose();
   void publish_map_state();  // state_mutex_ held
@@ -122,6 +125,10 @@ class EstimatorNode {
   StepObserver step_observer_;
   EstimatorCounters counters_;
   std::optional<slam::MapCheckpoint> checkpoint_;  // read at start, used by create_filter()
+  std::string checkpoint_source_;                  // where checkpoint_ came from, for the log
+  // The filter before its last step that moved the time on by more than
+  // max_stamp_jump_s: what a rebase (that jump undone) restarts from.
+  std::optional<slam::MapCheckpoint> before_jump_;
   std::uint64_t last_checkpoint_ns_ = 0;
   std::uint64_t last_published_ns_ = 0;
   bool latest_published_ = true;  // map_state_ went out (map_state_period_s)

@@ -35,8 +35,10 @@ class SensorInbox {
     std::vector<slam::SensorInput> inputs;  // in stamp order
     bool stopping = false;                  // stop() was called: this is the last batch
     // The time went back (StampGate: a wrong jump undone): what was held is
-    // dropped, the inputs are at the new time, older than those before.
+    // dropped, the inputs are at the new time, older than those before, on a
+    // new epoch (epoch_ns()).
     bool rebased = false;
+    std::uint64_t rebased_to_ns = 0;  // the stamp the time went back to
   };
   // Waits for new input, for a held sample's release time, for stop() or at
   // most 0.1 s, then returns what may be consumed now.
