@@ -21,6 +21,7 @@
 #include "pixyslam/slam_node/map_state_conversions.h"
 #include "temp_dir.h"
 #include "raw_sample_writer.h"
+#include "sensor_writers.h"
 #include "sim_sensor_messages.h"
 
 namespace pixyslam::map_optimizer_node {
@@ -75,6 +76,20 @@ void feed(const sim::WorldRun& run, std::uint64_t base_ns, dds::Writer<msg::Odom
   ASSERT_TRUE(odometry_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
   ASSERT_TRUE(observation_writer.wait_for_acknowledgments(std::chrono::seconds(10)));
 }
+
+// Signed seconds from base to stamp (a stamp a few ns before base is not 2^64 ns after it).
+double seconds_after(std::uint64_t base_ns, std::uint64_t stamp_ns) {
+  return static_cast<double>(static_cast<std::int64_t>(stamp_ns - base_ns)) * 1e-9;
+}
+
+// What map_optimizer --out-dir writes, as seconds after base.
+void collect_keyframes(OptimizerNode& node, std::uint64_t base_ns, std::vector<eval::TimedPose>& out) {
+  node.set_keyframe_sink([&out, base_ns](std::uint64_t stamp_ns, const slam::Pose2& pose) {
+    out.push_back({seconds_after(base_ns, stamp_ns), pose.x(), pose.y(), pose.z()});
+  });
+}
+
+using test_support::SensorWriters;
 
 TEST(OptimizerNode, OptimisesBesideTheEstimatorFromDdsInput) {
   const sim::WorldRun run = simulated_minute();
@@ -174,16 +189,11 @@ TEST(OptimizerNode, AProblemAtItsKeyframeLimitStartsAnewWithItsLandmarksAsPriors
   options.max_keyframes = 150;  // 10 Hz frames: a new problem every ~15 s
   OptimizerNode node(options);
   std::vector<eval::TimedPose> emitted;  // what map_optimizer --out-dir writes
-  node.set_keyframe_sink([&](std::uint64_t stamp_ns, const slam::Pose2& pose) {
-    emitted.push_back({static_cast<double>(stamp_ns - base_ns) * 1e-9, pose.x(), pose.y(), pose.z()});
-  });
+  collect_keyframes(node, base_ns, emitted);
   node.start();
-  dds::Participant sensors(options.dds, "test_sensors");
-  dds::Writer<msg::Odometry> odometry_writer(sensors);
-  dds::Writer<msg::LandmarkObservation> observation_writer(sensors);
-  ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
-  ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
-  feed(run, base_ns, odometry_writer, observation_writer);
+  SensorWriters sensors(options.dds);
+  ASSERT_TRUE(sensors.matched());
+  feed(run, base_ns, sensors.odometry, sensors.observations);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   node.stop();
 
@@ -220,11 +230,6 @@ TEST(OptimizerNode, AProblemAtItsKeyframeLimitStartsAnewWithItsLandmarksAsPriors
   EXPECT_LT(eval::compare_trajectory(emitted, run.truth).ate_rmse_m, 0.15);
 }
 
-// Signed seconds from base to stamp (a stamp a few ns before base is not 2^64 ns after it).
-double seconds_after(std::uint64_t base_ns, std::uint64_t stamp_ns) {
-  return static_cast<double>(static_cast<std::int64_t>(stamp_ns - base_ns)) * 1e-9;
-}
-
 // A consistent pair of odometry samples a year ahead moves the time; the run's
 // own samples after it would all be dropped as late. Once only they came for a
 // second, the time goes back: a new problem from the newest keyframe before
@@ -236,22 +241,17 @@ TEST(OptimizerNode, AfterAHostilePairOfFutureStampsTheOptimiserGoesOnAtTheRunsTi
   options.initial_pose = run.initial_pose;
   OptimizerNode node(options);
   std::vector<eval::TimedPose> emitted;
-  node.set_keyframe_sink([&](std::uint64_t stamp_ns, const slam::Pose2& pose) {
-    emitted.push_back({seconds_after(base_ns, stamp_ns), pose.x(), pose.y(), pose.z()});
-  });
+  collect_keyframes(node, base_ns, emitted);
   node.start();
-  dds::Participant sensors(options.dds, "test_sensors");
-  dds::Writer<msg::Odometry> odometry_writer(sensors);
-  dds::Writer<msg::LandmarkObservation> observation_writer(sensors);
-  ASSERT_TRUE(odometry_writer.wait_for_readers(1, std::chrono::seconds(10)));
-  ASSERT_TRUE(observation_writer.wait_for_readers(1, std::chrono::seconds(10)));
+  SensorWriters sensors(options.dds);
+  ASSERT_TRUE(sensors.matched());
   const std::uint64_t year_ns = 365ull * 86400ull * 1000000000ull;
   for (int i = 0; i < 2; ++i) {
     msg::Odometry m = test_support::odometry_msg(run.odometry[0], 0.1, base_ns + year_ns + 100'000'000ull * i);
-    ASSERT_TRUE(odometry_writer.publish(m));
+    ASSERT_TRUE(sensors.odometry.publish(m));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  feed(run, base_ns, odometry_writer, observation_writer);  // ~1.8 s of arrivals
+  feed(run, base_ns, sensors.odometry, sensors.observations);  // ~1.8 s of arrivals
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   node.stop();
 

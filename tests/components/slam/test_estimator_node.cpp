@@ -19,6 +19,7 @@
 #include "pixyslam/slam_node/estimator_node.h"
 #include "pixyslam/slam_node/map_state_conversions.h"
 #include "raw_sample_writer.h"
+#include "sensor_writers.h"
 #include "sim_sensor_messages.h"
 
 namespace pixyslam::slam_node {
@@ -85,19 +86,7 @@ sim::WorldOptions test_world(double duration_s) {
   return world;
 }
 
-// The sensors' side of a test: one participant with an odometry and a camera writer.
-struct SensorWriters {
-  explicit SensorWriters(const dds::DdsOptions& options)
-      : participant(options, "test_sensors"), odometry(participant), observations(participant) {}
-  // Both writers matched with the estimator's readers (within 10 s each).
-  bool matched() {
-    return odometry.wait_for_readers(1, std::chrono::seconds(10)) &&
-           observations.wait_for_readers(1, std::chrono::seconds(10));
-  }
-  dds::Participant participant;
-  dds::Writer<msg::Odometry> odometry;
-  dds::Writer<msg::LandmarkObservation> observations;
-};
+using test_support::SensorWriters;
 
 TEST(EstimatorNode, MapsTheSimulatedWorldFromDdsInputInTimeOrder) {
   const sim::WorldOptions world = test_world(60.0);
