@@ -155,23 +155,7 @@ void OptimizerNode::step(const slam::SensorInput& input) {
   std::lock_guard<std::mutex> lock(state_mutex_);
   const double t = slam::input_time(input);
   if (!optimizer_ && rebase_pending_) {
-    // After a rebase: the keyframes before the new time stay (written out), the
-    // ones after it (the jump) go, and the new problem starts at the newest kept.
-    const std::uint64_t old_epoch_ns = epoch_ns_;
-    epoch_ns_ = inbox_.epoch_ns();  // the inbox's new one
-    const std::uint64_t now_ns = slam_node::to_stamp_ns(t, epoch_ns_);
-    next_pose_ = options_.initial_pose;
-    last_emitted_ns_.reset();
-    for (const map_optimizer::Keyframe& k : rebase_keyframes_) {
-      const std::uint64_t stamp = slam_node::to_stamp_ns(k.t_s, old_epoch_ns);
-      if (stamp >= now_ns) break;
-      next_pose_ = k.pose;
-      if (keyframe_sink_) keyframe_sink_(stamp, k.pose);
-      last_emitted_ns_ = stamp;
-    }
-    rebase_keyframes_.clear();
-    rebase_pending_ = false;
-    begin_problem(t);
+    begin_problem_after_rebase(t);
   } else if (!optimizer_) {
     epoch_ns_ = inbox_.epoch_ns();
     optimizer_ = std::make_unique<map_optimizer::MapOptimizer>(options_.optimizer, options_.initial_pose, t);
@@ -287,14 +271,35 @@ void OptimizerNode::restart_at_new_time() {
                next_landmarks_.size());
 }
 
+void OptimizerNode::begin_problem_after_rebase(double t_s) {
+  // The keyframes before the new time stay (written out), the ones after it
+  // (the jump) go, and the new problem starts at the newest kept.
+  const std::uint64_t old_epoch_ns = epoch_ns_;
+  epoch_ns_ = inbox_.epoch_ns();  // the inbox's new one
+  const std::uint64_t now_ns = slam_node::to_stamp_ns(t_s, epoch_ns_);
+  next_pose_ = options_.initial_pose;
+  last_emitted_ns_.reset();
+  for (const map_optimizer::Keyframe& k : rebase_keyframes_) {
+    const std::uint64_t stamp = slam_node::to_stamp_ns(k.t_s, old_epoch_ns);
+    if (stamp >= now_ns) break;
+    next_pose_ = k.pose;
+    emit_keyframe(stamp, k.pose);
+  }
+  rebase_keyframes_.clear();
+  rebase_pending_ = false;
+  begin_problem(t_s);
+}
+
 void OptimizerNode::emit_keyframes() {
-  if (!keyframe_sink_) return;
   for (const map_optimizer::Keyframe& k : optimizer_->keyframes()) {
     const std::uint64_t stamp = slam_node::to_stamp_ns(k.t_s, epoch_ns_);
-    if (last_emitted_ns_ && stamp <= *last_emitted_ns_) continue;
-    keyframe_sink_(stamp, k.pose);
-    last_emitted_ns_ = stamp;
+    if (!last_emitted_ns_ || stamp > *last_emitted_ns_) emit_keyframe(stamp, k.pose);
   }
+}
+
+void OptimizerNode::emit_keyframe(std::uint64_t stamp_ns, const slam::Pose2& pose) {
+  if (keyframe_sink_) keyframe_sink_(stamp_ns, pose);
+  last_emitted_ns_ = stamp_ns;
 }
 
 map_optimizer::OptimizerCounters OptimizerNode::optimizer_counters() const {

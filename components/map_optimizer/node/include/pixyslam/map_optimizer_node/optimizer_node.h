@@ -126,9 +126,13 @@ class OptimizerNode {
   void begin_problem(double t_s);
   // After SensorInbox's rebase: the next input begins a new problem.
   void restart_at_new_time();
+  // That new problem, at the first input's time t_s.
+  void begin_problem_after_rebase(double t_s);
   // The current problem's keyframes after the last emitted to the sink (a new
   // problem begins with a keyframe at the time the last one ended).
   void emit_keyframes();
+  // One keyframe to the sink; it is the last emitted.
+  void emit_keyframe(std::uint64_t stamp_ns, const slam::Pose2& pose);
   // The core's counters over every segment.
   map_optimizer::OptimizerCounters optimizer_counters() const;
   void publish(const map_optimizer::SolveSummary& s, bool whole);

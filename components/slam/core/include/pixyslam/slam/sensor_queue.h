@@ -98,10 +98,8 @@ class StampGate {
     }
     Held& mine = held_[stream];
     if (behind(stamp_ns)) {
-      if (!behind_run_) {
-        behind_run_ = true;
+      if (behind_count_ == 0) {
         behind_since_ns_ = arrival_ns;
-        behind_count_ = 0;
         behind_newest_ns_ = stamp_ns;
       }
       ++behind_count_;
@@ -109,7 +107,7 @@ class StampGate {
       if (behind_count_ >= kRebaseSamples &&
           static_cast<double>(arrival_ns) - static_cast<double>(behind_since_ns_) >= max_hold_ns_) {
         reference_ns_ = behind_newest_ns_;
-        behind_run_ = false;
+        behind_count_ = 0;
         for (Held& h : held_) {
           if (h.has) drop(h);
         }
@@ -117,7 +115,7 @@ class StampGate {
         rebased_ = true;
       }
     } else if (known(stamp_ns)) {
-      behind_run_ = false;
+      behind_count_ = 0;
     }
     if (known(stamp_ns)) {
       reference_ns_ = std::max(reference_ns_, stamp_ns);
@@ -191,9 +189,10 @@ class StampGate {
   bool has_reference_ = false;
   std::uint64_t reference_ns_ = 0;
   std::uint64_t dropped_ = 0;
-  bool behind_run_ = false;  // only samples behind the time since behind_since_ns_ (arrival)
-  std::uint64_t behind_since_ns_ = 0;
+  // The run of samples behind the time with none at it between (0: none),
+  // since behind_since_ns_ (arrival).
   std::uint64_t behind_count_ = 0;
+  std::uint64_t behind_since_ns_ = 0;
   std::uint64_t behind_newest_ns_ = 0;
   std::uint64_t rebases_ = 0;
   bool rebased_ = false;
