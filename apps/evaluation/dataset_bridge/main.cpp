@@ -4,7 +4,7 @@
 // sigmas) and GroundTruth, header.robot_id "robot<N>", on the recording's
 // timeline at --rate times its speed (0: as fast as the readers acknowledge).
 //   dataset_bridge --config config/dataset_bridge.yaml --dataset DIR [--robots 1,2] [--rate R] [--duration S]
-//                  [--set KEY=VALUE ...] [--domain N]
+//                  [--set KEY=VALUE ...] [--domain N] [--verbose]
 // Exit status: 0 when every sample was published, 1 when DDS refused some or
 // readers did not acknowledge in time (counted), 2 for a usage, configuration
 // or data set error.
@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   app::StopSignal::install();
   std::string config, dataset, robots;
   double rate = -1.0, duration_s = 0.0;
+  bool verbose = false;
   std::vector<std::string> overrides, domain;
   app::Cli cli{"dataset_bridge",
                "A multi-robot recording (MRCLAM data set) onto the live topics: each robot's Odometry, "
@@ -43,6 +44,7 @@ int main(int argc, char** argv) {
       .type("S");
   app::add_set(cli, overrides, "dataset_bridge.wait_readers=2");
   app::add_domain(cli, domain);
+  app::add_verbose(cli, verbose);
   cli.footer("dataset_bridge parameters (dataset_bridge:; robots apart):\n" +
              parameters::help_text(dataset_bridge_node::dataset_bridge_parameters(), "dataset_bridge") +
              "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
@@ -59,6 +61,7 @@ int main(int argc, char** argv) {
     dataset_bridge_node::apply_overrides(options, overrides);
   });
   if (bad) return *bad;
+  if (verbose) app::print_effective_configuration("dataset_bridge", dataset_bridge_node::to_yaml(options));
   return app::run_main("dataset_bridge", [&] {
     // An input that is missing or does not read is a runtime failure (1), as in
     // slam_offline, pixyslam_calibrate and pixyslam_spy.

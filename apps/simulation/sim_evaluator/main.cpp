@@ -6,14 +6,16 @@
 // optimiser runs (pixyslam/optimised_map), the same for its newest solution
 // (keyframes against the truth, its landmarks) and its CPU time.
 //   sim_evaluator [--config config/slam_estimator.yaml] [--set dds.KEY=V ...] [--domain N] [--out-dir DIR] [--max-ate M]
-//                 [--max-optimised-ratio R]
+//                 [--max-optimised-ratio R] [--verbose]
 // Exit code 1 if the ATE exceeds --max-ate or nothing was estimated; with
 // --max-optimised-ratio also when no OptimisedMap arrived or its landmark RMSE
 // is above R times the filter's (1: at most the filter's).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -22,6 +24,7 @@
 #include "pixyslam/app/stop_signal.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/dds/endpoints.h"
+#include "pixyslam/dds/newest_stamp.h"
 #include "pixyslam/eval/csv_io.h"
 #include "pixyslam/eval/trajectory_metrics.h"
 
@@ -30,6 +33,27 @@ namespace {
 
 double seconds(std::uint64_t stamp_ns) { return static_cast<double>(stamp_ns) * 1e-9; }
 
+// A map's landmarks, each id once (the first): a sample from another
+// participant may repeat one, which would leave the map unscorable.
+template <class Landmarks>
+std::vector<eval::LandmarkPoint> unique_landmarks(const Landmarks& landmarks, std::uint64_t& duplicates) {
+  std::vector<eval::LandmarkPoint> out;
+  std::set<int> ids;
+  for (const auto& l : landmarks) {
+    if (ids.insert(l.landmark_id()).second) {
+      out.push_back({l.landmark_id(), l.x_m(), l.y_m()});
+    } else {
+      ++duplicates;
+    }
+  }
+  return out;
+}
+
+void sort_by_time(std::vector<eval::TimedPose>& poses) {
+  std::stable_sort(poses.begin(), poses.end(),
+                   [](const eval::TimedPose& a, const eval::TimedPose& b) { return a.t_s < b.t_s; });
+}
+
 // Everything received, under one lock (callbacks come from DDS threads).
 struct Received {
   std::mutex mutex;
@@ -37,6 +61,10 @@ struct Received {
   std::vector<eval::TimedPose> truth;
   std::vector<eval::LandmarkPoint> true_landmarks;
   std::vector<eval::LandmarkPoint> map;
+  // Stale MapState and OptimisedMap samples are dropped; one stamped far ahead
+  // (any participant can send one) does not stop the rest (dds::NewestStamp).
+  dds::NewestStamp map_order, optimised_order;
+  std::uint64_t duplicate_landmark_ids = 0;
   double last_update_ms = 0.0;
   std::vector<double> update_ms;
   // The newest OptimisedMap.
@@ -44,7 +72,6 @@ struct Received {
   std::vector<eval::TimedPose> optimised_keyframes;
   std::vector<eval::LandmarkPoint> optimised_landmarks;
   double optimiser_cpu_s = 0.0;
-  std::uint64_t optimised_stamp_ns = 0;
 };
 
 template <class Message>
@@ -65,11 +92,13 @@ struct Arguments {
   std::string out_dir;
   double max_ate_m = 0.0;
   double max_optimised_ratio = -1.0;  // < 0: not checked
+  bool verbose = false;
 };
 
 int run(const Arguments& args) {
   dds::DdsOptions dds_options = dds::read_dds_options_file(args.config, dds::default_profiles_file());
   dds::resolve_settings(dds_options, args.dds_overrides);
+  if (args.verbose) app::print_effective_configuration("sim_evaluator", dds::to_yaml(dds_options));
 
   Received r;
   dds::Participant participant(dds_options, "sim_evaluator");
@@ -80,30 +109,25 @@ int run(const Arguments& args) {
   dds::Reader<msg::GroundTruth> truth(participant, [&](const msg::GroundTruth& m) {
     std::lock_guard<std::mutex> lock(r.mutex);
     r.truth.push_back({seconds(m.header().stamp_ns()), m.pose().x_m(), m.pose().y_m(), m.pose().theta_rad()});
-    if (r.true_landmarks.empty()) {
-      for (const msg::TrueLandmark& l : m.landmarks()) r.true_landmarks.push_back({l.landmark_id(), l.x_m(), l.y_m()});
-    }
+    if (r.true_landmarks.empty()) r.true_landmarks = unique_landmarks(m.landmarks(), r.duplicate_landmark_ids);
   }, robot);
   dds::Reader<msg::MapState> maps(participant, [&](const msg::MapState& m) {
     std::lock_guard<std::mutex> lock(r.mutex);
-    const double t = seconds(m.header().stamp_ns());
-    if (!r.estimate.empty() && t < r.estimate.back().t_s) return;  // a late joiner's old state
-    r.estimate.push_back({t, m.mean_pose().x_m(), m.mean_pose().y_m(), m.mean_pose().theta_rad()});
+    if (!r.map_order.take(m.header().stamp_ns())) return;  // a late joiner's old state
+    r.estimate.push_back({seconds(m.header().stamp_ns()), m.mean_pose().x_m(), m.mean_pose().y_m(),
+                          m.mean_pose().theta_rad()});
     r.update_ms.push_back(m.update_time_s() * 1e3);
-    r.map.clear();
-    for (const msg::LandmarkEstimate& l : m.landmarks()) r.map.push_back({l.landmark_id(), l.x_m(), l.y_m()});
+    r.map = unique_landmarks(m.landmarks(), r.duplicate_landmark_ids);
   }, robot);
   dds::Reader<msg::OptimisedMap> optimised(participant, [&](const msg::OptimisedMap& m) {
     std::lock_guard<std::mutex> lock(r.mutex);
-    if (r.optimised_maps > 0 && m.header().stamp_ns() < r.optimised_stamp_ns) return;  // an older solution
+    if (!r.optimised_order.take(m.header().stamp_ns())) return;  // an older solution
     ++r.optimised_maps;
-    r.optimised_stamp_ns = m.header().stamp_ns();
     r.optimised_keyframes.clear();
     for (const msg::OptimisedKeyframe& k : m.keyframes()) {
       r.optimised_keyframes.push_back({seconds(k.stamp_ns()), k.pose().x_m(), k.pose().y_m(), k.pose().theta_rad()});
     }
-    r.optimised_landmarks.clear();
-    for (const msg::OptimisedLandmark& l : m.landmarks()) r.optimised_landmarks.push_back({l.landmark_id(), l.x_m(), l.y_m()});
+    r.optimised_landmarks = unique_landmarks(m.landmarks(), r.duplicate_landmark_ids);
     r.optimiser_cpu_s = m.cpu_time_s();
   }, robot);
   std::fprintf(stderr, "sim_evaluator: listening on DDS domain %d\n", dds_options.domain_id);
@@ -117,10 +141,20 @@ int run(const Arguments& args) {
   print_topic(maps);
   print_topic(truth);
   print_topic(optimised);
+  if (r.map_order.time_resets() + r.optimised_order.time_resets() + r.duplicate_landmark_ids > 0) {
+    std::printf("sim_evaluator: %llu samples stamped far behind the newest taken (the time went back), %llu repeated "
+                "landmark ids dropped\n",
+                static_cast<unsigned long long>(r.map_order.time_resets() + r.optimised_order.time_resets()),
+                static_cast<unsigned long long>(r.duplicate_landmark_ids));
+  }
   if (r.estimate.empty() || r.truth.empty()) {
     std::printf("sim_evaluator: no %s received: nothing to evaluate\n", r.estimate.empty() ? "MapState" : "GroundTruth");
     return 1;
   }
+  // In time order, whatever order the samples came in.
+  sort_by_time(r.estimate);
+  sort_by_time(r.truth);
+  sort_by_time(r.optimised_keyframes);
   const eval::TrajectoryErrors pose = eval::compare_trajectory(r.estimate, r.truth);
   const eval::LandmarkErrors landmarks = eval::compare_landmarks(r.map, r.true_landmarks);
   std::printf("sim_evaluator: %zu estimates over %.1f s, %zu ground-truth poses compared\n", r.estimate.size(),
@@ -193,6 +227,7 @@ int main(int argc, char** argv) {
                  "exit 1 if no OptimisedMap arrived or its landmark RMSE is above R times the filter's")
       .type("R")
       .non_negative();
+  app::add_verbose(cli, args.verbose);
   if (const auto done = cli.parse(argc, argv)) return *done;
   args.dds_overrides = sets;
   args.dds_overrides.insert(args.dds_overrides.end(), domain.begin(), domain.end());

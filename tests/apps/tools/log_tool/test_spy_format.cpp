@@ -423,6 +423,19 @@ TEST(SpyFormat, DiagnosticsTableOneReportPerProcessSortedAndWrapped) {
       "robot1 slam_estimator (pid 40): WARN, up 12 s: observations_gated +2\n"
       "    counter_number_0 0 counter_number_1 1000\n";
   EXPECT_EQ(table, expected);
+  // Any participant can publish a report: its texts cannot drive the terminal.
+  const std::string hostile = diagnostics_table({report("robot\x1b[2J", "slam\xc2\x9b" "2J", 1, 0, "ok\r\x07", 0)});
+  EXPECT_EQ(hostile, "robot?[2J slam?2J (pid 1): OK, up 12 s: ok??\n");
+}
+
+// Strings from the network in echo's YAML and JSON: every control character
+// (C0, DEL, C1) escaped, bytes that are not UTF-8 as U+FFFD: valid JSON that
+// cannot drive a terminal; other UTF-8 as sent.
+TEST(SpyFormat, StringsFromTheNetworkAreEscapedAndStayValidUtf8) {
+  msg::Odometry m = odometry();
+  m.header().robot_id("r\x1b\x7f\xc2\x9b\xff\xc3\xa9\"");
+  const std::string json = to_json_line(to_value(m));
+  EXPECT_NE(json.find("\"robot_id\":\"r\\u001b\\u007f\\u009b\\ufffd\xc3\xa9\\\"\""), std::string::npos) << json;
 }
 
 }  // namespace

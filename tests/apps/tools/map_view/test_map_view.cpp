@@ -601,6 +601,25 @@ TEST(MsgConversion, OptimisedMapReplacesTheOptimisedSolution) {
   EXPECT_EQ(builder.optimised_maps(), 2u);
 }
 
+// Any participant can stamp a sample 2^64 - 1 ns: after it, the robot's own
+// states (far behind it) are drawn again instead of being ignored as stale for
+// ever; a state a little older than the newest is still stale.
+TEST(MsgConversion, OneStampFarAheadDoesNotFreezeTheView) {
+  MapViewBuilder builder(0.0);
+  const std::uint64_t t0 = 1'700'000'000'000'000'000ULL;
+  ASSERT_TRUE(builder.add(map_state(t0, 0.1, 2)));
+  ASSERT_TRUE(builder.add(map_state(~std::uint64_t{0}, 5.0, 1)));
+  ASSERT_TRUE(builder.add(map_state(t0 + 100'000'000ULL, 0.2, 2)));
+  ASSERT_TRUE(builder.add(map_state(t0 + 200'000'000ULL, 0.3, 3)));
+  EXPECT_DOUBLE_EQ(builder.state().current_pose->x_m, 0.3);
+  EXPECT_EQ(builder.state().landmarks.size(), 3u);
+  EXPECT_FALSE(builder.add(map_state(t0 + 150'000'000ULL, 9.0, 1)));
+  EXPECT_EQ(builder.map_states(), 4u);
+  ASSERT_TRUE(builder.add(optimised_map(~std::uint64_t{0}, 2, 9.0)));
+  ASSERT_TRUE(builder.add(optimised_map(t0 + 300'000'000ULL, 3, 0.0)));
+  EXPECT_EQ(builder.state().optimised_trajectory.size(), 3u);
+}
+
 // Any participant can invent robot ids: past kMaxRobots their samples are
 // dropped and counted, and the robots already drawn go on.
 TEST(FleetView, InventedRobotsPastTheLimitAreDroppedAndCounted) {

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "pixyslam/dds/cdr_payload.h"
+#include "pixyslam/dds/newest_stamp.h"
 #include "pixyslam/dds/topic_selection.h"
 #include "pixyslam/dds/topics.h"
 #include "pixyslam/dds/wire_text.h"
@@ -99,6 +100,38 @@ TEST(WireText, ControlBytesAreReplacedAndLongTextIsCut) {
   EXPECT_EQ(printable(std::string("a\x1b[2Jb\n\x7f\0c", 10)), "a?[2Jb???c");
   EXPECT_EQ(printable(std::string(100, 'x'), 10), std::string(10, 'x') + "...");
   EXPECT_EQ(printable("caf\xc3\xa9"), "caf\xc3\xa9");  // UTF-8 kept
+}
+
+// 8-bit controls act on terminals too: C1 (U+009B is an escape-sequence start,
+// U+0085 a line break) and raw bytes that are no UTF-8 become '?'; a cut never
+// splits a character.
+TEST(WireText, C1ControlsAndBytesThatAreNotUtf8AreReplaced) {
+  EXPECT_EQ(printable("a\xc2\x9b" "31mb\xc2\x85" "c"), "a?31mb?c");
+  EXPECT_EQ(printable("a\x9b" "31m"), "a?31m");                      // a lone continuation byte
+  EXPECT_EQ(printable("\xc0\xaf\xe0\x80\xaf"), "?????");         // overlong forms
+  EXPECT_EQ(printable("\xed\xa0\x80"), "???");                     // a surrogate
+  EXPECT_EQ(printable("\xf4\x90\x80\x80"), "????");               // above U+10FFFF
+  EXPECT_EQ(printable("x\xe2\x82"), "x??");                         // cut short
+  EXPECT_EQ(printable("\xe2\x82\xac\xf0\x9f\x98\x80\xc2\xa0"), "\xe2\x82\xac\xf0\x9f\x98\x80\xc2\xa0");
+  EXPECT_EQ(printable("ab\xe2\x82\xac", 4), "ab...");  // the euro sign would not fit whole
+  EXPECT_EQ(printable("ab\xe2\x82\xac", 5), "ab\xe2\x82\xac");
+}
+
+// A reader of the newest state: stale samples (a little older than the newest)
+// are dropped, but one stamp far ahead does not make every later sample stale.
+TEST(NewestStamp, DropsStaleSamplesButNotEverythingAfterAStampFarAhead) {
+  NewestStamp order(10);
+  EXPECT_TRUE(order.take(100));
+  EXPECT_TRUE(order.take(100));  // the same stamp again: taken
+  EXPECT_FALSE(order.take(95));  // a late joiner's older state
+  EXPECT_TRUE(order.take(~std::uint64_t{0}));
+  EXPECT_TRUE(order.take(105));  // far behind: the time went back
+  EXPECT_TRUE(order.take(110));
+  EXPECT_FALSE(order.take(100));  // stale again, relative to 110
+  EXPECT_EQ(order.taken(), 5u);
+  EXPECT_EQ(order.stale(), 2u);
+  EXPECT_EQ(order.time_resets(), 1u);
+  EXPECT_EQ(order.newest_ns(), 110u);
 }
 
 TEST(TopicSelection, GlobMatchesWholeNames) {

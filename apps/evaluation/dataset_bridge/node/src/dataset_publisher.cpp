@@ -85,6 +85,15 @@ void apply_overrides(DatasetBridgeOptions& o, const std::vector<std::string>& as
   dds::resolve_settings(o.dds, dds);
 }
 
+std::string to_yaml(const DatasetBridgeOptions& o) {
+  std::string robots;
+  for (int r : o.robots) robots += (robots.empty() ? "" : ", ") + std::to_string(r);
+  std::string bridge = parameters::to_yaml(o, dataset_bridge_parameters(), "dataset_bridge");
+  bridge.insert(bridge.find('\n') + 1, "  robots: [" + robots + "]\n");
+  return bridge + parameters::to_yaml(o.filter, slam::filter_parameters(), "filter") +
+         parameters::to_yaml(o.sensor_model, offline::mrclam_sensor_parameters(), "mrclam") + dds::to_yaml(o.dds);
+}
+
 namespace {
 
 std::uint64_t to_ns(double t_s) { return static_cast<std::uint64_t>(std::llround(t_s * 1e9)); }

@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "pixyslam/dds/wire_text.h"
+
 namespace pixyslam::log_tool {
 
 Value Value::number(double v) {
@@ -146,25 +148,37 @@ Value optimised_landmark_value(const msg::OptimisedLandmark& l) {
 
 bool is_scalar(const Value& v) { return v.kind() != Value::Kind::kStruct && v.kind() != Value::Kind::kList; }
 
-// JSON string literal (also a valid YAML double-quoted scalar).
+// JSON string literal (also a valid YAML double-quoted scalar). The text comes
+// from the network: control characters (C0, DEL, C1) are escaped, so none
+// reaches the reader's terminal, and bytes that are not UTF-8 become U+FFFD,
+// so the output stays valid JSON.
 std::string quoted(const std::string& s) {
   std::string out = "\"";
-  for (const char c : s) {
-    switch (c) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    char32_t cp = 0;
+    const std::size_t length = dds::utf8_sequence(s, i, &cp);
+    if (length == 0) {
+      out += "\\ufffd";
+      ++i;
+      continue;
+    }
+    switch (cp) {
       case '"': out += "\\\""; break;
       case '\\': out += "\\\\"; break;
       case '\n': out += "\\n"; break;
       case '\r': out += "\\r"; break;
       case '\t': out += "\\t"; break;
       default:
-        if (static_cast<unsigned char>(c) < 0x20) {
+        if (dds::control_code_point(cp)) {
           char buf[8];
-          std::snprintf(buf, sizeof(buf), "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+          std::snprintf(buf, sizeof(buf), "\\u%04x", static_cast<unsigned>(cp));
           out += buf;
         } else {
-          out += c;
+          out.append(s, i, length);
         }
     }
+    i += length;
   }
   return out + "\"";
 }
@@ -416,15 +430,16 @@ std::string diagnostics_table(std::vector<msg::Diagnostics> reports) {
   std::string out;
   for (const msg::Diagnostics& d : reports) {
     char head[256];
-    std::snprintf(head, sizeof(head), "%s %s (pid %u): %s, up %.0f s", d.header().robot_id().c_str(),
-                  d.process().c_str(), static_cast<unsigned>(d.pid()), d.level() < 3 ? kLevels[d.level()] : "?",
-                  d.uptime_s());
+    // Every text in a report is another participant's: no control byte reaches the terminal.
+    std::snprintf(head, sizeof(head), "%s %s (pid %u): %s, up %.0f s", dds::printable(d.header().robot_id()).c_str(),
+                  dds::printable(d.process()).c_str(), static_cast<unsigned>(d.pid()),
+                  d.level() < 3 ? kLevels[d.level()] : "?", d.uptime_s());
     out += head;
-    if (!d.status().empty()) out += ": " + d.status();
+    if (!d.status().empty()) out += ": " + dds::printable(d.status(), 240);
     out += "\n";
     std::string line = "   ";
     for (const msg::DiagnosticCounter& c : d.counters()) {
-      const std::string item = " " + c.name() + " " + std::to_string(c.value());
+      const std::string item = " " + dds::printable(c.name()) + " " + std::to_string(c.value());
       if (line.size() + item.size() > 100) {
         out += line + "\n";
         line = "   ";

@@ -61,10 +61,8 @@ void MapViewBuilder::note_stamp(std::uint64_t stamp_ns) {
 
 bool MapViewBuilder::add(const msg::MapState& m) {
   const std::uint64_t stamp = m.header().stamp_ns();
-  if (map_states_ > 0 && stamp < last_map_ns_) return false;
+  if (!map_order_.take(stamp)) return false;
   note_stamp(stamp);
-  last_map_ns_ = stamp;
-  ++map_states_;
 
   state_.particles.clear();
   for (const msg::Pose2D& p : m.particle_poses()) state_.particles.push_back(to_pose(p));
@@ -92,10 +90,8 @@ void MapViewBuilder::add(const msg::GroundTruth& g) {
 
 bool MapViewBuilder::add(const msg::OptimisedMap& m) {
   const std::uint64_t stamp = m.header().stamp_ns();
-  if (optimised_maps_ > 0 && stamp < last_optimised_ns_) return false;
+  if (!optimised_order_.take(stamp)) return false;
   note_stamp(stamp);
-  last_optimised_ns_ = stamp;
-  ++optimised_maps_;
   // Each solution holds the whole trajectory: it replaces the one before.
   state_.optimised_trajectory.clear();
   for (const Point2& p : to_trajectory(m)) append_point(state_.optimised_trajectory, p, min_step_m_);
@@ -113,9 +109,7 @@ std::vector<LandmarkView> to_landmarks(const msg::FleetMap& map) {
 }
 
 bool FleetViewBuilder::add(const msg::FleetMap& map) {
-  if (fleet_maps_ > 0 && map.header().stamp_ns() < last_fleet_ns_) return false;
-  last_fleet_ns_ = map.header().stamp_ns();
-  ++fleet_maps_;
+  if (!fleet_order_.take(map.header().stamp_ns())) return false;
   fleet_landmarks_ = to_landmarks(map);
   return true;
 }

@@ -33,6 +33,9 @@ const parameters::Table<DatasetBridgeOptions>& dataset_bridge_parameters();
 DatasetBridgeOptions read_dataset_bridge_options_file(const std::string& path);
 // "dataset_bridge.KEY=V", "dds.KEY=V"; validated; DDS settings resolved.
 void apply_overrides(DatasetBridgeOptions& options, const std::vector<std::string>& assignments);
+// The effective configuration as YAML (--verbose): dataset_bridge:, the
+// filter_config's filter: and mrclam: it takes sigmas and corrections from, dds:.
+std::string to_yaml(const DatasetBridgeOptions& options);
 
 struct PublishCounters {
   std::uint64_t odometry = 0, observations = 0, ground_truth = 0, sightings = 0;

@@ -10,6 +10,7 @@
 #include "fleet_map.h"
 #include "ground_truth.h"
 #include "optimised_map.h"
+#include "pixyslam/dds/newest_stamp.h"
 #include "pixyslam/map_view/map_view_state.h"
 
 namespace pixyslam::map_view {
@@ -29,8 +30,10 @@ std::vector<LandmarkView> to_landmarks(const msg::FleetMap& map);   // times_obs
 // true trajectories accumulated so far (decimated by `trajectory_min_step_m`);
 // the latest optimised solution (its keyframes, decimated alike, and
 // landmarks) replaces the one before. A MapState or OptimisedMap stamped
-// before the last one of its kind taken (a late joiner's stale state) is
-// ignored. Caption times are relative to the first stamp of any kind.
+// up to 10 s before the last one of its kind taken (a late joiner's stale
+// state) is ignored; further behind, the time went back (dds::NewestStamp:
+// one stamp far ahead cannot freeze the view). Caption times are relative to
+// the first stamp of any kind.
 // Thread-compatible (the live view guards it with a mutex).
 class MapViewBuilder {
  public:
@@ -44,9 +47,9 @@ class MapViewBuilder {
   bool add(const msg::OptimisedMap& map);
 
   const MapViewState& state() const { return state_; }
-  std::size_t map_states() const { return map_states_; }
+  std::size_t map_states() const { return map_order_.taken(); }
   std::size_t ground_truths() const { return ground_truths_; }
-  std::size_t optimised_maps() const { return optimised_maps_; }
+  std::size_t optimised_maps() const { return optimised_order_.taken(); }
 
  private:
   void note_stamp(std::uint64_t stamp_ns);
@@ -54,13 +57,10 @@ class MapViewBuilder {
   double min_step_m_;
   PathThinning mean_path_, true_path_;
   MapViewState state_;
-  std::size_t map_states_ = 0;
+  dds::NewestStamp map_order_, optimised_order_;
   std::size_t ground_truths_ = 0;
-  std::size_t optimised_maps_ = 0;
   bool have_start_ = false;
   std::uint64_t start_ns_ = 0;
-  std::uint64_t last_map_ns_ = 0;
-  std::uint64_t last_optimised_ns_ = 0;
 };
 
 // One MapViewBuilder per robot (header.robot_id): several robots on one
@@ -85,7 +85,7 @@ class FleetViewBuilder {
     MapViewBuilder* b = robot(map.header().robot_id());
     return b != nullptr && b->add(map);
   }
-  // The newest fleet map (older ones are ignored: false).
+  // The newest fleet map (older ones are ignored as MapState's: false).
   bool add(const msg::FleetMap& map);
 
   MapViewState state() const;
@@ -94,7 +94,7 @@ class FleetViewBuilder {
   std::size_t map_states() const { return total(&MapViewBuilder::map_states); }
   std::size_t ground_truths() const { return total(&MapViewBuilder::ground_truths); }
   std::size_t optimised_maps() const { return total(&MapViewBuilder::optimised_maps); }
-  std::size_t fleet_maps() const { return fleet_maps_; }
+  std::size_t fleet_maps() const { return fleet_order_.taken(); }
   // Samples dropped because their robot id would be robot kMaxRobots + 1.
   std::size_t over_robot_limit() const { return over_robot_limit_; }
 
@@ -106,9 +106,8 @@ class FleetViewBuilder {
   double min_step_m_;
   std::map<std::string, MapViewBuilder> robots_;
   std::vector<LandmarkView> fleet_landmarks_;
-  std::size_t fleet_maps_ = 0;
+  dds::NewestStamp fleet_order_;
   std::size_t over_robot_limit_ = 0;
-  std::uint64_t last_fleet_ns_ = 0;
 };
 
 }  // namespace pixyslam::map_view
