@@ -1,7 +1,7 @@
 // encoder_bridge: the Arduino's wheel-encoder lines (serial) -> Odometry over
 // DDS at publish_rate_hz, until SIGINT/SIGTERM.
 //   encoder_bridge --config config/encoder_bridge.yaml [--device PATH] [--set KEY=VALUE ...] [--domain N] [--verbose]
-// --device overrides encoder_bridge.serial_device; --set encoder_bridge.KEY=V,
+// --device overrides node.serial_device; --set encoder_bridge.KEY=V,
 // node.KEY=V or dds.KEY=V a parameter. --verbose prints the effective configuration to
 // stdout; logs go to stderr. Exit status: 0 after a clean stop, 2 for a
 // configuration or command-line error, 1 for any other failure.
@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
   const std::optional<int> bad = app::configure("encoder_bridge", [&] {
     options = encoder_node::read_encoder_node_options_file(args.config);
     encoder_node::apply_overrides(options, args.overrides);
-    bridge::apply_command_line(args, options.encoder.serial_device, options.dds);
+    bridge::apply_command_line(args, options.process.serial_device, options.dds);
   });
   if (bad) return *bad;
   if (args.verbose) app::print_effective_configuration("encoder_bridge", encoder_node::to_yaml(options));

@@ -154,7 +154,7 @@ int main(int argc, char** argv) {
     if (!parameters::take_section(args.overrides, "camera").empty()) {
       throw std::invalid_argument("--set camera.KEY=V needs the camera backend: --camera INPUT or a camera: section");
     }
-    bridge::apply_command_line(args, options.serial_device, options.dds);
+    bridge::apply_command_line(args, options.process.serial_device, options.dds);
   });
   if (bad) return *bad;
   std::string effective = pixy_node::to_yaml(options);
@@ -168,7 +168,7 @@ int main(int argc, char** argv) {
 #ifdef PIXYSLAM_HAS_CAMERA
     if (camera_options) source = std::make_unique<camera::CameraByteSource>(*camera_options, bridge::stderr_log(name));
 #endif
-    if (!source) source = std::make_unique<bridge::SerialByteSource>(options.serial_device, options.baud);
+    if (!source) source = std::make_unique<bridge::SerialByteSource>(options.process.serial_device, options.process.baud);
     pixy_node::PixyNode node(options, std::move(source), bridge::stderr_log(name));
     node.start();
     while (!app::StopSignal::wait_for(std::chrono::milliseconds(200))) {

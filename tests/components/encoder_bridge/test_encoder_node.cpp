@@ -85,25 +85,29 @@ std::string config_error_of(const std::string& text) {
 TEST(EncoderNodeOptions, ShippedConfigLoadsWithNodeAndDds) {
   const EncoderNodeOptions o =
       read_encoder_node_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/encoder_bridge.yaml");
-  EXPECT_EQ(o.encoder.serial_device, "/dev/ttyACM0");
+  EXPECT_EQ(o.process.serial_device, "/dev/ttyACM0");
+  EXPECT_EQ(o.process.baud, 115200);
   EXPECT_DOUBLE_EQ(o.process.reopen_period_s, 1.0);
   EXPECT_DOUBLE_EQ(o.clock_window_s, 1.0);
   EXPECT_EQ(o.dds.profiles_file, std::string(PIXYSLAM_CONFIG_DIR) + "/dds/profiles.xml");
   // The core's file reader accepts the same file.
-  EXPECT_EQ(encoder::read_encoder_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/encoder_bridge.yaml")
-                .serial_device,
-            "/dev/ttyACM0");
+  EXPECT_DOUBLE_EQ(encoder::read_encoder_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/encoder_bridge.yaml")
+                       .wheel_base_m,
+                   o.encoder.wheel_base_m);
 }
 
 TEST(EncoderNodeOptions, EffectiveConfigurationReadsBack) {
   auto root = config::YamlReader::from_string(
-      valid_yaml("node:\n  reopen_period_s: 0.25\n  status_period_s: 0\n  clock_window_s: 2\n"
+      valid_yaml("node:\n  serial_device: /dev/ttyUSB1\n  baud: 57600\n  reopen_period_s: 0.25\n  status_period_s: 0\n"
+                 "  clock_window_s: 2\n"
                  "dds:\n  domain_id: 3\n  profiles_file: /x/p.xml\n  robot_id: r7\n"),
       "test.yaml");
   const EncoderNodeOptions o = read_encoder_node_options(root, "/cfg");
   auto again_root = config::YamlReader::from_string(to_yaml(o), "again.yaml");
   const EncoderNodeOptions again = read_encoder_node_options(again_root, "/elsewhere");
   EXPECT_EQ(to_yaml(again), to_yaml(o));
+  EXPECT_EQ(again.process.serial_device, "/dev/ttyUSB1");
+  EXPECT_EQ(again.process.baud, 57600);
   EXPECT_DOUBLE_EQ(again.process.reopen_period_s, 0.25);
   EXPECT_DOUBLE_EQ(again.process.status_period_s, 0.0);
   EXPECT_DOUBLE_EQ(again.clock_window_s, 2.0);
@@ -121,6 +125,12 @@ TEST(EncoderNodeOptions, ErrorsNameTheFileAndTheKey) {
       {valid_yaml("node:\n  reopen_period_s: 0\n"), "test.yaml: key 'node.reopen_period_s': value 0"},
       {valid_yaml("node:\n  clock_window: 1\n"), "test.yaml: key 'node.clock_window': unknown key"},
       {valid_yaml("node:\n  clock_window_s: abc\n"), "test.yaml: key 'node.clock_window_s'"},
+      // The serial link is the process's, as in pixy_bridge.yaml; a non-standard
+      // rate is refused with the list of the standard ones.
+      {valid_yaml("node:\n  serial_device: ttyACM0\n"), "key 'node.serial_device': value 'ttyACM0' is not an absolute path"},
+      {valid_yaml("node:\n  baud: 115201\n"), "key 'node.baud': value 115201 is not a standard serial rate (50, "},
+      {valid_yaml("node:\n  baud: 2e5\n"), "key 'node.baud': expected an integer"},
+      {"encoder_bridge:\n  serial_device: /dev/ttyACM0\n", "key 'encoder_bridge.serial_device': moved to node.serial_device"},
       {valid_yaml("dds:\n  domain_id: 300\n"), "test.yaml: key 'dds.domain_id'"},
       {valid_yaml("nodes: {}\n"), "test.yaml: key 'nodes': unknown key"},
       {"node: {}\n", "test.yaml: key 'encoder_bridge': missing"},
@@ -415,7 +425,7 @@ TEST(EncoderNode, ReadsARealPseudoTerminalAndReportsItsHangup) {
   const std::string device = ::testing::TempDir() + "encoder_node_pty_" + std::to_string(::getpid());
   auto pty = std::make_unique<serial::PseudoTerminal>(device);
   EncoderNodeOptions options = node_options();
-  options.encoder.serial_device = device;
+  options.process.serial_device = device;
   LogLines log;
   OdometryInbox& inbox = odometry_inbox();
   inbox.clear();

@@ -504,8 +504,6 @@ TEST(EncoderPipeline, SimulatedArduinoStreamGivesConstantVelocities) {
 
 const char* kFullYaml =
     "encoder_bridge:\n"
-    "  serial_device: /dev/ttyUSB1\n"
-    "  baud: 57600\n"
     "  wheel_radius_m: 0.034\n"
     "  ticks_per_revolution: 960\n"
     "  wheel_base_m: 0.142\n"
@@ -545,8 +543,6 @@ std::string bridge_yaml(const std::string& key = "", const std::string& value = 
 
 TEST(EncoderOptions, ReadsEveryKey) {
   const EncoderOptions o = read_text(kFullYaml);
-  EXPECT_EQ(o.serial_device, "/dev/ttyUSB1");
-  EXPECT_EQ(o.baud, 57600);
   EXPECT_DOUBLE_EQ(o.wheel_radius_m, 0.034);
   EXPECT_EQ(o.ticks_per_revolution, 960);
   EXPECT_DOUBLE_EQ(o.wheel_base_m, 0.142);
@@ -560,8 +556,6 @@ TEST(EncoderOptions, ReadsEveryKey) {
 TEST(EncoderOptions, OptionalKeysDefault) {
   const EncoderOptions o = read_text(bridge_yaml());
   const EncoderOptions d;
-  EXPECT_EQ(o.serial_device, d.serial_device);
-  EXPECT_EQ(o.baud, 115200);
   EXPECT_DOUBLE_EQ(o.publish_rate_hz, 10.0);
   EXPECT_DOUBLE_EQ(o.max_wheel_speed_mps, d.max_wheel_speed_mps);
 }
@@ -569,8 +563,6 @@ TEST(EncoderOptions, OptionalKeysDefault) {
 TEST(EncoderOptions, ToYamlRoundTrips) {
   const EncoderOptions d;
   const EncoderOptions o = read_text(to_yaml(d));
-  EXPECT_EQ(o.serial_device, d.serial_device);
-  EXPECT_EQ(o.baud, d.baud);
   EXPECT_EQ(o.wheel_radius_m, d.wheel_radius_m);
   EXPECT_EQ(o.ticks_per_revolution, d.ticks_per_revolution);
   EXPECT_EQ(o.wheel_base_m, d.wheel_base_m);
@@ -579,15 +571,6 @@ TEST(EncoderOptions, ToYamlRoundTrips) {
   const EncoderOptions f = read_text(kFullYaml);
   EXPECT_EQ(read_text(to_yaml(f)).right_sign, -1);
   EXPECT_EQ(read_text(to_yaml(f)).wheel_radius_m, 0.034);
-}
-
-TEST(EncoderOptions, NonStandardBaudNamesFileKeyAndValue) {
-  const std::string e = config_error_of([] { read_text(bridge_yaml("baud", "115201")); });
-  EXPECT_NE(e.find("test.yaml: key 'encoder_bridge.baud'"), std::string::npos) << e;
-  EXPECT_NE(e.find("115201"), std::string::npos) << e;
-  EXPECT_NE(e.find("230400"), std::string::npos) << e;  // lists the allowed rates
-  for (const long b : {9600L, 38400L, 115200L, 230400L, 921600L, 4000000L}) EXPECT_TRUE(is_standard_baud(b));
-  for (const long b : {0L, 14400L, 28800L, 100000L, 115201L}) EXPECT_FALSE(is_standard_baud(b));
 }
 
 TEST(EncoderOptions, ErrorsNameTheKeyPath) {
@@ -607,9 +590,6 @@ TEST(EncoderOptions, ErrorsNameTheKeyPath) {
       {bridge_yaml("publish_rate_hz", "0"), "key 'encoder_bridge.publish_rate_hz': value 0 is out of range"},
       {bridge_yaml("max_wheel_speed_mps", "fast"), "key 'encoder_bridge.max_wheel_speed_mps': expected a finite number"},
       {bridge_yaml("max_sample_gap_s", "100"), "key 'encoder_bridge.max_sample_gap_s': value 100 is out of range"},
-      {bridge_yaml("serial_device", "ttyACM0"), "key 'encoder_bridge.serial_device': value 'ttyACM0' is not an absolute path"},
-      {bridge_yaml("baud", "2e5"), "key 'encoder_bridge.baud': expected an integer"},
-      {bridge_yaml("baud", "9000000"), "key 'encoder_bridge.baud': value 9000000 is out of range"},
       {bridge_yaml() + "other: 1\n", "test.yaml: key 'other': unknown key"},
       {"encoder_bridge: 3\n", "key 'encoder_bridge': expected a mapping"},
   };
@@ -629,7 +609,7 @@ TEST(EncoderOptions, ShippedConfigFileIsValidAndMatchesTheDefaults) {
   const EncoderOptions options =
       read_encoder_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/encoder_bridge.yaml");
   const EncoderOptions defaults;
-  EXPECT_EQ(options.serial_device, defaults.serial_device);
+  EXPECT_DOUBLE_EQ(options.wheel_radius_m, defaults.wheel_radius_m);
   EXPECT_EQ(options.ticks_per_revolution, defaults.ticks_per_revolution);
   EXPECT_DOUBLE_EQ(options.wheel_base_m, defaults.wheel_base_m);
   EXPECT_DOUBLE_EQ(options.publish_rate_hz, 10.0);

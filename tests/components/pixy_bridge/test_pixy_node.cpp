@@ -117,15 +117,15 @@ const char* kPixyYaml = "pixy:\n  landmark_height_m: 0.08\n  landmarks:\n    \"1
 
 TEST(PixyNodeOptions, ShippedConfigLoadsWithNodeAndDds) {
   const PixyNodeOptions o = read_pixy_node_options_file(std::string(PIXYSLAM_CONFIG_DIR) + "/pixy_bridge.yaml");
-  EXPECT_EQ(o.serial_device, "/dev/serial0");
-  EXPECT_EQ(o.baud, 19200);
+  EXPECT_EQ(o.process.serial_device, "/dev/serial0");
+  EXPECT_EQ(o.process.baud, 19200);
   EXPECT_DOUBLE_EQ(o.camera_latency_s, 0.0);
   // The file's node: values are the defaults, as it says.
   const PixyNodeOptions defaults;
   EXPECT_DOUBLE_EQ(o.frame_timeout_s, 0.01);
   EXPECT_DOUBLE_EQ(o.frame_timeout_s, defaults.frame_timeout_s);
-  EXPECT_EQ(o.serial_device, defaults.serial_device);
-  EXPECT_EQ(o.baud, defaults.baud);
+  EXPECT_EQ(o.process.serial_device, defaults.process.serial_device);
+  EXPECT_EQ(o.process.baud, defaults.process.baud);
   EXPECT_DOUBLE_EQ(o.camera_latency_s, defaults.camera_latency_s);
   EXPECT_DOUBLE_EQ(o.process.reopen_period_s, defaults.process.reopen_period_s);
   EXPECT_DOUBLE_EQ(o.process.status_period_s, defaults.process.status_period_s);
@@ -144,8 +144,8 @@ TEST(PixyNodeOptions, EffectiveConfigurationReadsBack) {
   auto again_root = config::YamlReader::from_string(to_yaml(o), "again.yaml");
   const PixyNodeOptions again = read_pixy_node_options(again_root, "/elsewhere");
   EXPECT_EQ(to_yaml(again), to_yaml(o));
-  EXPECT_EQ(again.serial_device, "/dev/ttyUSB3");
-  EXPECT_EQ(again.baud, 115200);
+  EXPECT_EQ(again.process.serial_device, "/dev/ttyUSB3");
+  EXPECT_EQ(again.process.baud, 115200);
   EXPECT_DOUBLE_EQ(again.camera_latency_s, 0.02);
   EXPECT_DOUBLE_EQ(again.frame_timeout_s, 0.1);
   EXPECT_DOUBLE_EQ(again.process.reopen_period_s, 2.0);
@@ -161,7 +161,7 @@ TEST(PixyNodeOptions, ErrorsNameTheFileAndTheKey) {
   };
   const std::string pixy = kPixyYaml;
   const std::vector<Case> cases = {
-      {"node:\n  baud: 12345\n" + pixy, "test.yaml: key 'node.baud': value 12345 is not a supported serial rate"},
+      {"node:\n  baud: 12345\n" + pixy, "test.yaml: key 'node.baud': value 12345 is not a standard serial rate"},
       {"node:\n  serial_device: ttyS0\n" + pixy, "test.yaml: key 'node.serial_device': value 'ttyS0' is not an absolute path"},
       {"node:\n  camera_latency_s: 2\n" + pixy, "test.yaml: key 'node.camera_latency_s': value 2"},
       {"node:\n  reopen_period_s: 0\n" + pixy, "test.yaml: key 'node.reopen_period_s'"},

@@ -5,6 +5,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "pixyslam/serial/serial_port.h"
+
 namespace pixyslam::bridge {
 
 DeviceReaderOptions device_reader_options(const BridgeProcessOptions& o) {
@@ -14,10 +16,18 @@ DeviceReaderOptions device_reader_options(const BridgeProcessOptions& o) {
   return d;
 }
 
+void validate_serial_link(const BridgeProcessOptions& o, const std::string& section) {
+  if (serial::is_supported_baud(o.baud)) return;
+  std::string rates;
+  for (const long b : serial::supported_bauds()) rates += (rates.empty() ? "" : ", ") + std::to_string(b);
+  throw parameters::RuleError(section, "baud",
+                              "value " + std::to_string(o.baud) + " is not a standard serial rate (" + rates + ")");
+}
+
 void add_bridge_flags(app::Cli& cli, BridgeCommandLine& args, const std::string& config_help,
                       const std::string& set_example) {
   app::add_config(cli, args.config, config_help);
-  cli.option("--device", args.device, "the serial device (overrides the config's)").type("PATH");
+  cli.option("--device", args.device, "the serial device (overrides node.serial_device)").type("PATH");
   app::add_set(cli, args.overrides, set_example + " or dds.participant_profile=lan_multicast");
   app::add_domain(cli, args.domain);
   app::add_verbose(cli, args.verbose);

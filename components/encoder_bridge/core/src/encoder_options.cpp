@@ -1,45 +1,15 @@
 #include "pixyslam/encoder/encoder_options.h"
 
-#include <array>
 #include <sstream>
 #include <stdexcept>
 
 #include "pixyslam/config/parameters_yaml.h"
 
 namespace pixyslam::encoder {
-namespace {
-
-constexpr std::array<long, 30> kStandardBauds = {
-    50,     75,     110,    134,     150,     200,     300,     600,     1200,    1800,
-    2400,   4800,   9600,   19200,   38400,   57600,   115200,  230400,  460800,  500000,
-    576000, 921600, 1000000, 1152000, 1500000, 2000000, 2500000, 3000000, 3500000, 4000000};
-
-std::string baud_list() {
-  std::string s;
-  for (const long b : kStandardBauds) s += (s.empty() ? "" : ", ") + std::to_string(b);
-  return s;
-}
-
-}  // namespace
-
-bool is_standard_baud(long baud) {
-  for (const long b : kStandardBauds) {
-    if (b == baud) return true;
-  }
-  return false;
-}
-
 const parameters::Table<EncoderOptions>& encoder_parameters() {
   using O = EncoderOptions;
   namespace P = parameters;
-  const auto absolute_path = [](const std::string& v) {
-    if (v.empty() || v.front() != '/') throw std::invalid_argument("not an absolute path (e.g. /dev/ttyACM0)");
-  };
   static const P::Table<O> table = {
-      P::text<O>("serial_device", "the Arduino's serial device", [](O& o) -> std::string& { return o.serial_device; },
-                 absolute_path),
-      P::integer<O, int>("baud", 50, 4000000, "bit/s", "a standard serial rate (50 ... 4000000)",
-                         [](O& o) -> int& { return o.baud; }),
       P::required(P::real<O>("wheel_radius_m", 0.001, 1.0, "m", "wheel radius",
                              [](O& o) -> double& { return o.wheel_radius_m; })),
       P::required(P::integer<O, int>("ticks_per_revolution", 1, 10000000, "", "counter steps per wheel turn",
@@ -62,10 +32,6 @@ const parameters::Table<EncoderOptions>& encoder_parameters() {
 
 void validate(const EncoderOptions& o) {
   parameters::check_ranges(o, encoder_parameters(), "encoder_bridge");
-  if (!is_standard_baud(o.baud)) {
-    throw parameters::RuleError("encoder_bridge", "baud", "value " + std::to_string(o.baud) +
-                                                              " is not a standard serial rate (" + baud_list() + ")");
-  }
   for (const auto& [name, sign] : {std::pair{"left_sign", o.left_sign}, std::pair{"right_sign", o.right_sign}}) {
     if (sign == 0) throw parameters::RuleError("encoder_bridge", name, "value 0 is not a sign (expected 1 or -1)");
   }

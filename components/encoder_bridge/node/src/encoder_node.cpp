@@ -12,7 +12,7 @@ namespace pixyslam::encoder_node {
 
 EncoderNode::EncoderNode(const EncoderNodeOptions& options, bridge::LogFunction log)
     : EncoderNode(options,
-                  std::make_unique<bridge::SerialByteSource>(options.encoder.serial_device, options.encoder.baud),
+                  std::make_unique<bridge::SerialByteSource>(options.process.serial_device, options.process.baud),
                   std::move(log)) {}
 
 EncoderNode::EncoderNode(const EncoderNodeOptions& options, std::unique_ptr<bridge::ByteSource> source,

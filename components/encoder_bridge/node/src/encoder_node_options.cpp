@@ -8,7 +8,9 @@ namespace pixyslam::encoder_node {
 const parameters::Table<EncoderNodeOptions>& node_parameters() {
   using O = EncoderNodeOptions;
   static const parameters::Table<O> table = [] {
-    parameters::Table<O> t = bridge::process_parameters<O>([](O& o) -> bridge::BridgeProcessOptions& { return o.process; });
+    const auto process = [](O& o) -> bridge::BridgeProcessOptions& { return o.process; };
+    parameters::Table<O> t = bridge::serial_link_parameters<O>(process, "the Arduino's serial device");
+    for (parameters::Parameter<O>& p : bridge::process_parameters<O>(process)) t.push_back(std::move(p));
     t.push_back(parameters::real<O>("clock_window_s", 0.05, 60.0, "s", "window of the Arduino clock mapping (ArduinoClock)",
                                     [](O& o) -> double& { return o.clock_window_s; }));
     return t;
@@ -16,7 +18,10 @@ const parameters::Table<EncoderNodeOptions>& node_parameters() {
   return table;
 }
 
-void validate_node(const EncoderNodeOptions& o) { parameters::check_ranges(o, node_parameters(), "node"); }
+void validate_node(const EncoderNodeOptions& o) {
+  parameters::check_ranges(o, node_parameters(), "node");
+  bridge::validate_serial_link(o.process, "node");
+}
 
 void apply_overrides(EncoderNodeOptions& o, std::vector<std::string>& assignments) {
   for (const std::string& a : parameters::take_section(assignments, "encoder_bridge")) {
@@ -39,11 +44,15 @@ std::string help_text() {
 EncoderNodeOptions read_encoder_node_options(config::YamlReader& root, const std::string& config_dir) {
   EncoderNodeOptions o;
   config::YamlReader bridge = root.child("encoder_bridge");
+  for (const char* moved : {"serial_device", "baud"}) {
+    if (bridge.has(moved)) bridge.fail(moved, std::string("moved to node.") + moved + " (as in pixy_bridge.yaml)");
+  }
   o.encoder = encoder::read_encoder_options(bridge);
   if (root.has("node")) {
     config::YamlReader node = root.child("node");
     config::read_parameters(node, node_parameters(), o);
     node.finish();
+    config::check_rules(node, [&] { validate_node(o); });
   }
   o.dds = dds::read_dds_section(root, config_dir);
   root.finish();

@@ -23,7 +23,7 @@ const PixyNodeOptions& validated(const PixyNodeOptions& options) {
 }  // namespace
 
 PixyNode::PixyNode(const PixyNodeOptions& options, bridge::LogFunction log)
-    : PixyNode(options, std::make_unique<bridge::SerialByteSource>(options.serial_device, options.baud),
+    : PixyNode(options, std::make_unique<bridge::SerialByteSource>(options.process.serial_device, options.process.baud),
                std::move(log)) {}
 
 PixyNode::PixyNode(const PixyNodeOptions& options, std::unique_ptr<bridge::ByteSource> source,

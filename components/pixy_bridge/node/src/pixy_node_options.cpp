@@ -5,38 +5,24 @@
 
 #include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/config/yaml_reader.h"
-#include "pixyslam/serial/serial_port.h"
 
 namespace pixyslam::pixy_node {
-namespace {
-
-std::string baud_list() {
-  std::string s;
-  for (const long b : serial::supported_bauds()) s += (s.empty() ? "" : ", ") + std::to_string(b);
-  return s;
-}
-
-}  // namespace
 
 const parameters::Table<PixyNodeOptions>& node_parameters() {
   using O = PixyNodeOptions;
   namespace P = parameters;
   static const P::Table<O> table = [] {
-    P::Table<O> t = {
-        P::text<O>("serial_device", "the Pixy's UART (an absolute path)", [](O& o) -> std::string& { return o.serial_device; },
-                   [](const std::string& v) {
-                     if (v.empty() || v.front() != '/') throw std::invalid_argument("not an absolute path (e.g. /dev/serial0)");
-                   }),
-        P::integer<O, long>("baud", 1, 4000000, "bit/s", "the Pixy's UART rate (one of: " + baud_list() + ")",
-                            [](O& o) -> long& { return o.baud; }),
+    const auto process = [](O& o) -> bridge::BridgeProcessOptions& { return o.process; };
+    P::Table<O> t = bridge::serial_link_parameters<O>(process, "the Pixy's UART");
+    for (P::Parameter<O>& p : P::Table<O>{
         P::real<O>("camera_latency_s", 0.0, 1.0, "s", "subtracted from the host time a frame was read (exposure to UART)",
                    [](O& o) -> double& { return o.camera_latency_s; }),
         P::real<O>("frame_timeout_s", 0.005, 10.0, "s", "an open frame without new data this long is complete",
                    [](O& o) -> double& { return o.frame_timeout_s; }),
-    };
-    for (P::Parameter<O>& p : bridge::process_parameters<O>([](O& o) -> bridge::BridgeProcessOptions& { return o.process; })) {
+         }) {
       t.push_back(std::move(p));
     }
+    for (P::Parameter<O>& p : bridge::process_parameters<O>(process)) t.push_back(std::move(p));
     return t;
   }();
   return table;
@@ -44,10 +30,7 @@ const parameters::Table<PixyNodeOptions>& node_parameters() {
 
 void validate_node(const PixyNodeOptions& o) {
   parameters::check_ranges(o, node_parameters(), "node");
-  if (!serial::is_supported_baud(o.baud)) {
-    throw parameters::RuleError("node", "baud", "value " + std::to_string(o.baud) + " is not a supported serial rate (" +
-                                                    baud_list() + ")");
-  }
+  bridge::validate_serial_link(o.process, "node");
 }
 
 void apply_overrides(PixyNodeOptions& o, std::vector<std::string>& assignments) {

@@ -12,6 +12,10 @@ namespace pixyslam::bridge {
 
 DeviceReaderOptions device_reader_options(const BridgeProcessOptions& options);
 
+// The rule serial_link_parameters() leaves out: `section.baud` is a rate the
+// platform supports (parameters::RuleError listing them otherwise).
+void validate_serial_link(const BridgeProcessOptions& options, const std::string& section);
+
 // The flags both bridges share: --config FILE, --device PATH, --set KEY=VALUE
 // (the component's section or dds.), --verbose.
 struct BridgeCommandLine {

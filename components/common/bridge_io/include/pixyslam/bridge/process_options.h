@@ -12,6 +12,11 @@ namespace pixyslam::bridge {
 
 // Process settings every bridge has, in its config file's `node:` mapping.
 struct BridgeProcessOptions {
+  // The serial link (`node.serial_device`, `node.baud`); each bridge gives its
+  // own defaults (the encoder bridge: the Arduino's USB device; the pixy
+  // bridge: the Pi's GPIO UART).
+  std::string serial_device;
+  long baud = 115200;
   double reopen_period_s = 1.0;   // between attempts to open a missing or hung-up device
   double silence_warn_s = 5.0;    // an open device silent this long is logged and counted (0: never)
   double status_period_s = 10.0;  // counters to the log this often (0: only at exit)
@@ -22,6 +27,23 @@ struct BridgeProcessOptions {
   int wait_readers = 1;
   double wait_readers_timeout_s = 3.0;
 };
+
+// `node.serial_device` (an absolute path) and `node.baud` (checked against
+// the rates the platform supports by validate_serial_link(), bridge_options.h).
+template <class Options>
+parameters::Table<Options> serial_link_parameters(std::function<BridgeProcessOptions&(Options&)> member,
+                                                  const std::string& device_help) {
+  namespace P = parameters;
+  return {
+      P::text<Options>("serial_device", device_help + " (an absolute path)",
+                       [member](Options& o) -> std::string& { return member(o).serial_device; },
+                       [](const std::string& v) {
+                         if (v.empty() || v.front() != '/') throw std::invalid_argument("not an absolute path");
+                       }),
+      P::integer<Options, long>("baud", 1, 4000000, "bit/s", "the link's rate: a standard serial rate (e.g. 115200)",
+                                [member](Options& o) -> long& { return member(o).baud; }),
+  };
+}
 
 // The `node:` parameters every bridge has (reopen_period_s, silence_warn_s, status_period_s, ...),
 // for a bridge's own `node:` table; `member` finds them in its options.

@@ -7,14 +7,13 @@
 
 namespace pixyslam::encoder {
 
-// Options of the encoder bridge: the serial link to the Arduino, the wheel
-// geometry that turns ticks into metres, and the odometry output rate. SI units
+// Options of the encoder bridge: the wheel geometry that turns ticks into
+// metres, and the odometry output rate (the serial link is the process's,
+// `node.serial_device` and `node.baud`: encoder_node_options.h). SI units
 // as named. A sign of +1 means the wheel's counter increases when the wheel
 // rolls forward, -1 that it decreases (mirror-mounted motors). A plain value;
 // validate() checks it.
 struct EncoderOptions {
-  std::string serial_device = "/dev/ttyACM0";
-  int baud = 115200;                 // a standard termios rate (is_standard_baud)
   double wheel_radius_m = 0.0325;
   int ticks_per_revolution = 1320;   // counter steps per wheel turn (4 per quadrature cycle)
   double wheel_base_m = 0.135;       // distance between the wheels' contact points
@@ -25,9 +24,6 @@ struct EncoderOptions {
   double max_sample_gap_s = 0.5;     // longer Arduino intervals give no velocity
 };
 
-// True for the rates Linux termios names (B50 ... B4000000).
-bool is_standard_baud(long baud);
-
 // One declaration per field: key, range, unit, help.
 const parameters::Table<EncoderOptions>& encoder_parameters();
 
@@ -36,8 +32,7 @@ void validate(const EncoderOptions& options);
 
 // Reads the options from the keys of `reader` (the component's mapping, e.g.
 // `encoder_bridge` of config/encoder_bridge.yaml) and calls reader.finish().
-// serial_device, baud, publish_rate_hz, max_wheel_speed_mps and
-// max_sample_gap_s may be left out (defaults above); the wheel geometry
+// publish_rate_hz, max_wheel_speed_mps and max_sample_gap_s may be left out (defaults above); the wheel geometry
 // (wheel_radius_m, ticks_per_revolution, wheel_base_m, left_sign, right_sign)
 // is required. Throws config::ConfigError naming the file and the key path.
 EncoderOptions read_encoder_options(config::YamlReader& reader);

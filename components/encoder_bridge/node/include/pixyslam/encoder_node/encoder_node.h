@@ -43,7 +43,7 @@ struct EncoderNodeCounters {
 // the log every status_period_s and at stop(). Thread-safe.
 class EncoderNode {
  public:
-  // Reads options.encoder.serial_device at options.encoder.baud.
+  // Reads options.process.serial_device at options.process.baud.
   explicit EncoderNode(const EncoderNodeOptions& options,
                        bridge::LogFunction log = bridge::stderr_log("encoder_bridge"));
   // Reads `source` instead; `clock` (default dds::now_ns) stamps what it reads.

@@ -13,8 +13,9 @@ namespace pixyslam::encoder_node {
 // Everything the encoder_bridge process is configured with
 // (config/encoder_bridge.yaml).
 struct EncoderNodeOptions {
-  encoder::EncoderOptions encoder;       // `encoder_bridge:` (serial link, wheels, rate)
-  bridge::BridgeProcessOptions process;  // `node:` reopen_period_s, status_period_s
+  encoder::EncoderOptions encoder;  // `encoder_bridge:` (wheels, rate)
+  // `node:` the serial link (the Arduino's USB serial device), reopen_period_s, status_period_s, ...
+  bridge::BridgeProcessOptions process{"/dev/ttyACM0", 115200};
   double clock_window_s = 1.0;           // `node.clock_window_s`: Arduino clock mapping window (ArduinoClock)
   dds::DdsOptions dds;                   // `dds:`
 };
@@ -25,7 +26,7 @@ struct EncoderNodeOptions {
 EncoderNodeOptions read_encoder_node_options(config::YamlReader& root, const std::string& config_dir);
 EncoderNodeOptions read_encoder_node_options_file(const std::string& path);
 
-// The `node:` keys (reopen_period_s, status_period_s, clock_window_s).
+// The `node:` keys (serial_device, baud, reopen_period_s, status_period_s, clock_window_s).
 const parameters::Table<EncoderNodeOptions>& node_parameters();
 void validate_node(const EncoderNodeOptions& options);
 

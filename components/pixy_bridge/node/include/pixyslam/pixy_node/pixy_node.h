@@ -58,7 +58,7 @@ struct PixyNodeCounters {
 // status_period_s and at stop(). Thread-safe.
 class PixyNode {
  public:
-  // Reads options.serial_device at options.baud.
+  // Reads options.process.serial_device at options.process.baud.
   explicit PixyNode(const PixyNodeOptions& options, bridge::LogFunction log = bridge::stderr_log("pixy_bridge"));
   // Reads `source` instead; `clock` (default dds::now_ns) stamps what it reads.
   PixyNode(const PixyNodeOptions& options, std::unique_ptr<bridge::ByteSource> source, bridge::LogFunction log,

@@ -13,12 +13,12 @@ namespace pixyslam::pixy_node {
 
 // Everything the pixy_bridge process is configured with (config/pixy_bridge.yaml).
 struct PixyNodeOptions {
-  // `node:` -- the serial link and the process.
-  std::string serial_device = "/dev/serial0";  // the Pi's GPIO UART wired to the Pixy's UART
-  long baud = 19200;                           // the Pixy's UART default (PixyMon: Interface > UART baudrate)
+  // `node:` -- the serial link and the process. The link: the Pi's GPIO UART
+  // wired to the Pixy's UART, at the Pixy's default rate (PixyMon: Interface >
+  // UART baudrate).
+  bridge::BridgeProcessOptions process{"/dev/serial0", 19200};
   double camera_latency_s = 0.0;   // subtracted from the host time a frame was read (exposure to UART)
   double frame_timeout_s = 0.01;   // an open frame without new data this long is complete (docs/benchmarks.md)
-  bridge::BridgeProcessOptions process;  // reopen_period_s, status_period_s
   pixy::PixyOptions pixy;  // `pixy:` camera model and signature -> landmark map
   dds::DdsOptions dds;     // `dds:`
 };
