@@ -32,6 +32,22 @@ EstimatorOptions test_options() {
   return o;
 }
 
+// The shipped estimator keeps only the ids the shipped pixy bridge gives
+// (association.landmark_ids): the two files must name the same ids.
+TEST(EstimatorOptions, ShippedLandmarkIdsAreThoseOfThePixyBridgesColourCodes) {
+  const EstimatorOptions o = test_options();
+  config::YamlReader pixy_file = config::YamlReader::from_file(std::string(PIXYSLAM_CONFIG_DIR) + "/pixy_bridge.yaml");
+  config::YamlReader table = pixy_file.child("pixy").child("landmarks");
+  std::set<int> pixy_ids;
+  for (const std::string& code : table.keys()) pixy_ids.insert(static_cast<int>(table.integer(code, 0, 1000000)));
+  std::set<int> configured;
+  for (const auto& [first, last] : slam::parse_landmark_ids(o.filter.landmark_ids)) {
+    for (int id = first; id <= last; ++id) configured.insert(id);
+  }
+  EXPECT_FALSE(pixy_ids.empty());
+  EXPECT_EQ(configured, pixy_ids);
+}
+
 // Publishes the run's odometry and frames with stamps in [from_s, to_s],
 // interleaved by time, frames slightly out of order with odometry (as live:
 // odometry is sent at the end of its period). `pause` after every message (else

@@ -782,6 +782,38 @@ TEST(FastSlam2, NewLandmarkIdsBeyondTheMapLimitAreDroppedAndCounted) {
   }
 }
 
+// With the ids the camera can give configured (association.landmark_ids), a
+// sender inventing ids cannot fill the map: its detections are dropped and
+// counted, and a real new landmark is still mapped after 4096 invented ids.
+TEST(FastSlam2, IdsOutsideTheConfiguredLandmarkIdsAreDroppedAndCounted) {
+  FilterOptions o;
+  o.particles = 20;
+  o.max_map_landmarks = 8;
+  o.landmark_ids = {"1-5", "9"};
+  FastSlam2 f(o, Pose2(0.0, 0.0, 0.0));
+  f.add_odometry({0.0, 0.0, 0.0});
+  f.add_observations({1.0, {{1, 2.0, -0.5}, {5, 2.0, 0.5}}});
+  for (int i = 0; i < 4096; i += 4) {
+    f.add_observations({1.0 + 1e-4 * (i + 1), {{100 + i, 2.0, 0.0}, {101 + i, 3.0, 0.1}, {6 + i % 3, 2.5, 0.2}, {0, 1.5, 0.3}}});
+  }
+  f.add_observations({2.0, {{9, 2.0, 0.0}}});
+  std::vector<int> ids;
+  for (const LandmarkEstimate& l : f.landmarks_of_best()) ids.push_back(l.id);
+  EXPECT_EQ(ids, (std::vector<int>{1, 5, 9}));
+  EXPECT_EQ(f.counters().observations_unknown_id, 4096u);
+  EXPECT_EQ(f.counters().observations_over_map_limit, 0u);
+  EXPECT_EQ(parse_landmark_ids({"9", "1-5", "4-7", "8"}), (IdRanges{{1, 9}}));
+  EXPECT_TRUE(contains_id(parse_landmark_ids({"1-5", "9"}), 9));
+  EXPECT_FALSE(contains_id(parse_landmark_ids({"1-5", "9"}), 6));
+  EXPECT_FALSE(contains_id(parse_landmark_ids({"1-5", "9"}), 0));
+  for (const std::string bad : {"x", "5-1", "-3", "1-", "2000000", "1.5"}) {
+    EXPECT_THROW(parse_landmark_ids({bad}), std::invalid_argument) << bad;
+  }
+  // Maximum likelihood does not read the ids: the option is refused there.
+  o.association = Association::kMaximumLikelihood;
+  EXPECT_THROW(validate(o), std::invalid_argument);
+}
+
 // Property: whatever arrives (NaN, inf, negative or huge ranges, bearings out
 // of range, time going backwards or jumping by days, absurd speeds, bursts of
 // one landmark, unknown ids), the estimate and the map stay finite. Random

@@ -241,6 +241,7 @@ MapOptimizerOptions MapOptimizerOptions::from_filter(const slam::FilterOptions& 
   o.min_range_m = filter.min_range_m;
   o.max_range_m = filter.max_range_m;
   o.max_landmarks = filter.max_map_landmarks;
+  o.landmark_ids = slam::parse_landmark_ids(filter.landmark_ids);
   return o;
 }
 
@@ -411,6 +412,8 @@ void MapOptimizer::add_frame(const slam::ObservationFrame& frame, const std::opt
                               std::find(new_ids.begin(), new_ids.end(), d.landmark_id) != new_ids.end());
     if (!ok) {
       ++counters_.observations_invalid;
+    } else if (!options_.landmark_ids.empty() && !slam::contains_id(options_.landmark_ids, d.landmark_id)) {
+      ++counters_.observations_unknown_id;
     } else if (!known && landmarks_.size() + new_ids.size() >= static_cast<std::size_t>(options_.max_landmarks)) {
       ++counters_.observations_over_map_limit;
     } else {

@@ -116,6 +116,7 @@ diagnostics::Snapshot OptimizerNode::diagnostics_snapshot() const {
                 {"frames_dropped", o.frames_dropped, true},
                 {"observations_invalid", o.observations_invalid, true},
                 {"observations_over_map_limit", o.observations_over_map_limit, true},
+                {"observations_unknown_id", o.observations_unknown_id, true},
                 {"keyframes", o.keyframes, false},
                 {"observations", o.observations, false},
                 {"window_solves", c.window_solves, false},

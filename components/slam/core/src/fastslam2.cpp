@@ -92,6 +92,7 @@ FastSlam2::FastSlam2(const FilterOptions& options, const PoseGaussian& initial_p
     : options_(options), gate_d2_(0.0), rng_(options.seed) {
   validate(options_);
   gate_d2_ = gate_mahalanobis2(options_);
+  landmark_ids_ = parse_landmark_ids(options_.landmark_ids);
   new_landmark_d2_ = -2.0 * std::log(1.0 - options_.new_landmark_probability);  // chi-square, 2 dof
   if (!initial_pose.mean.allFinite() || !initial_pose.cov.allFinite() ||
       initial_pose.cov.diagonal().minCoeff() < 0.0) {
@@ -371,6 +372,11 @@ void FastSlam2::update_with_frame(const ObservationFrame& frame) {
                     plausible_sigma(d.bearing_sigma_rad);
     if (!ok) {
       ++counters_.observations_invalid;
+      continue;
+    }
+    if (options_.association == Association::kKnownId && !landmark_ids_.empty() &&
+        !contains_id(landmark_ids_, d.landmark_id)) {
+      ++counters_.observations_unknown_id;
       continue;
     }
     if (options_.association == Association::kKnownId && slot_of_id_.count(d.landmark_id) == 0 &&

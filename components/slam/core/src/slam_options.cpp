@@ -1,6 +1,8 @@
 #include "pixyslam/slam/slam_options.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -65,6 +67,17 @@ const parameters::Table<FilterOptions>& filter_parameters() {
                                  {"maximum_likelihood", Association::kMaximumLikelihood}},
                                 "landmarks by the detection's id, or per particle the most likely",
                                 [](O& o) -> Association& { return o.association; }),
+      P::list<O>("association.landmark_ids",
+                 "known_id: the landmark ids there are, each an id or a range A-B (e.g. 1-20); a detection with "
+                 "another id is dropped and counted (observations_unknown_id). Empty: every id",
+                 [](O& o) -> std::vector<std::string>& { return o.landmark_ids; },
+                 [](const std::string& item) {
+                   try {
+                     parse_landmark_ids({item});
+                   } catch (const std::invalid_argument&) {
+                     throw std::invalid_argument("not an id or a range A-B of ids (0 .. 1000000, the smaller first)");
+                   }
+                 }),
       P::real<O>("association.new_landmark_probability", 0.5, 0.999999999, "",
                  "maximum_likelihood: chi-square (2 dof) quantile beyond which a detection starts a landmark",
                  [](O& o) -> double& { return o.new_landmark_probability; }),
@@ -119,6 +132,10 @@ void validate(const FilterOptions& o) {
           "must be greater than min_range_m (" + parameters::number_text(o.min_range_m) + ")");
   require(o.error_correlation_s == 0.0 || o.association == Association::kKnownId, "observation.error_correlation_s",
           o.error_correlation_s, "needs association known_id (a landmark's last sighting is tracked by its id)");
+  if (!o.landmark_ids.empty() && o.association != Association::kKnownId) {
+    throw parameters::RuleError("filter", "association.landmark_ids",
+                                "needs association known_id (maximum likelihood does not read the ids)");
+  }
   const DelayedSamplingOptions& d = o.delayed_sampling;
   require(d.exit_heading_sigma_rad <= d.enter_heading_sigma_rad, "delayed_sampling.exit_heading_sigma_rad",
           d.exit_heading_sigma_rad,
@@ -138,6 +155,49 @@ void apply_overrides(FilterOptions& options, const std::vector<std::string>& ass
 double gate_mahalanobis2(const FilterOptions& o) {
   // Chi-square with 2 degrees of freedom: P(d2 <= x) = 1 - exp(-x / 2).
   return -2.0 * std::log(1.0 - o.gate_probability);
+}
+
+IdRanges parse_landmark_ids(const std::vector<std::string>& items) {
+  IdRanges ranges;
+  for (const std::string& item : items) {
+    const auto bad = [&](const std::string& why) {
+      return std::invalid_argument("landmark id item '" + item + "': " + why);
+    };
+    const std::size_t dash = item.find('-', 1);  // a leading '-' is a sign
+    const auto number = [&](const std::string& text) {
+      std::size_t used = 0;
+      long v = 0;
+      try {
+        v = std::stol(text, &used);
+      } catch (const std::exception&) {
+        throw bad("expected an id or a range A-B of ids");
+      }
+      if (used != text.size()) throw bad("expected an id or a range A-B of ids");
+      if (v < 0 || v > 1000000) throw bad("an id is 0 .. 1000000");
+      return static_cast<int>(v);
+    };
+    const int first = number(item.substr(0, dash));
+    const int last = dash == std::string::npos ? first : number(item.substr(dash + 1));
+    if (last < first) throw bad("a range runs from the smaller id to the larger");
+    ranges.emplace_back(first, last);
+  }
+  // Sorted and merged: contains_id() is one binary search.
+  std::sort(ranges.begin(), ranges.end());
+  IdRanges merged;
+  for (const auto& r : ranges) {
+    if (!merged.empty() && r.first <= merged.back().second + 1) {
+      merged.back().second = std::max(merged.back().second, r.second);
+    } else {
+      merged.push_back(r);
+    }
+  }
+  return merged;
+}
+
+bool contains_id(const IdRanges& ranges, int id) {
+  // The range starting last at or before id.
+  const auto after = std::upper_bound(ranges.begin(), ranges.end(), std::make_pair(id, std::numeric_limits<int>::max()));
+  return after != ranges.begin() && id <= std::prev(after)->second;
 }
 
 std::string to_string(Association association) {

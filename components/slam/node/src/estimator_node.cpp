@@ -138,6 +138,7 @@ diagnostics::Snapshot EstimatorNode::diagnostics_snapshot() const {
                 {"observations_gated", f.observations_gated, true},
                 {"observations_invalid", f.observations_invalid, true},
                 {"observations_over_map_limit", f.observations_over_map_limit, true},
+                {"observations_unknown_id", f.observations_unknown_id, true},
                 {"landmark_slots_recycled", f.landmark_slots_recycled, false},
                 {"resamples", f.resamples, false},
                 {"landmarks", map_state_.landmarks().size(), false},

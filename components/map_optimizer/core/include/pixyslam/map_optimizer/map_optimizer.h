@@ -67,6 +67,7 @@ struct MapOptimizerOptions {
   double min_range_m = 0.05;
   double max_range_m = 50.0;
   int max_landmarks = 4096;  // the filter's max_map_landmarks: detections of more ids are dropped
+  slam::IdRanges landmark_ids;  // the filter's association.landmark_ids: others dropped (empty: every id)
   double keyframe_interval_s = 1.0;
   // Huber threshold on the whitened residual norm: sqrt(chi2_2(0.95)).
   double huber_threshold = 2.4477;
@@ -122,6 +123,7 @@ struct OptimizerCounters {
   std::size_t observations = 0;       // range/bearing factors added
   std::size_t observations_invalid = 0;  // non-finite or outside the range limits
   std::size_t observations_over_map_limit = 0;  // a new id beyond max_landmarks: dropped
+  std::size_t observations_unknown_id = 0;  // an id outside landmark_ids: dropped
   std::size_t keyframes = 0;
   std::size_t solves = 0;
 
@@ -134,6 +136,7 @@ struct OptimizerCounters {
     observations += o.observations;
     observations_invalid += o.observations_invalid;
     observations_over_map_limit += o.observations_over_map_limit;
+    observations_unknown_id += o.observations_unknown_id;
     keyframes += o.keyframes;
     solves += o.solves;
     return *this;

@@ -63,6 +63,7 @@ struct FilterCounters {
   std::uint64_t observations_gated = 0;
   std::uint64_t observations_invalid = 0;
   std::uint64_t observations_over_map_limit = 0;  // would start a landmark beyond max_map_landmarks: dropped
+  std::uint64_t observations_unknown_id = 0;  // an id outside association.landmark_ids: dropped
   std::uint64_t landmark_slots_recycled = 0;  // maximum likelihood: landmarks no particle held any more, freed
   std::uint64_t resamples = 0;
   std::uint64_t delayed_sampling_starts = 0;  // particle-frames that began a joint state
@@ -222,6 +223,7 @@ class FastSlam2 {
   LandmarkEstimate to_output(const LandmarkEstimate& landmark) const;
 
   FilterOptions options_;
+  IdRanges landmark_ids_;  // options_.landmark_ids parsed (empty: every id)
   double gate_d2_;
   std::mt19937_64 rng_;
   LandmarkMapPool pool_;  // declared before particles_: outlives their maps

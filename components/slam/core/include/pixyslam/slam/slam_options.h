@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pixyslam/parameters/parameters.h"
@@ -112,6 +113,11 @@ struct FilterOptions {
   int gate_readmit_after = 3;
 
   Association association = Association::kKnownId;
+  // kKnownId: the landmark ids there are (the pixy bridge's colour-code table),
+  // each item an id ("7") or an inclusive range ("1-20"). A detection with
+  // another id is dropped and counted (observations_unknown_id): ids a faulty
+  // or hostile sender invents cannot fill max_map_landmarks. Empty: every id.
+  std::vector<std::string> landmark_ids;
   // kMaximumLikelihood: a detection starts a new landmark when no mapped one is
   // within this chi-square (2 dof) quantile of its predicted observation.
   double new_landmark_probability = 0.99;
@@ -153,6 +159,12 @@ void validate(const FilterOptions& options);
 // Applies "filter.KEY=VALUE" assignments (command-line overrides) in order,
 // then validate(); throws std::invalid_argument naming the first bad one.
 void apply_overrides(FilterOptions& options, const std::vector<std::string>& assignments);
+
+// FilterOptions::landmark_ids as inclusive [first, last] ranges, sorted;
+// throws std::invalid_argument naming a bad item. Empty: every id.
+using IdRanges = std::vector<std::pair<int, int>>;
+IdRanges parse_landmark_ids(const std::vector<std::string>& items);
+bool contains_id(const IdRanges& ranges, int id);
 
 // Squared Mahalanobis distance of the gate: chi-square quantile with 2 dof.
 double gate_mahalanobis2(const FilterOptions& options);
