@@ -2,7 +2,7 @@
 // set for every robot, several seeds per robot.
 //   mrclam_eval --dataset DIR --config FILE [--robots 1,2,3,4,5] [--seeds 1,2,3]
 //               [--association known_id|maximum_likelihood] [--segments SECONDS] [--loro]
-//               [--blind-return] [--optimise] [--set filter.KEY=V|mrclam.KEY=V|optimizer.KEY=V ...]
+//               [--blind-return] [--resume GAP_S] [--optimise] [--set filter.KEY=V|mrclam.KEY=V|optimizer.KEY=V ...]
 // --association maximum_likelihood withholds the landmark ids from the filter
 // (the landmark columns then match nothing by id; ATE and heading still count).
 // Every run also reports the pose NEES against the truth (3 dof, ideal mean 3).
@@ -24,6 +24,11 @@
 // cases of blind_return.h restarted from the truth every 60 s (the heading bias
 // alternating in sign): heading error at the return, after it and at the end
 // (docs/mrclam.md, "Blind stretch and return").
+// --resume GAP_S adds, per robot with ground truth and seed, the estimator
+// killed every 60 s and restarted GAP_S s later from a checkpoint taken then
+// (slam::resume_pose; the gap's odometry lost): the ATE and heading RMSE from
+// the restart to the end, beside the uninterrupted run's over the same time and
+// a resume from the saved pose alone (docs/robustness.md).
 // --optimise adds, to every full run and segment (and the LORO runs with the
 // held-out fit), the map optimiser over the whole run after the filter
 // (optimised_run.h): its ATE, heading RMSE and landmark errors beside the filter's.
@@ -57,6 +62,7 @@
 #include "pixyslam/mrclam/mrclam_fit.h"
 #include "pixyslam/offline/offline_run.h"
 #include "pixyslam/offline/optimizer_sets.h"
+#include "pixyslam/slam/map_checkpoint.h"
 #ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
 #include "pixyslam/offline/optimised_run.h"
 #endif
@@ -357,6 +363,13 @@ void run_loro(const std::string& dataset, slam::FilterOptions options, const off
   }
 }
 
+// One line: mean, median, p90 and worst of `values`, after a label padded to `width`.
+void print_distribution(const char* label, int width, const std::vector<double>& values, const char* unit) {
+  const offline::Summary x = offline::summarize(values);
+  std::printf("  %-*s mean %7.3f median %7.3f p90 %7.3f worst %7.3f %s\n", width, label, x.mean, x.median, x.p90, x.max,
+              unit);
+}
+
 // mrclam_eval --blind-return (see the top of this file).
 void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<int, offline::RunInput>>& inputs,
                       const std::vector<int>& seeds, const OptimiseRequest& optimise) {
@@ -414,9 +427,7 @@ void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<i
     }
   }
   const auto line = [](const char* label, const std::vector<double>& v, const char* unit) {
-    const offline::Summary x = offline::summarize(v);
-    std::printf("  %-36s mean %7.3f median %7.3f p90 %7.3f worst %7.3f %s\n", label, x.mean, x.median, x.p90, x.max,
-                unit);
+    print_distribution(label, 36, v, unit);
   };
   std::printf("BLIND RETURN: %zu cases (%zu starts without a return skipped)\n", at_return.size(), skipped);
   line("dead-reckoning heading error at return", dr_at_return, "deg");
@@ -430,6 +441,83 @@ void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<i
     line("map optimiser: heading error, last 10 s", opt_at_end, "deg");
     line("map optimiser: ATE after return", opt_ate_after, "m");
   }
+}
+
+// mrclam_eval --resume GAP_S (see the top of this file).
+void run_resume(slam::FilterOptions options, const std::vector<std::pair<int, offline::RunInput>>& inputs,
+                const std::vector<int>& seeds, double gap_s) {
+  constexpr double kDeg = 180.0 / M_PI;
+  constexpr double kEveryS = 60.0;
+  // The estimator's checkpoint.max_speed_mps and max_turn_rate_radps defaults.
+  constexpr double kMaxSpeedMps = 0.5, kMaxTurnRateRadps = 1.0;
+  std::printf("\nRESUME: the estimator killed every %.0f s and restarted %.2f s later from its checkpoint (pose "
+              "widened for the gap by %.1f m/s and %.1f rad/s, map as prior; the gap's odometry lost); scored to the "
+              "end against the uninterrupted run over the same time\n",
+              kEveryS, gap_s, kMaxSpeedMps, kMaxTurnRateRadps);
+  std::printf("%-5s %-5s %8s %9s %9s %9s %9s %9s %9s\n", "robot", "seed", "kill_s", "ATE_run", "ATE_res", "ATE_pose",
+              "head_run", "head_res", "head_pose");
+  std::vector<double> run_ate, res_ate, pose_ate, run_head, res_head, pose_head, res_extra, pose_extra;
+  for (const auto& [robot, input] : inputs) {
+    if (input.truth.empty()) continue;
+    const std::vector<eval::TimedPose> truth = offline::sorted_by_time(input.truth);
+    const std::vector<double> starts = offline::segment_starts(truth, kEveryS);
+    for (int seed : seeds) {
+      options.seed = static_cast<std::uint64_t>(seed);
+      // The uninterrupted run, with a checkpoint at the first step of each start (after the first).
+      std::vector<std::pair<double, slam::MapCheckpoint>> checkpoints;
+      std::size_t next = 1;
+      const offline::RunResult full = offline::run_filter(options, input, [&](const slam::FastSlam2& f, double t) {
+        if (next < starts.size() && t >= starts[next]) {
+          checkpoints.emplace_back(t, slam::checkpoint_of(f, 0));
+          ++next;
+        }
+      });
+      for (const auto& [kill_s, checkpoint] : checkpoints) {
+        const double resume_s = kill_s + gap_s;
+        std::vector<eval::TimedPose> run_after;
+        for (const eval::TimedPose& p : full.trajectory) {
+          if (p.t_s >= resume_s) run_after.push_back(p);
+        }
+        if (run_after.empty()) continue;
+        // As resumed, and as resumed from the pose alone (the held control not
+        // saved: a version-1 checkpoint), which is what the control buys.
+        slam::MapCheckpoint pose_only = checkpoint;
+        pose_only.control_v_mps = pose_only.control_w_radps = 0.0;
+        const auto resumed = [&](const slam::MapCheckpoint& c) {
+          return offline::run_filter(options, offline::resumed_after(input, kill_s, c, gap_s, kMaxSpeedMps,
+                                                                     kMaxTurnRateRadps, options.control_timeout_s))
+              .trajectory;
+        };
+        const eval::TrajectoryErrors run = eval::compare_trajectory(run_after, truth);
+        const eval::TrajectoryErrors res = eval::compare_trajectory(resumed(checkpoint), truth);
+        const eval::TrajectoryErrors pose = eval::compare_trajectory(resumed(pose_only), truth);
+        std::printf("%-5d %-5d %8.1f %9.3f %9.3f %9.3f %9.1f %9.1f %9.1f\n", robot, seed, kill_s - truth.front().t_s,
+                    run.ate_rmse_m, res.ate_rmse_m, pose.ate_rmse_m, run.heading_rmse_rad * kDeg,
+                    res.heading_rmse_rad * kDeg, pose.heading_rmse_rad * kDeg);
+        std::fflush(stdout);
+        run_ate.push_back(run.ate_rmse_m);
+        res_ate.push_back(res.ate_rmse_m);
+        pose_ate.push_back(pose.ate_rmse_m);
+        run_head.push_back(run.heading_rmse_rad * kDeg);
+        res_head.push_back(res.heading_rmse_rad * kDeg);
+        pose_head.push_back(pose.heading_rmse_rad * kDeg);
+        res_extra.push_back(res.ate_rmse_m - run.ate_rmse_m);
+        pose_extra.push_back(pose.ate_rmse_m - run.ate_rmse_m);
+      }
+    }
+  }
+  const auto line = [](const char* label, const std::vector<double>& v, const char* unit) {
+    print_distribution(label, 44, v, unit);
+  };
+  std::printf("RESUME: %zu restarts, %.2f s gap\n", run_ate.size(), gap_s);
+  line("ATE after the restart, uninterrupted run", run_ate, "m");
+  line("ATE after the restart, resumed", res_ate, "m");
+  line("ATE after the restart, resumed from the pose only", pose_ate, "m");
+  line("resumed minus uninterrupted ATE", res_extra, "m");
+  line("resumed from the pose only minus uninterrupted", pose_extra, "m");
+  line("heading RMSE, uninterrupted run", run_head, "deg");
+  line("heading RMSE, resumed", res_head, "deg");
+  line("heading RMSE, resumed from the pose only", pose_head, "deg");
 }
 
 // The CSV files of --out-dir (none when the folder is empty).
@@ -546,6 +634,7 @@ struct EvalArguments {
   std::vector<std::string> sets;  // --set: filter.KEY=V, mrclam.KEY=V or optimizer.KEY=V
   double segment_every_s = 0.0;  // 0: no segments
   bool loro = false, blind_return = false;
+  double resume_gap_s = -1.0;  // < 0: no resume evaluation
   OptimiseRequest optimise;
 };
 
@@ -620,7 +709,7 @@ int run(const EvalArguments& args) {
   for (int robot : robots) {
     const mrclam::RobotData data = mrclam::load_robot(dataset, robot);
     const offline::RunInput input = offline::mrclam_input(data, model);
-    if (segment_every_s > 0.0 || blind_return) inputs.emplace_back(robot, input);
+    if (segment_every_s > 0.0 || blind_return || args.resume_gap_s >= 0.0) inputs.emplace_back(robot, input);
     double robot_ate = 0, robot_dr = 0;
     for (int seed : seeds) {
       options.seed = static_cast<std::uint64_t>(seed);
@@ -728,6 +817,7 @@ int run(const EvalArguments& args) {
     }
   }
   if (blind_return) run_blind_return(options, inputs, seeds, optimise);
+  if (args.resume_gap_s >= 0.0) run_resume(options, inputs, seeds, args.resume_gap_s);
   if (loro) {
     run_loro(dataset, options, model, robots, seeds, segment_every_s, optimise, config_scores, config_segments);
   }
@@ -763,6 +853,11 @@ int main(int argc, char** argv) {
   cli.flag("--blind-return", a.blind_return,
            "restarts every 60 s with a blind stretch, then far new landmarks, then the first ones again: the "
            "heading error before and after they return");
+  cli.option("--resume", a.resume_gap_s,
+             "the estimator killed every 60 s and restarted GAP_S s later from its checkpoint: the error after the "
+             "restart against the uninterrupted run's")
+      .non_negative()
+      .type("GAP_S");
   cli.flag("--optimise", a.optimise.on,
            "also the map optimiser (Ceres) over every run after the filter (--set optimizer.KEY=V: map_optimizer "
            "--help lists them)");

@@ -22,6 +22,9 @@ MapCheckpoint sample_checkpoint() {
   c.pose.cov << 0.01, 0.002, 0.0001, 0.002, 0.02, -0.0003, 0.0001, -0.0003, 0.004;
   c.landmarks.push_back({3, Eigen::Vector2d(2.0 / 3.0, 1e-7), (Eigen::Matrix2d() << 0.003, 0.001, 0.001, 0.002).finished(), 17});
   c.landmarks.push_back({12, Eigen::Vector2d(-4.5, 3.25), Eigen::Matrix2d::Identity() * 0.05, 1});
+  c.control_v_mps = 0.25;
+  c.control_w_radps = -0.5;
+  c.control_age_s = 0.125;
   return c;
 }
 
@@ -31,6 +34,9 @@ TEST(MapCheckpoint, RoundTripsExactly) {
   EXPECT_EQ(back.stamp_ns, c.stamp_ns);
   EXPECT_EQ(back.pose.mean, c.pose.mean);
   EXPECT_EQ(back.pose.cov, c.pose.cov);
+  EXPECT_EQ(back.control_v_mps, c.control_v_mps);
+  EXPECT_EQ(back.control_w_radps, c.control_w_radps);
+  EXPECT_EQ(back.control_age_s, c.control_age_s);
   ASSERT_EQ(back.landmarks.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {
     EXPECT_EQ(back.landmarks[i].id, c.landmarks[i].id);
@@ -40,6 +46,14 @@ TEST(MapCheckpoint, RoundTripsExactly) {
   }
   MapCheckpoint empty;
   EXPECT_TRUE(parse_map_checkpoint(to_yaml(empty), "empty.yaml").landmarks.empty());
+  // A version-1 file (before the held control was saved) still loads, holding none.
+  std::string v1 = to_yaml(c);
+  v1.replace(v1.find("version: 2"), 10, "version: 1");
+  v1.erase(v1.find("control: {"), v1.find("landmarks:") - v1.find("control: {"));
+  const MapCheckpoint old = parse_map_checkpoint(v1, "v1.yaml");
+  EXPECT_EQ(old.pose.mean, c.pose.mean);
+  EXPECT_EQ(old.control_v_mps, 0.0);
+  EXPECT_EQ(old.control_w_radps, 0.0);
 }
 
 TEST(MapCheckpoint, BadFilesAreErrorsNamingFileAndKey) {
@@ -51,7 +65,9 @@ TEST(MapCheckpoint, BadFilesAreErrorsNamingFileAndKey) {
     return text.replace(at, from.size(), to);
   };
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {replaced("version: 1", "version: 2"), "key 'version'"},
+      {replaced("version: 2", "version: 3"), "key 'version'"},
+      {replaced("w_radps: -0.5", "w_radps: .inf"), "key 'control.w_radps'"},
+      {replaced("age_s: 0.125", "age_s: -1"), "key 'control.age_s'"},
       {replaced("  x_m: 1.25", "  x_m: .nan"), "key 'pose.x_m'"},
       {replaced("  cov_tt: 0.004", "  cov_tt: -1"), "key 'pose.cov_tt'"},
       {replaced("  cov_xy: 0.002", "  cov_xy: 0.9"), "not positive semi-definite"},
@@ -126,15 +142,37 @@ TEST(MapCheckpoint, ACheckpointOverTheConfigFileLimitStillLoads) {
 }
 
 TEST(MapCheckpoint, ResumePoseWidensWithTheGap) {
-  const MapCheckpoint c = sample_checkpoint();
-  const slam::PoseGaussian now = resume_pose(c, 0.0, 0.5, 1.0);
+  MapCheckpoint c = sample_checkpoint();
+  c.control_v_mps = c.control_w_radps = 0.0;
+  const slam::PoseGaussian now = resume_pose(c, 0.0, 0.5, 1.0, 5.0);
   EXPECT_EQ(now.cov, c.pose.cov);
-  const slam::PoseGaussian later = resume_pose(c, 2.0, 0.5, 1.0);
+  const slam::PoseGaussian later = resume_pose(c, 2.0, 0.5, 1.0, 5.0);
   EXPECT_EQ(later.mean, c.pose.mean);
   EXPECT_NEAR(later.cov(0, 0), c.pose.cov(0, 0) + 0.25, 1e-12);  // (0.5 m/s * 2 s / 2)^2
   EXPECT_NEAR(later.cov(1, 1), c.pose.cov(1, 1) + 0.25, 1e-12);
   EXPECT_NEAR(later.cov(2, 2), c.pose.cov(2, 2) + 1.0, 1e-12);    // (1 rad/s * 2 s / 2)^2
-  EXPECT_NEAR(resume_pose(c, 1e6, 0.5, 1.0).cov(2, 2), c.pose.cov(2, 2) + M_PI * M_PI, 1e-9);
+  EXPECT_NEAR(resume_pose(c, 1e6, 0.5, 1.0, 5.0).cov(2, 2), c.pose.cov(2, 2) + M_PI * M_PI, 1e-9);
+}
+
+// The robot most likely went on with the command the filter held: the resumed
+// pose is moved by it over the gap, for as long as the filter would have held
+// it (control_timeout_s after it came), as the filter predicts a gap in its
+// odometry. The covariance is widened as without it.
+TEST(MapCheckpoint, ResumePoseMovesOnWithTheHeldControl) {
+  MapCheckpoint c = sample_checkpoint();
+  c.control_v_mps = 0.3;
+  c.control_w_radps = 0.5;
+  c.control_age_s = 0.2;
+  const slam::PoseGaussian resumed = resume_pose(c, 1.0, 0.5, 1.0, 5.0);
+  EXPECT_TRUE(resumed.mean.isApprox(slam::move(c.pose.mean, 0.3, 0.5, 1.0), 1e-12));
+  c.control_v_mps = c.control_w_radps = 0.0;
+  EXPECT_EQ(resumed.cov, resume_pose(c, 1.0, 0.5, 1.0, 5.0).cov);
+  // Held only until the control times out: 5 s after it came, 4.8 s after the checkpoint.
+  c.control_v_mps = 0.3;
+  c.control_w_radps = 0.5;
+  EXPECT_TRUE(resume_pose(c, 20.0, 0.5, 1.0, 5.0).mean.isApprox(slam::move(c.pose.mean, 0.3, 0.5, 4.8), 1e-12));
+  c.control_age_s = 6.0;
+  EXPECT_EQ(resume_pose(c, 2.0, 0.5, 1.0, 5.0).mean, c.pose.mean);
 }
 
 // A filter restarted 0.4 m and 0.15 rad off with a saved map: started with the
@@ -154,7 +192,7 @@ TEST(MapCheckpoint, FilterStartedFromAWidePoseGaussianLocksOnToThePriorMap) {
   c.pose.mean = truth + slam::Pose2(0.3, -0.25, 0.15);
   c.pose.cov = Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal();
   c.landmarks = map;
-  slam::FastSlam2 filter(options, resume_pose(c, 2.0, 0.5, 0.3));
+  slam::FastSlam2 filter(options, resume_pose(c, 2.0, 0.5, 0.3, 5.0));
   filter.set_prior_map(map);
   for (int k = 0; k < 5; ++k) {
     slam::ObservationFrame frame;
@@ -194,18 +232,23 @@ TEST(MapCheckpoint, IsTheFiltersEstimate) {
     filter.add_observations(f);
   }
   const PoseEstimate e = filter.pose_estimate();
-  const MapCheckpoint best = checkpoint_of(filter, 42, false);
-  EXPECT_EQ(best.stamp_ns, 42u);
-  EXPECT_EQ(best.pose.mean, e.mean);
-  EXPECT_TRUE(best.pose.cov.isApprox(e.cov, 1e-12));
-  EXPECT_EQ(best.pose.cov, best.pose.cov.transpose());
-  ASSERT_EQ(best.landmarks.size(), 2u);
+  const MapCheckpoint c = checkpoint_of(filter, 42);
+  EXPECT_EQ(c.stamp_ns, 42u);
+  EXPECT_EQ(c.pose.mean, e.mean);
+  EXPECT_TRUE(c.pose.cov.isApprox(e.cov, 1e-12));
+  EXPECT_EQ(c.pose.cov, c.pose.cov.transpose());
+  // The control held since the last odometry sample (0.05 s before the last frame).
+  EXPECT_EQ(c.control_v_mps, 0.2);
+  EXPECT_EQ(c.control_w_radps, 0.1);
+  EXPECT_NEAR(c.control_age_s, 0.05, 1e-9);
+  // The map is the mixture over the particles (its covariance with their spread).
+  ASSERT_EQ(c.landmarks.size(), 2u);
   const std::vector<LandmarkEstimate> of_best = filter.landmarks_of_best();
   const std::vector<LandmarkEstimate> mixture = filter.landmarks_mixture();
   for (std::size_t i = 0; i < 2; ++i) {
-    EXPECT_EQ(best.landmarks[i].id, of_best[i].id);
-    EXPECT_EQ(best.landmarks[i].mean, of_best[i].mean);
-    EXPECT_EQ(checkpoint_of(filter, 42, true).landmarks[i].cov, mixture[i].cov);
+    EXPECT_EQ(c.landmarks[i].id, mixture[i].id);
+    EXPECT_EQ(c.landmarks[i].mean, mixture[i].mean);
+    EXPECT_EQ(c.landmarks[i].cov, mixture[i].cov);
   }
   // Particles disagree a little: the mixture's covariance holds their spread.
   EXPECT_NE(mixture[0].cov, of_best[0].cov);

@@ -1,5 +1,6 @@
 #include "pixyslam/slam/map_checkpoint.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -33,13 +34,16 @@ bool is_covariance(const Eigen::Matrix<double, N, N>& c) {
 
 }  // namespace
 
-MapCheckpoint checkpoint_of(const FastSlam2& filter, std::uint64_t stamp_ns, bool mixture_landmarks) {
+MapCheckpoint checkpoint_of(const FastSlam2& filter, std::uint64_t stamp_ns) {
   const PoseEstimate estimate = filter.pose_estimate();
   MapCheckpoint c;
   c.stamp_ns = stamp_ns;
   c.pose.mean = estimate.mean;
   c.pose.cov = 0.5 * (estimate.cov + estimate.cov.transpose());
-  c.landmarks = mixture_landmarks ? filter.landmarks_mixture() : filter.landmarks_of_best();
+  c.landmarks = filter.landmarks_mixture();
+  c.control_v_mps = filter.held_control().v_mps;
+  c.control_w_radps = filter.held_control().w_radps;
+  c.control_age_s = std::max(0.0, filter.time_s() - filter.held_control_since_s());
   return c;
 }
 
@@ -47,7 +51,7 @@ std::string to_yaml(const MapCheckpoint& c) {
   std::ostringstream out;
   const Eigen::Matrix3d& p = c.pose.cov;
   out << "# pixyslam estimator checkpoint: pose and map to resume from (slam_estimator)\n"
-      << "version: 1\n"
+      << "version: 2\n"
       << "stamp_ns: " << c.stamp_ns << "\n"
       << "pose:\n"
       << "  x_m: " << yaml_number(c.pose.mean.x()) << "\n"
@@ -57,6 +61,9 @@ std::string to_yaml(const MapCheckpoint& c) {
       << "  cov_xx: " << yaml_number(p(0, 0)) << "\n  cov_xy: " << yaml_number(p(0, 1))
       << "\n  cov_xt: " << yaml_number(p(0, 2)) << "\n  cov_yy: " << yaml_number(p(1, 1))
       << "\n  cov_yt: " << yaml_number(p(1, 2)) << "\n  cov_tt: " << yaml_number(p(2, 2)) << "\n"
+      << "# the odometry command held at stamp_ns, and for how long (s)\n"
+      << "control: {v_mps: " << yaml_number(c.control_v_mps) << ", w_radps: " << yaml_number(c.control_w_radps)
+      << ", age_s: " << yaml_number(c.control_age_s) << "}\n"
       << "landmarks:" << (c.landmarks.empty() ? " []\n" : "\n");
   for (const slam::LandmarkEstimate& l : c.landmarks) {
     out << "  - {id: " << l.id << ", x_m: " << yaml_number(l.mean.x()) << ", y_m: " << yaml_number(l.mean.y())
@@ -70,7 +77,7 @@ namespace {
 
 MapCheckpoint parse(config::YamlReader root) {
   MapCheckpoint c;
-  root.integer("version", 1, 1);
+  const std::int64_t version = root.integer("version", 1, 2);
   c.stamp_ns = static_cast<std::uint64_t>(root.integer("stamp_ns", 0, INT64_MAX));
   config::YamlReader pose = root.child("pose");
   c.pose.mean = slam::Pose2(pose.number("x_m", -kMaxCoordinate, kMaxCoordinate),
@@ -85,6 +92,13 @@ MapCheckpoint parse(config::YamlReader root) {
   p(2, 2) = pose.number("cov_tt", 0.0, kMaxVariance);
   if (!is_covariance(p)) pose.fail("cov_xx", "the pose covariance is not positive semi-definite");
   pose.finish();
+  if (version >= 2) {  // version 1 had no control: none held
+    config::YamlReader control = root.child("control");
+    c.control_v_mps = control.number("v_mps", -1000.0, 1000.0);
+    c.control_w_radps = control.number("w_radps", -1000.0, 1000.0);
+    c.control_age_s = control.number("age_s", 0.0, 1e9);
+    control.finish();
+  }
   for (config::YamlReader& l : root.mapping_list("landmarks")) {
     slam::LandmarkEstimate e;
     e.id = static_cast<int>(l.integer("id", INT32_MIN, INT32_MAX));
@@ -137,9 +151,11 @@ void write_map_checkpoint(const std::string& path, const MapCheckpoint& checkpoi
 }
 
 slam::PoseGaussian resume_pose(const MapCheckpoint& checkpoint, double gap_s, double max_speed_mps,
-                               double max_turn_rate_radps) {
+                               double max_turn_rate_radps, double control_timeout_s) {
   slam::PoseGaussian g = checkpoint.pose;
   const double gap = std::max(0.0, gap_s);
+  const double held_s = std::clamp(control_timeout_s - checkpoint.control_age_s, 0.0, gap);
+  g.mean = slam::move(g.mean, checkpoint.control_v_mps, checkpoint.control_w_radps, held_s);
   const double sd_position = 0.5 * max_speed_mps * gap;
   const double sd_heading = std::min(M_PI, 0.5 * max_turn_rate_radps * gap);
   g.cov(0, 0) += sd_position * sd_position;

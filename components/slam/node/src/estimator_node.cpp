@@ -214,7 +214,7 @@ void EstimatorNode::step(const slam::SensorInput& input) {
   if (fresh) create_filter(slam::input_time(input));
   const double filter_time_s = filter_->time_s();
   if (!fresh && slam::input_time(input) > filter_time_s + options_.queue.max_stamp_jump_s) {
-    before_jump_ = slam::checkpoint_of(*filter_, map_state_.header().stamp_ns(), options_.landmarks == "mixture");
+    before_jump_ = slam::checkpoint_of(*filter_, map_state_.header().stamp_ns());
   }
   const slam::FilterCounters late_before = filter_->counters();
   if (const auto* odometry = std::get_if<slam::OdometryInput>(&input)) {
@@ -288,7 +288,8 @@ void EstimatorNode::create_filter(double first_t_s) {
         static_cast<double>(static_cast<std::int64_t>(inbox_.epoch_ns() - c.stamp_ns)) * 1e-9 + first_t_s;
     // A checkpoint from the future (another clock, a replayed log) is as unusable as an old one.
     if (gap_s >= -1.0 && gap_s <= k.max_age_s) {
-      const slam::PoseGaussian pose = slam::resume_pose(c, gap_s, k.max_speed_mps, k.max_turn_rate_radps);
+      const slam::PoseGaussian pose =
+          slam::resume_pose(c, gap_s, k.max_speed_mps, k.max_turn_rate_radps, options_.filter.control_timeout_s);
       filter_ = std::make_unique<slam::FastSlam2>(options_.filter, pose);
       filter_->set_prior_map(c.landmarks);
       counters_.resumed = true;
@@ -317,7 +318,7 @@ void EstimatorNode::restart_filter_at_new_time(std::uint64_t new_time_ns) {
     // future) is dropped with it.
     checkpoint_ = std::move(before_jump_);
   } else {
-    checkpoint_ = slam::checkpoint_of(*filter_, new_time_ns, options_.landmarks == "mixture");
+    checkpoint_ = slam::checkpoint_of(*filter_, new_time_ns);
   }
   before_jump_.reset();
   checkpoint_source_ = stepped_into_future ? "the state before the time jump" : "the state at the time jump";
@@ -346,7 +347,7 @@ slam::Pose2 EstimatorNode::initial_pose() {
 
 void EstimatorNode::write_checkpoint(bool final) {
   const slam::MapCheckpoint c =
-      slam::checkpoint_of(*filter_, map_state_.header().stamp_ns(), options_.landmarks == "mixture");
+      slam::checkpoint_of(*filter_, map_state_.header().stamp_ns());
   try {
     slam::write_map_checkpoint(options_.checkpoint.file, c);
     ++counters_.checkpoints_written;

@@ -4,6 +4,7 @@
 // and return").
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include <gtest/gtest.h>
 
@@ -187,8 +188,6 @@ LoopScores simulated_loop_returns(bool split_heading) {
 }
 
 // The filter must come back towards the first poles' frame: over the cases,
-// its heading error in the last 10 s at most half the dead reckoning's.
-// The filter must come back towards the first poles' frame: over the cases,
 // its heading error in the last 10 s at most half the dead reckoning's. With
 // the heading split at the return (delayed_sampling.split_heading) the
 // particles draw the heading the returning poles imply instead of one
@@ -203,6 +202,63 @@ TEST(BlindReturn, SimulatedLoopFilterRecoversAndTheHeadingSplitComesBackCloser) 
   ASSERT_EQ(split.cases, linear.cases);
   EXPECT_LT(split.filter_end_rad, 0.5 * split.dr_end_rad);
   EXPECT_LT(split.filter_rmse_after_rad, 0.8 * linear.filter_rmse_after_rad);
+}
+
+// mrclam_eval --resume's restart: the estimator killed 30 s into the
+// simulated loop and restarted 1.4 s later from the checkpoint it had taken.
+// The gap's odometry is gone, the pose widened as the estimator widens it
+// (40 deg heading sd), the map a prior; the resumed filter relocalises on the
+// map at once (within 0.3 m over its first 5 s) and does not lose it (ATE
+// under 0.5 m; measured 0.40 m against the uninterrupted run's 0.14 m: the
+// checkpoint keeps no pose-landmark correlations, and 30 s is the earliest and
+// costliest of the kill times 30, 45, 60, 80 and 100 s tried).
+TEST(Resume, ARestartFromTheCheckpointDropsTheGapAndRelocalisesOnTheMap) {
+  sim::WorldOptions w;
+  w.seed = 5;
+  w.duration_s = 150.0;
+  const sim::WorldRun run = sim::simulate(w);
+  RunInput in;
+  in.initial_pose = run.initial_pose;
+  in.start_time_s = run.truth.front().t_s;
+  in.odometry = run.odometry;
+  in.frames = run.frames;
+  in.truth = run.truth;
+  config::YamlReader root = config::YamlReader::from_file(std::string(PIXYSLAM_CONFIG_DIR) + "/slam_estimator.yaml");
+  config::YamlReader filter_yaml = root.child("filter");
+  const slam::FilterOptions options = slam::read_filter_options(filter_yaml);
+  const double kill_s = in.start_time_s + 30.0, gap_s = 1.4;
+  std::optional<slam::MapCheckpoint> checkpoint;
+  double checkpoint_s = 0.0;
+  const RunResult full = run_filter(options, in, [&](const slam::FastSlam2& f, double t) {
+    if (!checkpoint && t >= kill_s) {
+      checkpoint = slam::checkpoint_of(f, 0);
+      checkpoint_s = t;
+    }
+  });
+  ASSERT_TRUE(checkpoint.has_value());
+  ASSERT_GE(checkpoint->landmarks.size(), 5u);
+  const RunInput resumed = resumed_after(in, checkpoint_s, *checkpoint, gap_s, 0.5, 1.0, options.control_timeout_s);
+  EXPECT_DOUBLE_EQ(resumed.start_time_s, checkpoint_s + gap_s);
+  ASSERT_FALSE(resumed.odometry.empty());
+  EXPECT_GE(resumed.odometry.front().t_s, resumed.start_time_s);  // no control known from the gap
+  EXPECT_EQ(resumed.prior_map.size(), checkpoint->landmarks.size());
+  EXPECT_NEAR(resumed.initial_pose_cov(2, 2), checkpoint->pose.cov(2, 2) + 0.7 * 0.7, 1e-9);
+  const RunResult after = run_filter(options, resumed);
+  std::vector<eval::TimedPose> full_after;
+  for (const eval::TimedPose& p : full.trajectory) {
+    if (p.t_s >= resumed.start_time_s) full_after.push_back(p);
+  }
+  std::vector<eval::TimedPose> first_5s;
+  for (const eval::TimedPose& p : after.trajectory) {
+    if (p.t_s <= resumed.start_time_s + 5.0) first_5s.push_back(p);
+  }
+  const double relocalised_m = eval::compare_trajectory(first_5s, in.truth).max_position_error_m;
+  const double resumed_ate = eval::compare_trajectory(after.trajectory, in.truth).ate_rmse_m;
+  const double full_ate = eval::compare_trajectory(full_after, in.truth).ate_rmse_m;
+  std::printf("after the restart: worst position error in the first 5 s %.3f m; ATE resumed %.3f m, "
+              "uninterrupted %.3f m\n", relocalised_m, resumed_ate, full_ate);
+  EXPECT_LT(relocalised_m, 0.3);
+  EXPECT_LT(resumed_ate, 0.5);
 }
 
 }  // namespace

@@ -22,9 +22,10 @@ double thread_cpu_seconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-RunResult run_filter(const slam::FilterOptions& options, const RunInput& input) {
+RunResult run_filter(const slam::FilterOptions& options, const RunInput& input, const StepHook& after_step) {
   RunResult result;
-  slam::FastSlam2 filter(options, input.initial_pose);
+  slam::FastSlam2 filter(options, slam::PoseGaussian{input.initial_pose, input.initial_pose_cov});
+  if (!input.prior_map.empty()) filter.set_prior_map(input.prior_map);
   slam::PoseGaussian dead_reckoning{input.initial_pose, Eigen::Matrix3d::Zero()};
   slam::OdometrySample control{input.start_time_s, 0.0, 0.0};
   double dr_time = input.start_time_s;
@@ -35,6 +36,7 @@ RunResult run_filter(const slam::FilterOptions& options, const RunInput& input) 
     result.covariance.push_back(e.cov);
     result.dead_reckoning.push_back(
         {t, dead_reckoning.mean.x(), dead_reckoning.mean.y(), dead_reckoning.mean.z()});
+    if (after_step) after_step(filter, t);
   };
   auto advance_dead_reckoning = [&](double t) {
     if (t > dr_time) dead_reckoning.mean = slam::move(dead_reckoning.mean, control.v_mps, control.w_radps, t - dr_time);
@@ -231,6 +233,21 @@ RunInput restart_at_truth(const RunInput& input, double start_s) {
   restarted.initial_pose = slam::Pose2(g->x_m, g->y_m, g->theta_rad);
   restarted.start_time_s = start_s;
   return restarted;
+}
+
+RunInput resumed_after(const RunInput& input, double checkpoint_t_s, const slam::MapCheckpoint& checkpoint,
+                       double gap_s, double max_speed_mps, double max_turn_rate_radps, double control_timeout_s) {
+  RunInput resumed = input;
+  const slam::PoseGaussian pose =
+      slam::resume_pose(checkpoint, gap_s, max_speed_mps, max_turn_rate_radps, control_timeout_s);
+  resumed.initial_pose = pose.mean;
+  resumed.initial_pose_cov = pose.cov;
+  resumed.prior_map = checkpoint.landmarks;
+  resumed.start_time_s = checkpoint_t_s + gap_s;
+  resumed.odometry.erase(std::remove_if(resumed.odometry.begin(), resumed.odometry.end(),
+                                        [&](const slam::OdometrySample& o) { return o.t_s < resumed.start_time_s; }),
+                         resumed.odometry.end());
+  return resumed;
 }
 
 }  // namespace pixyslam::offline

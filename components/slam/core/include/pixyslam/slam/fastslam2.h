@@ -138,6 +138,10 @@ class FastSlam2 {
   const FilterCounters& counters() const { return counters_; }
   const FilterOptions& options() const { return options_; }
   double time_s() const { return time_s_; }
+  // The odometry command held now (applied until the next sample or for
+  // control_timeout_s) and the filter time it was taken at.
+  const OdometrySample& held_control() const { return control_; }
+  double held_control_since_s() const { return control_time_s_; }
   const LandmarkMapPool& pool() const { return pool_; }
 
  private:

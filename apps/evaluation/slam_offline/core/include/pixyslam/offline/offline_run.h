@@ -9,6 +9,7 @@
 #include "pixyslam/eval/trajectory_metrics.h"
 #include "pixyslam/parameters/parameters.h"
 #include "pixyslam/slam/fastslam2.h"
+#include "pixyslam/slam/map_checkpoint.h"
 #include "pixyslam/offline/segment_eval.h"
 
 namespace pixyslam::offline {
@@ -17,6 +18,8 @@ namespace pixyslam::offline {
 // odometry first on equal stamps), the start pose and time, and evaluation truth.
 struct RunInput {
   slam::Pose2 initial_pose = slam::Pose2::Zero();
+  Eigen::Matrix3d initial_pose_cov = Eigen::Matrix3d::Zero();  // a resume's widened pose (resume_pose)
+  std::vector<slam::LandmarkEstimate> prior_map;               // a resume's map (FastSlam2::set_prior_map)
   double start_time_s = 0.0;
   std::vector<slam::OdometrySample> odometry;
   std::vector<slam::ObservationFrame> frames;
@@ -38,8 +41,10 @@ struct RunResult {
 // This thread's CPU time in seconds (steadier than wall time on a shared machine).
 double thread_cpu_seconds();
 
-// Feeds the filter in time order, skipping samples before start_time_s.
-RunResult run_filter(const slam::FilterOptions& options, const RunInput& input);
+// Feeds the filter in time order, skipping samples before start_time_s;
+// `after_step` (optional) sees the filter after every step.
+using StepHook = std::function<void(const slam::FastSlam2& filter, double t_s)>;
+RunResult run_filter(const slam::FilterOptions& options, const RunInput& input, const StepHook& after_step = {});
 
 // The input in the filter's order (odometry first on equal stamps): odometry
 // before start_time_s becomes the control held at the start (on_odometry with
@@ -84,6 +89,14 @@ void print_accuracy(const std::string& title, const Report& report);
 // segment of mrclam_eval --segments runs, from start_s to the end of the input.
 // Throws std::invalid_argument when the truth does not cover start_s.
 RunInput restart_at_truth(const RunInput& input, double start_s);
+
+// An estimator restarted `gap_s` after it saved `checkpoint` (slam_estimator
+// killed, checkpoint.file): its pose widened for the gap (resume_pose, with
+// the robot's speed bounds) and its map as a prior, from checkpoint time +
+// gap_s on. What the robot did in the gap is unknown to it: the odometry of
+// the gap is dropped, and no control is held before the first sample after it.
+RunInput resumed_after(const RunInput& input, double checkpoint_t_s, const slam::MapCheckpoint& checkpoint,
+                       double gap_s, double max_speed_mps, double max_turn_rate_radps, double control_timeout_s);
 
 }  // namespace pixyslam::offline
 
