@@ -49,6 +49,9 @@ std::vector<eval::LandmarkPoint> unique_landmarks(const Landmarks& landmarks, st
   return out;
 }
 
+// MapStates this far outside the ground truth's time span are not scored.
+constexpr double kScoredMarginS = 10.0;
+
 void sort_by_time(std::vector<eval::TimedPose>& poses) {
   std::stable_sort(poses.begin(), poses.end(),
                    [](const eval::TimedPose& a, const eval::TimedPose& b) { return a.t_s < b.t_s; });
@@ -147,14 +150,26 @@ int run(const Arguments& args) {
                 static_cast<unsigned long long>(r.map_order.time_resets() + r.optimised_order.time_resets()),
                 static_cast<unsigned long long>(r.duplicate_landmark_ids));
   }
+  // In time order, whatever order the samples came in; estimates stamped far
+  // outside the truth's time (made up by another participant) are not scored.
+  sort_by_time(r.estimate);
+  sort_by_time(r.truth);
+  sort_by_time(r.optimised_keyframes);
+  if (!r.truth.empty()) {
+    const double from_s = r.truth.front().t_s - kScoredMarginS, to_s = r.truth.back().t_s + kScoredMarginS;
+    const std::size_t before = r.estimate.size();
+    r.estimate.erase(std::remove_if(r.estimate.begin(), r.estimate.end(),
+                                    [&](const eval::TimedPose& p) { return p.t_s < from_s || p.t_s > to_s; }),
+                     r.estimate.end());
+    if (r.estimate.size() < before) {
+      std::printf("sim_evaluator: %zu MapStates stamped more than %.0f s outside the ground truth's time not scored\n",
+                  before - r.estimate.size(), kScoredMarginS);
+    }
+  }
   if (r.estimate.empty() || r.truth.empty()) {
     std::printf("sim_evaluator: no %s received: nothing to evaluate\n", r.estimate.empty() ? "MapState" : "GroundTruth");
     return 1;
   }
-  // In time order, whatever order the samples came in.
-  sort_by_time(r.estimate);
-  sort_by_time(r.truth);
-  sort_by_time(r.optimised_keyframes);
   const eval::TrajectoryErrors pose = eval::compare_trajectory(r.estimate, r.truth);
   const eval::LandmarkErrors landmarks = eval::compare_landmarks(r.map, r.true_landmarks);
   std::printf("sim_evaluator: %zu estimates over %.1f s, %zu ground-truth poses compared\n", r.estimate.size(),

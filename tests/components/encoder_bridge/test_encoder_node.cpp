@@ -130,7 +130,9 @@ TEST(EncoderNodeOptions, ErrorsNameTheFileAndTheKey) {
       {valid_yaml("node:\n  serial_device: ttyACM0\n"), "key 'node.serial_device': value 'ttyACM0' is not an absolute path"},
       {valid_yaml("node:\n  baud: 115201\n"), "key 'node.baud': value 115201 is not a standard serial rate (50, "},
       {valid_yaml("node:\n  baud: 2e5\n"), "key 'node.baud': expected an integer"},
-      {"encoder_bridge:\n  serial_device: /dev/ttyACM0\n", "key 'encoder_bridge.serial_device': moved to node.serial_device"},
+      {valid_yaml("  serial_device: /dev/ttyACM0\nnode:\n  serial_device: /dev/ttyUSB0\n"),
+       "key 'encoder_bridge.serial_device': given twice: here and as node.serial_device"},
+      {valid_yaml("  baud: 115201\n"), "key 'encoder_bridge.baud': value 115201 is not a standard serial rate"},
       {valid_yaml("dds:\n  domain_id: 300\n"), "test.yaml: key 'dds.domain_id'"},
       {valid_yaml("nodes: {}\n"), "test.yaml: key 'nodes': unknown key"},
       {"node: {}\n", "test.yaml: key 'encoder_bridge': missing"},
@@ -139,6 +141,17 @@ TEST(EncoderNodeOptions, ErrorsNameTheFileAndTheKey) {
     const std::string e = config_error_of(c.yaml);
     EXPECT_NE(e.find(c.expected), std::string::npos) << "got: " << e << "\nyaml:\n" << c.yaml;
   }
+}
+
+// Until 2026-11-29 the serial link was in encoder_bridge:. An installed file
+// the user edited keeps it after an upgrade: still taken (with a warning on
+// stderr), so the robot comes up.
+TEST(EncoderNodeOptions, TheSerialLinkWhereItWasBeforeIsStillTaken) {
+  auto root = config::YamlReader::from_string(valid_yaml("  serial_device: /dev/ttyUSB7\n  baud: 57600\n"), "old.yaml");
+  const EncoderNodeOptions o = read_encoder_node_options(root, "/cfg");
+  EXPECT_EQ(o.process.serial_device, "/dev/ttyUSB7");
+  EXPECT_EQ(o.process.baud, 57600);
+  EXPECT_DOUBLE_EQ(o.encoder.wheel_base_m, encoder::EncoderOptions{}.wheel_base_m);
 }
 
 TEST(EncoderNodeOptions, FileErrorsNameThePath) {

@@ -241,6 +241,26 @@ TEST(MapOptimizer, BadInputIsCountedAndDropped) {
   EXPECT_NO_THROW(opt.solve());
 }
 
+// The filter's association.landmark_ids hold in the optimiser too: an id
+// outside them is counted and dropped, and adds no landmark.
+TEST(MapOptimizer, IdsOutsideTheFiltersLandmarkIdsAreDropped) {
+  slam::FilterOptions filter;
+  filter.landmark_ids = {"1-3"};
+  MapOptimizerOptions options = exact_options();
+  options.landmark_ids = MapOptimizerOptions::from_filter(filter).landmark_ids;
+  ASSERT_EQ(options.landmark_ids, (slam::IdRanges{{1, 3}}));
+  const ExactRun run = exact_circle(50);
+  MapOptimizer opt(options, run.truth.front(), 50.0);
+  opt.add_odometry(run.odometry[0]);
+  slam::ObservationFrame frame;
+  frame.t_s = 50.5;
+  frame.detections = {{2, 1.0, 0.1}, {7, 1.5, 0.2}, {1000, 2.0, -0.3}};
+  opt.add_frame(frame);
+  EXPECT_EQ(opt.counters().observations_unknown_id, 2u);
+  EXPECT_EQ(opt.counters().observations, 1u);
+  EXPECT_EQ(opt.landmarks().size(), 1u);
+}
+
 // What decodes fine but no sensor sends: a stamp a year on (one stretch of
 // unknown motion, not a keyframe a second), sigmas of 1e-200 (weights that
 // would swamp every other factor), ids beyond max_landmarks, guesses at 1e300.

@@ -809,9 +809,13 @@ TEST(FastSlam2, IdsOutsideTheConfiguredLandmarkIdsAreDroppedAndCounted) {
   for (const std::string bad : {"x", "5-1", "-3", "1-", "2000000", "1.5"}) {
     EXPECT_THROW(parse_landmark_ids({bad}), std::invalid_argument) << bad;
   }
-  // Maximum likelihood does not read the ids: the option is refused there.
+  // Maximum likelihood does not read the ids, nor the list: nothing dropped.
   o.association = Association::kMaximumLikelihood;
-  EXPECT_THROW(validate(o), std::invalid_argument);
+  FastSlam2 ml(o, Pose2(0.0, 0.0, 0.0));
+  ml.add_odometry({0.0, 0.0, 0.0});
+  ml.add_observations({1.0, {{100, 2.0, 0.0}}});
+  EXPECT_EQ(ml.counters().observations_unknown_id, 0u);
+  EXPECT_EQ(ml.landmarks_of_best().size(), 1u);
 }
 
 // Property: whatever arrives (NaN, inf, negative or huge ranges, bearings out

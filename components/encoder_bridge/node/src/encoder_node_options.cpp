@@ -1,5 +1,8 @@
 #include "pixyslam/encoder_node/encoder_node_options.h"
 
+#include <cstdio>
+#include <optional>
+
 #include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/config/yaml_reader.h"
 
@@ -44,15 +47,31 @@ std::string help_text() {
 EncoderNodeOptions read_encoder_node_options(config::YamlReader& root, const std::string& config_dir) {
   EncoderNodeOptions o;
   config::YamlReader bridge = root.child("encoder_bridge");
-  for (const char* moved : {"serial_device", "baud"}) {
-    if (bridge.has(moved)) bridge.fail(moved, std::string("moved to node.") + moved + " (as in pixy_bridge.yaml)");
+  // Until 2026-11-29 the serial link was in encoder_bridge:. An installed file
+  // the user edited (a conffile: wheel calibration goes there) keeps it after
+  // an upgrade, so the old keys are still taken, with a warning naming the new.
+  std::optional<std::string> old_device;
+  std::optional<long> old_baud;
+  if (bridge.has("serial_device")) old_device = bridge.text("serial_device");
+  if (bridge.has("baud")) old_baud = static_cast<long>(bridge.integer("baud", 1, 4000000));
+  for (const char* key : {"serial_device", "baud"}) {
+    if (!bridge.has(key)) continue;
+    if (root.has("node") && root.child("node").has(key)) {
+      bridge.fail(key, std::string("given twice: here and as node.") + key + ", where it belongs now");
+    }
+    std::fprintf(stderr, "encoder_bridge: %s: key '%s' is deprecated: it moved to node.%s (as in pixy_bridge.yaml); "
+                 "taken as that\n", bridge.origin().c_str(), bridge.key_path(key).c_str(), key);
   }
   o.encoder = encoder::read_encoder_options(bridge);
+  if (old_device) o.process.serial_device = *old_device;
+  if (old_baud) o.process.baud = *old_baud;
   if (root.has("node")) {
     config::YamlReader node = root.child("node");
     config::read_parameters(node, node_parameters(), o);
     node.finish();
     config::check_rules(node, [&] { validate_node(o); });
+  } else {
+    config::check_rules(bridge, [&] { validate_node(o); });  // an old encoder_bridge.baud
   }
   o.dds = dds::read_dds_section(root, config_dir);
   root.finish();

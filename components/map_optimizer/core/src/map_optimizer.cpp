@@ -241,7 +241,7 @@ MapOptimizerOptions MapOptimizerOptions::from_filter(const slam::FilterOptions& 
   o.min_range_m = filter.min_range_m;
   o.max_range_m = filter.max_range_m;
   o.max_landmarks = filter.max_map_landmarks;
-  o.landmark_ids = slam::parse_landmark_ids(filter.landmark_ids);
+  if (filter.association == slam::Association::kKnownId) o.landmark_ids = slam::parse_landmark_ids(filter.landmark_ids);
   return o;
 }
 

@@ -57,9 +57,12 @@ std::string to_yaml(const OptimizerNodeOptions& o) {
 }
 
 std::string help_text() {
+  // Named defaults: GCC 12 warns (maybe-uninitialized, falsely) on the temporary default argument.
+  const map_optimizer::MapOptimizerOptions core_defaults;
+  const OptimizerNodeOptions node_defaults;
   return "optimizer parameters (optimizer:; the noise models come from filter_config):\n" +
-         parameters::help_text(map_optimizer::map_optimizer_parameters(), "optimizer") +
-         parameters::help_text(optimizer_node_parameters(), "optimizer") +
+         parameters::help_text(map_optimizer::map_optimizer_parameters(), "optimizer", core_defaults) +
+         parameters::help_text(optimizer_node_parameters(), "optimizer", node_defaults) +
          "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
          parameters::help_text(dds::dds_parameters(), "dds");
 }

@@ -43,7 +43,9 @@ MapCheckpoint checkpoint_of(const FastSlam2& filter, std::uint64_t stamp_ns) {
   c.landmarks = filter.landmarks_mixture();
   c.control_v_mps = filter.held_control().v_mps;
   c.control_w_radps = filter.held_control().w_radps;
-  c.control_age_s = std::max(0.0, filter.time_s() - filter.held_control_since_s());
+  // Past control_timeout_s the command is not held any more: an older age means nothing more
+  // (and a filter time far from the control's, e.g. after a hostile stamp, stays within the file's bounds).
+  c.control_age_s = std::clamp(filter.time_s() - filter.held_control_since_s(), 0.0, filter.options().control_timeout_s);
   return c;
 }
 

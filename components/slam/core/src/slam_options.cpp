@@ -69,7 +69,8 @@ const parameters::Table<FilterOptions>& filter_parameters() {
                                 [](O& o) -> Association& { return o.association; }),
       P::list<O>("association.landmark_ids",
                  "known_id: the landmark ids there are, each an id or a range A-B (e.g. 1-20); a detection with "
-                 "another id is dropped and counted (observations_unknown_id). Empty: every id",
+                 "another id is dropped and counted (observations_unknown_id). Empty: every id. Not read by "
+                 "maximum_likelihood",
                  [](O& o) -> std::vector<std::string>& { return o.landmark_ids; },
                  [](const std::string& item) {
                    try {
@@ -132,10 +133,6 @@ void validate(const FilterOptions& o) {
           "must be greater than min_range_m (" + parameters::number_text(o.min_range_m) + ")");
   require(o.error_correlation_s == 0.0 || o.association == Association::kKnownId, "observation.error_correlation_s",
           o.error_correlation_s, "needs association known_id (a landmark's last sighting is tracked by its id)");
-  if (!o.landmark_ids.empty() && o.association != Association::kKnownId) {
-    throw parameters::RuleError("filter", "association.landmark_ids",
-                                "needs association known_id (maximum likelihood does not read the ids)");
-  }
   const DelayedSamplingOptions& d = o.delayed_sampling;
   require(d.exit_heading_sigma_rad <= d.enter_heading_sigma_rad, "delayed_sampling.exit_heading_sigma_rad",
           d.exit_heading_sigma_rad,

@@ -226,6 +226,7 @@ void EstimatorNode::step(const slam::SensorInput& input) {
     last_observation_seq_ = observation.seq;
   }
   warn_if_late(input, filter_time_s, late_before);
+  warn_if_unknown_id(input, late_before);
   StepInfo info;
   info.epoch_ns = inbox_.epoch_ns();
   info.odometry_seq = last_odometry_seq_;
@@ -272,6 +273,25 @@ void EstimatorNode::warn_if_late(const slam::SensorInput& input, double filter_t
                "(%llu so far)\n",
                what, slam::input_time(input), filter_time_s, filter_time_s - slam::input_time(input), how,
                static_cast<unsigned long long>(n));
+}
+
+void EstimatorNode::warn_if_unknown_id(const slam::SensorInput& input, const slam::FilterCounters& before) {
+  if (unknown_id_logged_ || filter_->counters().observations_unknown_id == before.observations_unknown_id) return;
+  const auto* observation = std::get_if<slam::ObservationInput>(&input);
+  if (observation == nullptr) return;
+  const slam::IdRanges ids = slam::parse_landmark_ids(options_.filter.landmark_ids);
+  for (const slam::RangeBearing& d : observation->frame.detections) {
+    if (slam::contains_id(ids, d.landmark_id)) continue;
+    std::string list;
+    for (const std::string& item : options_.filter.landmark_ids) list += (list.empty() ? "" : ", ") + item;
+    std::fprintf(stderr,
+                 "slam_estimator: WARN: landmark id %d is not in filter.association.landmark_ids [%s]: its sightings "
+                 "are dropped and counted (observations_unknown_id); a pole of yours? add its id there (logged "
+                 "once)\n",
+                 d.landmark_id, list.c_str());
+    unknown_id_logged_ = true;
+    return;
+  }
 }
 
 void EstimatorNode::publish_map_state() {

@@ -243,6 +243,10 @@ TEST(Resume, ARestartFromTheCheckpointDropsTheGapAndRelocalisesOnTheMap) {
   EXPECT_GE(resumed.odometry.front().t_s, resumed.start_time_s);  // no control known from the gap
   EXPECT_EQ(resumed.prior_map.size(), checkpoint->landmarks.size());
   EXPECT_NEAR(resumed.initial_pose_cov(2, 2), checkpoint->pose.cov(2, 2) + 0.7 * 0.7, 1e-9);
+  // The robot was driving: the resumed pose moved on by the held command over the gap.
+  ASSERT_GT(checkpoint->control_v_mps, 0.05);
+  EXPECT_TRUE(resumed.initial_pose.isApprox(
+      slam::move(checkpoint->pose.mean, checkpoint->control_v_mps, checkpoint->control_w_radps, gap_s), 1e-12));
   const RunResult after = run_filter(options, resumed);
   std::vector<eval::TimedPose> full_after;
   for (const eval::TimedPose& p : full.trajectory) {

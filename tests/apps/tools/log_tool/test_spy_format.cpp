@@ -436,6 +436,9 @@ TEST(SpyFormat, StringsFromTheNetworkAreEscapedAndStayValidUtf8) {
   m.header().robot_id("r\x1b\x7f\xc2\x9b\xff\xc3\xa9\"");
   const std::string json = to_json_line(to_value(m));
   EXPECT_NE(json.find("\"robot_id\":\"r\\u001b\\u007f\\u009b\\ufffd\xc3\xa9\\\"\""), std::string::npos) << json;
+  // Line and paragraph separators (YAML 1.1 breaks lines there) and the non-characters.
+  m.header().robot_id("a\xe2\x80\xa8" "b\xe2\x80\xa9" "c\xef\xbf\xbf");
+  EXPECT_NE(to_json_line(to_value(m)).find("\"robot_id\":\"a\\u2028b\\u2029c\\uffff\""), std::string::npos);
 }
 
 }  // namespace

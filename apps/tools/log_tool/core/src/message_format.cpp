@@ -149,7 +149,8 @@ Value optimised_landmark_value(const msg::OptimisedLandmark& l) {
 bool is_scalar(const Value& v) { return v.kind() != Value::Kind::kStruct && v.kind() != Value::Kind::kList; }
 
 // JSON string literal (also a valid YAML double-quoted scalar). The text comes
-// from the network: control characters (C0, DEL, C1) are escaped, so none
+// from the network: control characters (C0, DEL, C1, and U+2028, U+2029,
+// U+FFFE, U+FFFF for YAML readers) are escaped, so none
 // reaches the reader's terminal, and bytes that are not UTF-8 become U+FFFD,
 // so the output stays valid JSON.
 std::string quoted(const std::string& s) {
@@ -170,7 +171,8 @@ std::string quoted(const std::string& s) {
       case '\r': out += "\\r"; break;
       case '\t': out += "\\t"; break;
       default:
-        if (dds::control_code_point(cp)) {
+        // Also the characters YAML 1.1 readers take as line breaks or refuse.
+        if (dds::control_code_point(cp) || cp == 0x2028 || cp == 0x2029 || cp == 0xfffe || cp == 0xffff) {
           char buf[8];
           std::snprintf(buf, sizeof(buf), "\\u%04x", static_cast<unsigned>(cp));
           out += buf;

@@ -117,6 +117,7 @@ struct FilterOptions {
   // each item an id ("7") or an inclusive range ("1-20"). A detection with
   // another id is dropped and counted (observations_unknown_id): ids a faulty
   // or hostile sender invents cannot fill max_map_landmarks. Empty: every id.
+  // kMaximumLikelihood does not read the ids, nor this list.
   std::vector<std::string> landmark_ids;
   // kMaximumLikelihood: a detection starts a new landmark when no mapped one is
   // within this chi-square (2 dof) quantile of its predicted observation.

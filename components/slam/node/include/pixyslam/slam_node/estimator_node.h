@@ -82,6 +82,9 @@ class EstimatorNode {
   // frames_late, frames_out_of_order; their counts before the step in late_before) and how it
   // was applied: the first ten, then every hundredth.
   void warn_if_late(const slam::SensorInput& input, double filter_time_s, const slam::FilterCounters& late_before);
+  // Logs the first detection dropped for an id outside filter.association.landmark_ids
+  // (a pole added to the pixy bridge's table but not here loses every sighting).
+  void warn_if_unknown_id(const slam::SensorInput& input, const slam::FilterCounters& before);
   // The filter, from the checkpoint when there is a fresh one (state_mutex_ held).
   void create_filter(double first_t_s);
   // After SensorInbox's rebase to new_time_ns: the filter again, its time set
@@ -132,6 +135,7 @@ class EstimatorNode {
   std::uint64_t last_checkpoint_ns_ = 0;
   std::uint64_t last_published_ns_ = 0;
   bool latest_published_ = true;  // map_state_ went out (map_state_period_s)
+  bool unknown_id_logged_ = false;
 };
 
 }  // namespace pixyslam::slam_node
