@@ -152,6 +152,18 @@ TEST(EncoderNodeOptions, TheSerialLinkWhereItWasBeforeIsStillTaken) {
   EXPECT_EQ(o.process.serial_device, "/dev/ttyUSB7");
   EXPECT_EQ(o.process.baud, 57600);
   EXPECT_DOUBLE_EQ(o.encoder.wheel_base_m, encoder::EncoderOptions{}.wheel_base_m);
+  // On the command line the old name says where the key went.
+  EncoderNodeOptions set = o;
+  std::vector<std::string> assignments = {"encoder_bridge.baud=9600"};
+  try {
+    apply_overrides(set, assignments);
+    ADD_FAILURE() << "encoder_bridge.baud accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("moved to node.baud"), std::string::npos) << e.what();
+  }
+  assignments = {"node.baud=9600"};
+  apply_overrides(set, assignments);
+  EXPECT_EQ(set.process.baud, 9600);
 }
 
 TEST(EncoderNodeOptions, FileErrorsNameThePath) {

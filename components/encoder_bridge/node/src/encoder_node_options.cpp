@@ -28,6 +28,11 @@ void validate_node(const EncoderNodeOptions& o) {
 
 void apply_overrides(EncoderNodeOptions& o, std::vector<std::string>& assignments) {
   for (const std::string& a : parameters::take_section(assignments, "encoder_bridge")) {
+    for (const std::string key : {"serial_device", "baud"}) {
+      if (a.rfind("encoder_bridge." + key + "=", 0) == 0) {
+        throw std::invalid_argument("'" + a + "': encoder_bridge." + key + " moved to node." + key);
+      }
+    }
     parameters::apply_override(o.encoder, encoder::encoder_parameters(), "encoder_bridge", a);
   }
   encoder::validate(o.encoder);
