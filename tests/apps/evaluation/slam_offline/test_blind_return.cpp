@@ -145,13 +145,11 @@ struct LoopScores {
   double filter_end_rad = 0.0, dr_end_rad = 0.0, filter_rmse_after_rad = 0.0;
 };
 
-// The simulated loop's blind returns from 0, 60 and 120 s through the MRCLAM
-// config's filter, with `split_heading` as given; every case must be hard (dead
-// reckoning over 20 deg off at the return) and end closer than dead reckoning.
-LoopScores simulated_loop_returns(bool split_heading) {
+// The simulated loop (world seed 5) as an offline run's input.
+RunInput simulated_loop(double duration_s) {
   sim::WorldOptions w;
   w.seed = 5;
-  w.duration_s = 400.0;
+  w.duration_s = duration_s;
   const sim::WorldRun run = sim::simulate(w);
   RunInput in;
   in.initial_pose = run.initial_pose;
@@ -159,10 +157,23 @@ LoopScores simulated_loop_returns(bool split_heading) {
   in.odometry = run.odometry;
   in.frames = run.frames;
   in.truth = run.truth;
-  BlindReturnOptions o;
-  config::YamlReader root = config::YamlReader::from_file(std::string(PIXYSLAM_CONFIG_DIR) + "/slam_mrclam.yaml");
+  return in;
+}
+
+// The filter: section of a config file of config/.
+slam::FilterOptions shipped_filter_options(const std::string& file) {
+  config::YamlReader root = config::YamlReader::from_file(std::string(PIXYSLAM_CONFIG_DIR) + "/" + file);
   config::YamlReader filter_yaml = root.child("filter");
-  slam::FilterOptions options = slam::read_filter_options(filter_yaml);
+  return slam::read_filter_options(filter_yaml);
+}
+
+// The simulated loop's blind returns from 0, 60 and 120 s through the MRCLAM
+// config's filter, with `split_heading` as given; every case must be hard (dead
+// reckoning over 20 deg off at the return) and end closer than dead reckoning.
+LoopScores simulated_loop_returns(bool split_heading) {
+  const RunInput in = simulated_loop(400.0);
+  BlindReturnOptions o;
+  slam::FilterOptions options = shipped_filter_options("slam_mrclam.yaml");
   options.delayed_sampling.split_heading = split_heading;
   constexpr double kDeg = 180.0 / M_PI;
   LoopScores scores;
@@ -213,19 +224,8 @@ TEST(BlindReturn, SimulatedLoopFilterRecoversAndTheHeadingSplitComesBackCloser) 
 // checkpoint keeps no pose-landmark correlations, and 30 s is the earliest and
 // costliest of the kill times 30, 45, 60, 80 and 100 s tried).
 TEST(Resume, ARestartFromTheCheckpointDropsTheGapAndRelocalisesOnTheMap) {
-  sim::WorldOptions w;
-  w.seed = 5;
-  w.duration_s = 150.0;
-  const sim::WorldRun run = sim::simulate(w);
-  RunInput in;
-  in.initial_pose = run.initial_pose;
-  in.start_time_s = run.truth.front().t_s;
-  in.odometry = run.odometry;
-  in.frames = run.frames;
-  in.truth = run.truth;
-  config::YamlReader root = config::YamlReader::from_file(std::string(PIXYSLAM_CONFIG_DIR) + "/slam_estimator.yaml");
-  config::YamlReader filter_yaml = root.child("filter");
-  const slam::FilterOptions options = slam::read_filter_options(filter_yaml);
+  const RunInput in = simulated_loop(150.0);
+  const slam::FilterOptions options = shipped_filter_options("slam_estimator.yaml");
   const double kill_s = in.start_time_s + 30.0, gap_s = 1.4;
   std::optional<slam::MapCheckpoint> checkpoint;
   double checkpoint_s = 0.0;
