@@ -51,6 +51,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -370,6 +371,23 @@ void print_distribution(const char* label, int width, const std::vector<double>&
               unit);
 }
 
+// Per robot with ground truth and per seed (options.seed set): `run` with the
+// robot's truth in time order and its starts every `every_s` seconds.
+template <class Run>
+void for_each_run_with_starts(const std::vector<std::pair<int, offline::RunInput>>& inputs,
+                              const std::vector<int>& seeds, double every_s, slam::FilterOptions& options,
+                              const Run& run) {
+  for (const auto& [robot, input] : inputs) {
+    if (input.truth.empty()) continue;
+    const std::vector<eval::TimedPose> truth = offline::sorted_by_time(input.truth);
+    const std::vector<double> starts = offline::segment_starts(truth, every_s);
+    for (int seed : seeds) {
+      options.seed = static_cast<std::uint64_t>(seed);
+      run(robot, input, truth, starts, seed);
+    }
+  }
+}
+
 // mrclam_eval --blind-return (see the top of this file).
 void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<int, offline::RunInput>>& inputs,
                       const std::vector<int>& seeds, const OptimiseRequest& optimise) {
@@ -385,47 +403,43 @@ void run_blind_return(slam::FilterOptions options, const std::vector<std::pair<i
               "DR_end", "err_ret", "rmse_aft", "err_end", "ATE_aft");
   std::vector<double> at_return, after, at_end, ate_after, dr_at_return, dr_at_end, opt_after, opt_at_end, opt_ate_after;
   std::size_t skipped = 0;
-  for (const auto& [robot, input] : inputs) {
-    if (input.truth.empty()) continue;
-    const std::vector<eval::TimedPose> truth = offline::sorted_by_time(input.truth);
-    const std::vector<double> starts = offline::segment_starts(truth, kEveryS);
-    for (int seed : seeds) {
-      options.seed = static_cast<std::uint64_t>(seed);
-      for (std::size_t k = 0; k < starts.size(); ++k) {
-        offline::BlindReturnOptions o = cases;
-        if (k % 2 == 1) o.heading_bias_radps = -o.heading_bias_radps;
-        const std::optional<offline::BlindReturnCase> c =
-            offline::make_blind_return(offline::restart_at_truth(input, starts[k]), o);
-        if (!c) {
-          if (seed == seeds.front()) ++skipped;
-          continue;
-        }
-        const offline::RunResult res = offline::run_filter(options, c->input);
-        const offline::ReturnScore score = offline::score_return(*c, res.trajectory);
-        const offline::ReturnScore dr = offline::score_return(*c, res.dead_reckoning);
-        std::printf("%-5d %-5d %8.1f %8.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.3f", robot, seed,
-                    starts[k] - truth.front().t_s, c->return_s - starts[k], dr.heading_error_at_return_rad * kDeg,
-                    dr.heading_error_end_rad * kDeg, score.heading_error_at_return_rad * kDeg, score.heading_rmse_after_rad * kDeg,
-                    score.heading_error_end_rad * kDeg, score.ate_after_m);
-        if (const auto opt = optimised(optimise, options, c->input, res)) {
-          const offline::ReturnScore os = offline::score_return(*c, opt->trajectory);
-          std::printf("  optimised: rmse_aft %.1f err_end %.1f ATE_aft %.3f", os.heading_rmse_after_rad * kDeg,
-                      os.heading_error_end_rad * kDeg, os.ate_after_m);
-          opt_after.push_back(os.heading_rmse_after_rad * kDeg);
-          opt_at_end.push_back(os.heading_error_end_rad * kDeg);
-          opt_ate_after.push_back(os.ate_after_m);
-        }
-        std::printf("\n");
-        std::fflush(stdout);
-        dr_at_return.push_back(dr.heading_error_at_return_rad * kDeg);
-        dr_at_end.push_back(dr.heading_error_end_rad * kDeg);
-        at_return.push_back(score.heading_error_at_return_rad * kDeg);
-        after.push_back(score.heading_rmse_after_rad * kDeg);
-        at_end.push_back(score.heading_error_end_rad * kDeg);
-        ate_after.push_back(score.ate_after_m);
+  for_each_run_with_starts(inputs, seeds, kEveryS, options, [&](int robot, const offline::RunInput& input,
+                                                                 const std::vector<eval::TimedPose>& truth,
+                                                                 const std::vector<double>& starts, int seed) {
+    for (std::size_t k = 0; k < starts.size(); ++k) {
+      offline::BlindReturnOptions o = cases;
+      if (k % 2 == 1) o.heading_bias_radps = -o.heading_bias_radps;
+      const std::optional<offline::BlindReturnCase> c =
+          offline::make_blind_return(offline::restart_at_truth(input, starts[k]), o);
+      if (!c) {
+        if (seed == seeds.front()) ++skipped;
+        continue;
       }
+      const offline::RunResult res = offline::run_filter(options, c->input);
+      const offline::ReturnScore score = offline::score_return(*c, res.trajectory);
+      const offline::ReturnScore dr = offline::score_return(*c, res.dead_reckoning);
+      std::printf("%-5d %-5d %8.1f %8.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.3f", robot, seed,
+                  starts[k] - truth.front().t_s, c->return_s - starts[k], dr.heading_error_at_return_rad * kDeg,
+                  dr.heading_error_end_rad * kDeg, score.heading_error_at_return_rad * kDeg, score.heading_rmse_after_rad * kDeg,
+                  score.heading_error_end_rad * kDeg, score.ate_after_m);
+      if (const auto opt = optimised(optimise, options, c->input, res)) {
+        const offline::ReturnScore os = offline::score_return(*c, opt->trajectory);
+        std::printf("  optimised: rmse_aft %.1f err_end %.1f ATE_aft %.3f", os.heading_rmse_after_rad * kDeg,
+                    os.heading_error_end_rad * kDeg, os.ate_after_m);
+        opt_after.push_back(os.heading_rmse_after_rad * kDeg);
+        opt_at_end.push_back(os.heading_error_end_rad * kDeg);
+        opt_ate_after.push_back(os.ate_after_m);
+      }
+      std::printf("\n");
+      std::fflush(stdout);
+      dr_at_return.push_back(dr.heading_error_at_return_rad * kDeg);
+      dr_at_end.push_back(dr.heading_error_end_rad * kDeg);
+      at_return.push_back(score.heading_error_at_return_rad * kDeg);
+      after.push_back(score.heading_rmse_after_rad * kDeg);
+      at_end.push_back(score.heading_error_end_rad * kDeg);
+      ate_after.push_back(score.ate_after_m);
     }
-  }
+  });
   const auto line = [](const char* label, const std::vector<double>& v, const char* unit) {
     print_distribution(label, 36, v, unit);
   };
@@ -457,67 +471,62 @@ void run_resume(slam::FilterOptions options, const std::vector<std::pair<int, of
   std::printf("%-5s %-5s %8s %9s %9s %9s %9s %9s %9s\n", "robot", "seed", "kill_s", "ATE_run", "ATE_res", "ATE_pose",
               "head_run", "head_res", "head_pose");
   std::vector<double> run_ate, res_ate, pose_ate, run_head, res_head, pose_head, res_extra, pose_extra;
-  for (const auto& [robot, input] : inputs) {
-    if (input.truth.empty()) continue;
-    const std::vector<eval::TimedPose> truth = offline::sorted_by_time(input.truth);
-    const std::vector<double> starts = offline::segment_starts(truth, kEveryS);
-    for (int seed : seeds) {
-      options.seed = static_cast<std::uint64_t>(seed);
-      // The uninterrupted run, with a checkpoint at the first step of each start (after the first).
-      std::vector<std::pair<double, slam::MapCheckpoint>> checkpoints;
-      std::size_t next = 1;
-      const offline::RunResult full = offline::run_filter(options, input, [&](const slam::FastSlam2& f, double t) {
-        if (next < starts.size() && t >= starts[next]) {
-          checkpoints.emplace_back(t, slam::checkpoint_of(f, 0));
-          ++next;
-        }
-      });
-      for (const auto& [kill_s, checkpoint] : checkpoints) {
-        const double resume_s = kill_s + gap_s;
-        std::vector<eval::TimedPose> run_after;
-        for (const eval::TimedPose& p : full.trajectory) {
-          if (p.t_s >= resume_s) run_after.push_back(p);
-        }
-        if (run_after.empty()) continue;
-        // As resumed, and as resumed from the pose alone (the held control not
-        // saved: a version-1 checkpoint), which is what the control buys.
-        slam::MapCheckpoint pose_only = checkpoint;
-        pose_only.control_v_mps = pose_only.control_w_radps = 0.0;
-        const auto resumed = [&](const slam::MapCheckpoint& c) {
-          return offline::run_filter(options, offline::resumed_after(input, kill_s, c, gap_s, kMaxSpeedMps,
-                                                                     kMaxTurnRateRadps, options.control_timeout_s))
-              .trajectory;
-        };
-        const eval::TrajectoryErrors run = eval::compare_trajectory(run_after, truth);
-        const eval::TrajectoryErrors res = eval::compare_trajectory(resumed(checkpoint), truth);
-        const eval::TrajectoryErrors pose = eval::compare_trajectory(resumed(pose_only), truth);
-        std::printf("%-5d %-5d %8.1f %9.3f %9.3f %9.3f %9.1f %9.1f %9.1f\n", robot, seed, kill_s - truth.front().t_s,
-                    run.ate_rmse_m, res.ate_rmse_m, pose.ate_rmse_m, run.heading_rmse_rad * kDeg,
-                    res.heading_rmse_rad * kDeg, pose.heading_rmse_rad * kDeg);
-        std::fflush(stdout);
-        run_ate.push_back(run.ate_rmse_m);
-        res_ate.push_back(res.ate_rmse_m);
-        pose_ate.push_back(pose.ate_rmse_m);
-        run_head.push_back(run.heading_rmse_rad * kDeg);
-        res_head.push_back(res.heading_rmse_rad * kDeg);
-        pose_head.push_back(pose.heading_rmse_rad * kDeg);
-        res_extra.push_back(res.ate_rmse_m - run.ate_rmse_m);
-        pose_extra.push_back(pose.ate_rmse_m - run.ate_rmse_m);
+  for_each_run_with_starts(inputs, seeds, kEveryS, options, [&](int robot, const offline::RunInput& input,
+                                                                 const std::vector<eval::TimedPose>& truth,
+                                                                 const std::vector<double>& starts, int seed) {
+    // The uninterrupted run, with a checkpoint at the first step of each start (after the first).
+    std::vector<std::pair<double, slam::MapCheckpoint>> checkpoints;
+    std::size_t next = 1;
+    const offline::RunResult full = offline::run_filter(options, input, [&](const slam::FastSlam2& f, double t) {
+      if (next < starts.size() && t >= starts[next]) {
+        checkpoints.emplace_back(t, slam::checkpoint_of(f, 0));
+        ++next;
       }
+    });
+    for (const auto& [kill_s, checkpoint] : checkpoints) {
+      const double resume_s = kill_s + gap_s;
+      std::vector<eval::TimedPose> run_after;
+      for (const eval::TimedPose& p : full.trajectory) {
+        if (p.t_s >= resume_s) run_after.push_back(p);
+      }
+      if (run_after.empty()) continue;
+      // As resumed, and as resumed from the pose alone (the held control not
+      // saved: a version-1 checkpoint), which is what the control buys.
+      slam::MapCheckpoint pose_only = checkpoint;
+      pose_only.control_v_mps = pose_only.control_w_radps = 0.0;
+      const auto resumed = [&](const slam::MapCheckpoint& c) {
+        return offline::run_filter(options, offline::resumed_after(input, kill_s, c, gap_s, kMaxSpeedMps,
+                                                                   kMaxTurnRateRadps, options.control_timeout_s))
+            .trajectory;
+      };
+      const eval::TrajectoryErrors run = eval::compare_trajectory(run_after, truth);
+      const eval::TrajectoryErrors res = eval::compare_trajectory(resumed(checkpoint), truth);
+      const eval::TrajectoryErrors pose = eval::compare_trajectory(resumed(pose_only), truth);
+      std::printf("%-5d %-5d %8.1f %9.3f %9.3f %9.3f %9.1f %9.1f %9.1f\n", robot, seed, kill_s - truth.front().t_s,
+                  run.ate_rmse_m, res.ate_rmse_m, pose.ate_rmse_m, run.heading_rmse_rad * kDeg,
+                  res.heading_rmse_rad * kDeg, pose.heading_rmse_rad * kDeg);
+      std::fflush(stdout);
+      run_ate.push_back(run.ate_rmse_m);
+      res_ate.push_back(res.ate_rmse_m);
+      pose_ate.push_back(pose.ate_rmse_m);
+      run_head.push_back(run.heading_rmse_rad * kDeg);
+      res_head.push_back(res.heading_rmse_rad * kDeg);
+      pose_head.push_back(pose.heading_rmse_rad * kDeg);
+      res_extra.push_back(res.ate_rmse_m - run.ate_rmse_m);
+      pose_extra.push_back(pose.ate_rmse_m - run.ate_rmse_m);
     }
-  }
-  const auto line = [](const char* label, const std::vector<double>& v, const char* unit) {
-    print_distribution(label, 44, v, unit);
-  };
+  });
   std::printf("RESUME: %zu restarts, %.2f s gap\n", run_ate.size(), gap_s);
-  line("ATE after the restart, uninterrupted run", run_ate, "m");
-  line("ATE after the restart, resumed", res_ate, "m");
-  line("ATE after the restart, resumed from the pose only", pose_ate, "m");
-  line("resumed minus uninterrupted ATE", res_extra, "m");
-  line("resumed from the pose only minus uninterrupted", pose_extra, "m");
-  line("heading RMSE, uninterrupted run", run_head, "deg");
-  line("heading RMSE, resumed", res_head, "deg");
-  line("heading RMSE, resumed from the pose only", pose_head, "deg");
+  const std::vector<std::tuple<const char*, const std::vector<double>*, const char*>> rows = {
+      {"ATE after the restart, uninterrupted run", &run_ate, "m"},
+      {"ATE after the restart, resumed", &res_ate, "m"},
+      {"ATE after the restart, resumed from the pose only", &pose_ate, "m"},
+      {"resumed minus uninterrupted ATE", &res_extra, "m"},
+      {"resumed from the pose only minus uninterrupted", &pose_extra, "m"},
+      {"heading RMSE, uninterrupted run", &run_head, "deg"},
+      {"heading RMSE, resumed", &res_head, "deg"},
+      {"heading RMSE, resumed from the pose only", &pose_head, "deg"}};
+  for (const auto& [label, values, unit] : rows) print_distribution(label, 44, *values, unit);
 }
 
 // The CSV files of --out-dir (none when the folder is empty).
