@@ -162,16 +162,15 @@ IdRanges parse_landmark_ids(const std::vector<std::string>& items) {
     };
     const std::size_t dash = item.find('-', 1);  // a leading '-' is a sign
     const auto number = [&](const std::string& text) {
-      std::size_t used = 0;
-      long v = 0;
+      std::vector<int> v;  // one item: the list has been split at its commas
       try {
-        v = std::stol(text, &used);
-      } catch (const std::exception&) {
+        v = parameters::parse_int_list(text, "landmark id", 0);
+      } catch (const std::invalid_argument&) {
         throw bad("expected an id or a range A-B of ids");
       }
-      if (used != text.size()) throw bad("expected an id or a range A-B of ids");
-      if (v < 0 || v > 1000000) throw bad("an id is 0 .. 1000000");
-      return static_cast<int>(v);
+      if (v.size() != 1) throw bad("expected an id or a range A-B of ids");
+      if (v.front() > 1000000) throw bad("an id is 0 .. 1000000");
+      return v.front();
     };
     const int first = number(item.substr(0, dash));
     const int last = dash == std::string::npos ? first : number(item.substr(dash + 1));
