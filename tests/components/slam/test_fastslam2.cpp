@@ -1150,7 +1150,7 @@ TEST(FastSlam2, AJointStateCountsGatedObservationsAndEndsForReadmission) {
     f.add_observations({t += 0.1, {{7, 7.0, 0.0}}});
     for (const Particle& p : f.particles()) {
       ASSERT_TRUE(p.joint.active());
-      EXPECT_EQ(p.joint->counts.at(0).consecutive_rejections, static_cast<std::uint32_t>(i));
+      EXPECT_EQ(p.joint->landmarks.at(0).counts.consecutive_rejections, static_cast<std::uint32_t>(i));
       EXPECT_EQ(p.map.find(0)->consecutive_rejections, 0u);  // the map catches up later
     }
   }

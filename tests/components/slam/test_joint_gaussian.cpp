@@ -417,7 +417,7 @@ TEST(JointGaussian, HeadingSplitTurnsRelativeLandmarksOnTheirArcs) {
     EXPECT_NEAR(std::sqrt(c.heading_variance()), 0.5 * spacing, 1e-9);
     EXPECT_NEAR((c.landmark_mean(ahead) - c.mean.head<2>()).norm(), 7.0, 1e-9) << delta;
     EXPECT_TRUE(c.landmark_mean(known).isApprox(known_position, 1e-12));
-    const Eigen::Vector2d first_ahead = c.first[static_cast<std::size_t>(ahead)] - c.frame_pose.head<2>();
+    const Eigen::Vector2d first_ahead = c.landmarks[static_cast<std::size_t>(ahead)].first - c.frame_pose.head<2>();
     EXPECT_NEAR(std::atan2(first_ahead.y(), first_ahead.x()), c.frame_pose(2), 1e-9);
     EXPECT_TRUE(c.healthy());
     weight += parts[k].weight;

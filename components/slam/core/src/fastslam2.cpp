@@ -60,8 +60,8 @@ Landmark landmark_now(const Particle& p, std::uint32_t slot, const Landmark& in_
   Landmark lm = in_map;
   lm.mean = p.joint->landmark_mean(i);
   lm.cov = p.joint->landmark_cov(i);
-  lm.times_observed = p.joint->counts[static_cast<std::size_t>(i)].times_observed;
-  lm.consecutive_rejections = p.joint->counts[static_cast<std::size_t>(i)].consecutive_rejections;
+  lm.times_observed = p.joint->landmarks[static_cast<std::size_t>(i)].counts.times_observed;
+  lm.consecutive_rejections = p.joint->landmarks[static_cast<std::size_t>(i)].counts.consecutive_rejections;
   return lm;
 }
 
@@ -318,7 +318,7 @@ void FastSlam2::recycle_slots() {
   for (const Particle& p : particles_) {
     p.map.for_each([&held](std::uint32_t slot, const Landmark&) { held[slot] = 1; });
     if (p.joint.active()) {
-      for (const std::uint32_t slot : p.joint->slots) held[slot] = 1;
+      for (const JointLandmark& l : p.joint->landmarks) held[l.slot] = 1;
     }
   }
   for (const Anchor& a : anchors_) held[a.slot] = 1;
@@ -763,7 +763,7 @@ FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian
       // joint state instead, and plain FastSLAM 2.0 re-admits it next frame.
       decision_[k] = Decision::kGated;
       log_w += outlier_log_likelihood(fit.log_likelihood, fit.mahalanobis2);
-      if (g.counts[static_cast<std::size_t>(i)].consecutive_rejections + 1 >=
+      if (g.landmarks[static_cast<std::size_t>(i)].counts.consecutive_rejections + 1 >=
           static_cast<std::uint32_t>(options_.gate_readmit_after)) {
         end_joint = true;
       }
@@ -790,7 +790,8 @@ FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian
     for (int i = 0; i < landmarks_before; ++i) {
       const auto u = static_cast<std::size_t>(i);
       const Eigen::Index j = 3 + 2 * i;
-      marginals_before_.push_back({g.slots[u], mean_before_.segment<2>(j), cov_before_.diagonal_block<2>(j), g.counts[u]});
+      marginals_before_.push_back(
+          {g.landmarks[u].slot, mean_before_.segment<2>(j), cov_before_.diagonal_block<2>(j), g.landmarks[u].counts});
     }
     return JointOutcome::kBrokeDown;
   }
@@ -798,7 +799,7 @@ FastSlam2::JointOutcome FastSlam2::update_joint_state(Particle& p, JointGaussian
   // entry for a first sighting only, so that later frames know it is mapped.
   for (std::size_t k = 0; k < n; ++k) {
     if (decision_[k] == Decision::kNew || decision_[k] == Decision::kInvalid) continue;
-    LandmarkCounts& counts = g.counts[static_cast<std::size_t>(g.find(slots_[k]))];
+    LandmarkCounts& counts = g.landmarks[static_cast<std::size_t>(g.find(slots_[k]))].counts;
     switch (decision_[k]) {
       case Decision::kNewDone:
         p.map.modify(slots_[k]).id = id_of_slot_[slots_[k]];
@@ -862,7 +863,7 @@ double FastSlam2::draw_heading_at_return(Particle& p, JointGaussian& g) {
   known_.clear();
   for (std::size_t k = 0; k < decision_.size(); ++k) {
     if (decision_[k] == Decision::kNewDone) continue;
-    if (g.relative[static_cast<std::size_t>(joint_index(p, g, k))] == 0) known_.push_back(k);
+    if (!g.landmarks[static_cast<std::size_t>(joint_index(p, g, k))].relative) known_.push_back(k);
   }
   if (known_.empty()) return 0.0;
   std::vector<HeadingComponent> components = split_heading(g, spacing);

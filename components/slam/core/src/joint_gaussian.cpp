@@ -25,10 +25,8 @@ int append_block(JointGaussian& g, std::uint32_t slot) {
   g.mean.conservativeResize(n + 2);
   g.mean.tail<2>().setZero();
   g.cov.grow(2);
-  g.slots.push_back(slot);
-  g.first.emplace_back(Eigen::Vector2d::Zero());
-  g.relative.push_back(0);
-  g.counts.emplace_back();
+  g.landmarks.push_back({});
+  g.landmarks.back().slot = slot;
   return g.landmark_count() - 1;
 }
 
@@ -55,8 +53,8 @@ Eigen::Matrix<double, 3, 2> JointGaussian::pose_landmark_cov(int i) const {
 }
 
 int JointGaussian::find(std::uint32_t slot) const {
-  for (std::size_t i = 0; i < slots.size(); ++i) {
-    if (slots[i] == slot) return static_cast<int>(i);
+  for (std::size_t i = 0; i < landmarks.size(); ++i) {
+    if (landmarks[i].slot == slot) return static_cast<int>(i);
   }
   return -1;
 }
@@ -71,20 +69,14 @@ PoseGaussian JointGaussian::pose() const {
 void JointGaussian::begin(const PoseGaussian& pose) {
   mean = pose.mean;
   cov.assign(pose.cov);
-  slots.clear();
-  first.clear();
-  relative.clear();
-  counts.clear();
+  landmarks.clear();
   frame_pose = pose.mean;
 }
 
 void JointGaussian::clear() {
   mean.resize(0);
   cov.clear();
-  slots.clear();
-  first.clear();
-  relative.clear();
-  counts.clear();
+  landmarks.clear();
 }
 
 JointGaussian& SharedJointGaussian::begin(const PoseGaussian& pose) {
@@ -148,8 +140,8 @@ int JointGaussian::add_known(std::uint32_t slot, const Eigen::Vector2d& landmark
   const int i = append_block(*this, slot);
   mean.tail<2>() = landmark_mean;
   cov.set_diagonal_block<2>(3 + 2 * i, landmark_cov);
-  first.back() = landmark_mean;
-  counts.back() = landmark_counts;
+  landmarks.back().first = landmark_mean;
+  landmarks.back().counts = landmark_counts;
   return i;
 }
 
@@ -174,8 +166,8 @@ int JointGaussian::add_new(std::uint32_t slot, const Eigen::Vector2d& z, const E
   }
   const int i = append_block(*this, slot);
   mean.tail<2>() = landmark;
-  first.back() = landmark;
-  relative.back() = 1;
+  landmarks.back().first = landmark;
+  landmarks.back().relative = true;
   for (Eigen::Index k = 0; k < n; ++k) {
     cov.lower(n, k) = cross(0, k);
     cov.lower(n + 1, k) = cross(1, k);
@@ -187,7 +179,7 @@ int JointGaussian::add_new(std::uint32_t slot, const Eigen::Vector2d& z, const E
 JointFit fit_observation(const JointGaussian& g, int index, const Eigen::Vector2d& z, const Eigen::Matrix2d& r) {
   const Eigen::Index j = 3 + 2 * index;
   const PredictedObservation p =
-      predict_observation(g.frame_pose, g.first[static_cast<std::size_t>(index)]);
+      predict_observation(g.frame_pose, g.landmarks[static_cast<std::size_t>(index)].first);
   JointFit fit;
   fit.index = index;
   fit.innovation = innovation(z, predict_observation(g.mean.head<3>(), g.mean.segment<2>(j)).z);
@@ -325,7 +317,7 @@ void to_robocentric(const JointGaussian& g, Eigen::VectorXd& mean, Eigen::Matrix
   Eigen::MatrixXd j = Eigen::MatrixXd::Identity(n, n);
   mean = g.mean;
   for (int i = 0; i < g.landmark_count(); ++i) {
-    if (g.relative[static_cast<std::size_t>(i)] == 0) continue;
+    if (!g.landmarks[static_cast<std::size_t>(i)].relative) continue;
     const Eigen::Index b = 3 + 2 * i;
     const Eigen::Vector2d d = g.mean.segment<2>(b) - pose.head<2>();
     mean.segment<2>(b) = rt * d;
@@ -349,7 +341,7 @@ void from_robocentric(const JointGaussian& from, const Eigen::VectorXd& mean, co
   Eigen::MatrixXd j = Eigen::MatrixXd::Identity(n, n);
   out.mean = mean;
   for (int i = 0; i < from.landmark_count(); ++i) {
-    if (from.relative[static_cast<std::size_t>(i)] == 0) continue;
+    if (!from.landmarks[static_cast<std::size_t>(i)].relative) continue;
     const Eigen::Index b = 3 + 2 * i;
     const Eigen::Vector2d m_r = mean.segment<2>(b);
     out.mean.segment<2>(b) = after.head<2>() + r * m_r;
@@ -364,7 +356,7 @@ void from_robocentric(const JointGaussian& from, const Eigen::VectorXd& mean, co
   };
   for (int i = 0; i < from.landmark_count(); ++i) {
     const auto k = static_cast<std::size_t>(i);
-    if (from.relative[k] != 0) out.first[k] = move(from.first[k]);
+    if (from.landmarks[k].relative) out.landmarks[k].first = move(from.landmarks[k].first);
   }
   out.frame_pose.head<2>() = move(from.frame_pose.head<2>());
   out.frame_pose(2) = wrap_angle(from.frame_pose(2) + wrap_angle(after(2) - before(2)));
@@ -409,14 +401,14 @@ std::vector<ConditionedLandmark> condition_on_pose(const JointGaussian& g, const
   Eigen::Vector3d dx = pose - g.mean.head<3>();
   dx(2) = wrap_angle(dx(2));
   std::vector<ConditionedLandmark> out;
-  out.reserve(g.slots.size());
+  out.reserve(g.landmarks.size());
   for (int i = 0; i < g.landmark_count(); ++i) {
     const Eigen::Index j = 3 + 2 * i;
     const Eigen::Matrix<double, 3, 2> pxi = g.pose_landmark_cov(i);
     const Eigen::Matrix<double, 2, 3> a = ldlt.solve(pxi).transpose();  // P_ix Pxx^-1
     ConditionedLandmark c;
-    c.slot = g.slots[static_cast<std::size_t>(i)];
-    c.counts = g.counts[static_cast<std::size_t>(i)];
+    c.slot = g.landmarks[static_cast<std::size_t>(i)].slot;
+    c.counts = g.landmarks[static_cast<std::size_t>(i)].counts;
     c.mean = g.mean.segment<2>(j) + a * dx;
     c.cov = g.landmark_cov(i) - a * pxi;
     c.cov = 0.5 * (c.cov + c.cov.transpose()).eval();

@@ -19,6 +19,19 @@ struct LandmarkCounts {
   std::uint32_t consecutive_rejections = 0;
 };
 
+// What a JointGaussian keeps of one of its landmarks besides its mean and covariance.
+struct JointLandmark {
+  Eigen::Vector2d first = Eigen::Vector2d::Zero();  // first estimate (the FEJ linearisation point)
+  std::uint32_t slot = 0;
+  // While a landmark is in the state its counters live here, so a frame's
+  // bookkeeping does not copy the particle's map tree; the map takes them when
+  // the state ends.
+  LandmarkCounts counts;
+  // First seen in this state (add_new): placed relative to the pose, it turns
+  // with it when a mapped landmark corrects the heading.
+  bool relative = false;
+};
+
 // One particle's pose and the landmarks it saw while its pose was too uncertain
 // to sample (delayed sampling, see FastSlam2): a single Gaussian over
 // (x, y, theta, m1x, m1y, m2x, ...), updated like EKF-SLAM. Landmarks seen from
@@ -39,21 +52,14 @@ struct JointGaussian {
   // The covariance, packed: with thousands of particles the filter waits on
   // memory, and an update streams half the bytes of dense storage.
   PackedSymmetric cov;
-  std::vector<std::uint32_t> slots;       // landmark slot of state block i (at 3 + 2i)
-  std::vector<Eigen::Vector2d> first;     // first estimate of landmark i
-  // Landmark i was first seen in this state (add_new): placed relative to the
-  // pose, it turns with it when a mapped landmark corrects the heading.
-  std::vector<std::uint8_t> relative;
-  // Landmark i's counters. While a landmark is in the state its counters live
-  // here with its mean and covariance, so a frame's bookkeeping does not copy the
-  // particle's map tree; the map takes them when the state ends.
-  std::vector<LandmarkCounts> counts;
+  // What the state keeps of landmark i besides its mean and covariance (block 3 + 2i).
+  std::vector<JointLandmark> landmarks;
   Eigen::Vector3d frame_pose = Eigen::Vector3d::Zero();  // pose predicted for the frame
 
   bool active() const { return mean.size() != 0; }
   // Finite, with non-negative and bounded variances.
   bool healthy() const;
-  int landmark_count() const { return static_cast<int>(slots.size()); }
+  int landmark_count() const { return static_cast<int>(landmarks.size()); }
   // Block index of a landmark slot, -1 when it is not in the state.
   int find(std::uint32_t slot) const;
   PoseGaussian pose() const;
