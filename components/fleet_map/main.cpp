@@ -53,9 +53,11 @@ int main(int argc, char** argv) {
     }
     node.stop();
     const fleet_map_node::FleetMapCounters c = node.counters();
-    std::fprintf(stderr, "fleet_map: stopped; %llu map states from %zu robots (%llu stale, %llu restarts, %llu beyond "
-                         "max_robots, %llu malformed), %llu fleet maps published (%llu failed)\n",
-                 static_cast<unsigned long long>(c.map_states), c.robots, static_cast<unsigned long long>(c.stale),
+    std::fprintf(stderr, "fleet_map: stopped; %llu map states, %zu robots at the end (%llu timed out; %llu stale, "
+                         "%llu restarts, %llu beyond max_robots, %llu malformed), %llu fleet maps published (%llu "
+                         "failed)\n",
+                 static_cast<unsigned long long>(c.map_states), c.robots,
+                 static_cast<unsigned long long>(c.robots_timed_out), static_cast<unsigned long long>(c.stale),
                  static_cast<unsigned long long>(c.restarts), static_cast<unsigned long long>(c.robots_over_limit),
                  static_cast<unsigned long long>(c.malformed),
                  static_cast<unsigned long long>(c.fleet_maps), static_cast<unsigned long long>(c.publish_failures));

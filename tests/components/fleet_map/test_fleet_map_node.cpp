@@ -37,13 +37,15 @@ msg::MapState map_state(std::uint64_t stamp_ns, double dx) {
 
 // A FleetMapNode on the loopback domain and a reader of what it publishes.
 struct FleetBench {
-  explicit FleetBench(int max_robots = 64) : node(options(max_robots)), robots(loopback_options(), "test_estimators") {
+  explicit FleetBench(int max_robots = 64, double robot_timeout_s = 60.0)
+      : node(options(max_robots, robot_timeout_s)), robots(loopback_options(), "test_estimators") {
     node.start();
   }
-  static FleetMapOptions options(int max_robots) {
+  static FleetMapOptions options(int max_robots, double robot_timeout_s) {
     FleetMapOptions o;
     o.period_s = 0.1;
     o.max_robots = max_robots;
+    o.robot_timeout_s = robot_timeout_s;
     o.dds = loopback_options();
     o.dds.robot_id = "fleet";
     return o;
@@ -174,6 +176,41 @@ TEST(FleetMapNode, AFarFutureStampAndInventedRobotsAreBounded) {
   EXPECT_EQ(bench.got.back().header().stamp_ns(), t);
   ASSERT_EQ(bench.got.back().landmarks().size(), 6u);
   EXPECT_NEAR(bench.got.back().landmarks()[0].x_m(), 0.0, 1e-9);  // the real map, not the hostile one
+}
+
+// Robot ids invented once (or robots that left) fill max_robots; once silent
+// for robot_timeout_s they leave the fusion, and a real robot takes their place.
+TEST(FleetMapNode, SilentRobotsTimeOutAndFreeTheirPlaces) {
+  FleetBench bench(2, 2.0);
+  FleetMapNode& node = bench.node;
+  dds::Writer<msg::MapState> ghost1(bench.robots, "ghost1"), ghost2(bench.robots, "ghost2"),
+      robot(bench.robots, "robot3");
+  for (dds::Writer<msg::MapState>* w : {&ghost1, &ghost2, &robot}) {
+    ASSERT_TRUE(w->wait_for_readers(1, std::chrono::seconds(10)));
+  }
+  const std::uint64_t t = 1'000'000'000'000ull;
+  msg::MapState ghost = map_state(t, 0.0), first = map_state(t + 1, 0.0), second = map_state(t + 2, 0.0);
+  ASSERT_TRUE(ghost1.publish(ghost));
+  ASSERT_TRUE(ghost2.publish(ghost));
+  ASSERT_TRUE(ghost1.wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(ghost2.wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(robot.publish(first));  // no place: dropped
+  ASSERT_TRUE(robot.wait_for_acknowledgments(std::chrono::seconds(10)));
+  EXPECT_EQ(node.counters().robots_over_limit, 1u);
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  ASSERT_TRUE(robot.publish(second));
+  ASSERT_TRUE(robot.wait_for_acknowledgments(std::chrono::seconds(10)));
+  bench.wait_for(1, t + 2);
+  node.stop();
+  const FleetMapCounters c = node.counters();
+  EXPECT_EQ(c.robots_timed_out, 2u);
+  EXPECT_EQ(c.robots_over_limit, 1u);
+  EXPECT_EQ(c.robots, 1u);
+  std::lock_guard<std::mutex> lock(bench.mutex);
+  ASSERT_FALSE(bench.got.empty());
+  ASSERT_EQ(bench.got.back().robots().size(), 1u);
+  EXPECT_EQ(bench.got.back().robots()[0].robot_id(), "robot3");
+  EXPECT_EQ(bench.got.back().header().stamp_ns(), t + 2);
 }
 
 }  // namespace

@@ -26,6 +26,9 @@ const parameters::Table<FleetMapOptions>& fleet_map_parameters() {
                  [](O& o) -> double& { return o.period_s; }),
       P::integer<O, int>("max_robots", 1, 4096, "", "robots fused at most; MapStates of further robot ids are dropped",
                          [](O& o) -> int& { return o.max_robots; }),
+      P::real<O>("robot_timeout_s", 0.0, 1e6, "s",
+                 "a robot heard from no MapState for this long leaves the fusion and frees its place (0: never)",
+                 [](O& o) -> double& { return o.robot_timeout_s; }),
       P::integer<O, int>("min_common_landmarks", 3, 100000, "",
                          "landmarks a robot must share with the others for its frame to be checked (and aligned)",
                          [](O& o) -> int& { return o.fusion.min_common_landmarks; }),
@@ -137,6 +140,7 @@ diagnostics::Snapshot FleetMapNode::diagnostics_snapshot() const {
                 {"stale", c.stale, false},
                 {"restarts", c.restarts, true},
                 {"robots_over_limit", c.robots_over_limit, true},
+                {"robots_timed_out", c.robots_timed_out, false},
                 {"malformed", c.malformed, true},
                 {"seq_jumps", c.seq_jumps, true},
                 {"fleet_maps", c.fleet_maps, false},
@@ -181,20 +185,41 @@ void FleetMapNode::on_map_state(const msg::MapState& state) {
   std::lock_guard<std::mutex> lock(mutex_);
   ++counters_.map_states;
   const std::uint64_t stamp = state.header().stamp_ns();
+  const auto now = std::chrono::steady_clock::now();
   const auto it = maps_.find(state.header().robot_id());
   if (it == maps_.end() && maps_.size() >= static_cast<std::size_t>(options_.max_robots)) {
-    ++counters_.robots_over_limit;
-    return;
+    time_out_silent_robots(now);
+    if (maps_.size() >= static_cast<std::size_t>(options_.max_robots)) {
+      ++counters_.robots_over_limit;
+      return;
+    }
   }
-  if (it != maps_.end() && stamp < it->second.stamp_ns) {
-    if (static_cast<double>(it->second.stamp_ns - stamp) * 1e-9 <= kRestartGapS) {
+  if (it != maps_.end() && stamp < it->second.map.stamp_ns) {
+    if (static_cast<double>(it->second.map.stamp_ns - stamp) * 1e-9 <= kRestartGapS) {
       ++counters_.stale;
       return;
     }
     ++counters_.restarts;
   }
-  maps_[state.header().robot_id()] = to_robot_map(state);
+  maps_[state.header().robot_id()] = {to_robot_map(state), now};
   changed_ = true;
+}
+
+void FleetMapNode::time_out_silent_robots(std::chrono::steady_clock::time_point now) {
+  if (options_.robot_timeout_s <= 0.0) return;
+  const auto timeout = std::chrono::duration<double>(options_.robot_timeout_s);
+  for (auto it = maps_.begin(); it != maps_.end();) {
+    if (now - it->second.heard <= timeout) {
+      ++it;
+      continue;
+    }
+    std::fprintf(stderr, "fleet_map: no MapState from %s for %g s: it leaves the fleet map\n",
+                 dds::printable(it->first).c_str(), options_.robot_timeout_s);
+    ++counters_.robots_timed_out;
+    verdicts_.erase(it->first);
+    it = maps_.erase(it);
+    changed_ = true;
+  }
 }
 
 void FleetMapNode::loop() {
@@ -216,12 +241,16 @@ void FleetMapNode::fuse_and_publish() {
   std::uint64_t stamp = 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    time_out_silent_robots(std::chrono::steady_clock::now());
     if (!changed_) return;
     changed_ = false;
     for (const auto& entry : maps_) {
-      maps.push_back(entry.second);
-      stamp = std::max(stamp, entry.second.stamp_ns);
+      maps.push_back(entry.second.map);
+      stamp = std::max(stamp, entry.second.map.stamp_ns);
     }
+    // With every robot gone the (empty) fleet map keeps the last stamp.
+    if (maps.empty()) stamp = published_stamp_ns_;
+    published_stamp_ns_ = stamp;
   }
   const fleet_map::FleetMap fleet = fleet_map::fuse_maps(maps, options_.fusion);
   msg::FleetMap message = to_fleet_map_msg(fleet, maps, stamp);

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <map>
@@ -34,6 +35,10 @@ namespace pixyslam::fleet_map_node {
 struct FleetMapOptions {
   double period_s = 1.0;  // `fleet_map.period_s`: a fleet map this often while some robot's map changed
   int max_robots = 64;    // `fleet_map.max_robots`: MapStates of further robot ids are dropped (counted)
+  // `fleet_map.robot_timeout_s`: a robot heard from no MapState for this long
+  // (receive time) leaves the fusion, and its place under max_robots is free
+  // again (0: robots stay for good).
+  double robot_timeout_s = 60.0;
   fleet_map::FusionOptions fusion;  // `fleet_map.min_common_landmarks`, `agreement_probability`, `disagreement`
   dds::DdsOptions dds;    // dds.robot_id names the fleet map's writer (e.g. "fleet")
 };
@@ -55,6 +60,7 @@ struct FleetMapCounters {
   std::uint64_t stale = 0;            // older than the robot's newest: ignored
   std::uint64_t restarts = 0;         // more than 10 s older than the robot's newest: a restart, taken
   std::uint64_t robots_over_limit = 0;  // MapStates of robots beyond max_robots: dropped
+  std::uint64_t robots_timed_out = 0;   // robots silent for robot_timeout_s: left the fusion
   std::uint64_t malformed = 0;        // did not decode, or the callback threw
   std::uint64_t seq_jumps = 0;
   std::uint64_t fleet_maps = 0;       // published
@@ -67,8 +73,11 @@ struct FleetMapCounters {
 // them (fleet_map::fuse_maps) and publishes a FleetMap stamped with the newest
 // kept MapState's stamp. A MapState more than 10 s older than its
 // robot's newest is taken as a restart (a new clock), not as stale, so that
-// one stamp from the far future cannot freeze a robot's map. A robot's frame
-// verdict that changes is logged; counters go out on pixyslam/diagnostics.
+// one stamp from the far future cannot freeze a robot's map. A robot silent for
+// robot_timeout_s leaves the fusion (the fleet map is of the robots on the
+// domain now, and invented robot ids cannot hold max_robots for good). A
+// robot's frame verdict that changes, and a robot that times out, are logged;
+// counters go out on pixyslam/diagnostics.
 class FleetMapNode {
  public:
   explicit FleetMapNode(const FleetMapOptions& options);
@@ -84,12 +93,20 @@ class FleetMapNode {
   void on_map_state(const msg::MapState& state);
   void loop();
   void fuse_and_publish();
+  // Drops the robots heard from no MapState since `now - robot_timeout_s`.
+  // Call with mutex_ held.
+  void time_out_silent_robots(std::chrono::steady_clock::time_point now);
   diagnostics::Snapshot diagnostics_snapshot() const;
 
   const FleetMapOptions options_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;
-  std::map<std::string, fleet_map::RobotMap> maps_;  // newest per robot
+  struct KeptMap {
+    fleet_map::RobotMap map;                      // the robot's newest
+    std::chrono::steady_clock::time_point heard;  // when its last MapState came
+  };
+  std::map<std::string, KeptMap> maps_;
+  std::uint64_t published_stamp_ns_ = 0;          // of the last fleet map
   std::map<std::string, std::string> verdicts_;      // last logged per robot
   bool changed_ = false;
   bool stopping_ = false;
