@@ -148,7 +148,7 @@ void print_segment_summary(const std::string& label, const std::vector<Segment>&
 // The runs of one robot and seed restarted from the truth every every_s seconds.
 std::vector<Segment> run_segments(const slam::FilterOptions& options, const offline::RunInput& input, int robot,
                                   double every_s, const OptimiseRequest& optimise) {
-  const std::vector<eval::TimedPose> truth = offline::sorted_by_time(input.truth);
+  const std::vector<eval::TimedPose> truth = eval::sorted_by_time(input.truth);
   std::vector<Segment> out;
   for (double start : offline::segment_starts(truth, every_s)) {
     const offline::RunInput restarted = offline::restart_at_truth(input, start);
@@ -379,7 +379,7 @@ void for_each_run_with_starts(const std::vector<std::pair<int, offline::RunInput
                               const Run& run) {
   for (const auto& [robot, input] : inputs) {
     if (input.truth.empty()) continue;
-    const std::vector<eval::TimedPose> truth = offline::sorted_by_time(input.truth);
+    const std::vector<eval::TimedPose> truth = eval::sorted_by_time(input.truth);
     const std::vector<double> starts = offline::segment_starts(truth, every_s);
     for (int seed : seeds) {
       options.seed = static_cast<std::uint64_t>(seed);
@@ -548,7 +548,7 @@ class CsvOutput {
           << rep.dead_reckoning.heading_rmse_rad * kDeg << ',' << rep.landmarks.rmse_m << ','
           << rep.landmarks.rmse_aligned_m << ',' << rep.nees.fraction_inside() << '\n';
     if (input.truth.empty() || res.trajectory.empty()) return;
-    const std::vector<eval::TimedPose> truth = offline::sorted_by_time(input.truth);
+    const std::vector<eval::TimedPose> truth = eval::sorted_by_time(input.truth);
     const std::vector<eval::PoseError> filter = eval::pose_errors(res.trajectory, truth);
     const std::vector<eval::PoseError> dr = eval::pose_errors(res.dead_reckoning, truth);
     std::ofstream out = open("errors_robot" + std::to_string(robot) + "_seed" + std::to_string(seed) + ".csv");

@@ -52,11 +52,6 @@ std::vector<eval::LandmarkPoint> unique_landmarks(const Landmarks& landmarks, st
 // MapStates this far outside the ground truth's time span are not scored.
 constexpr double kScoredMarginS = 10.0;
 
-void sort_by_time(std::vector<eval::TimedPose>& poses) {
-  std::stable_sort(poses.begin(), poses.end(),
-                   [](const eval::TimedPose& a, const eval::TimedPose& b) { return a.t_s < b.t_s; });
-}
-
 // Everything received, under one lock (callbacks come from DDS threads).
 struct Received {
   std::mutex mutex;
@@ -152,9 +147,9 @@ int run(const Arguments& args) {
   }
   // In time order, whatever order the samples came in; estimates stamped far
   // outside the truth's time (made up by another participant) are not scored.
-  sort_by_time(r.estimate);
-  sort_by_time(r.truth);
-  sort_by_time(r.optimised_keyframes);
+  r.estimate = eval::sorted_by_time(std::move(r.estimate));
+  r.truth = eval::sorted_by_time(std::move(r.truth));
+  r.optimised_keyframes = eval::sorted_by_time(std::move(r.optimised_keyframes));
   if (!r.truth.empty()) {
     const double from_s = r.truth.front().t_s - kScoredMarginS, to_s = r.truth.back().t_s + kScoredMarginS;
     const std::size_t before = r.estimate.size();

@@ -151,4 +151,9 @@ LandmarkErrors compare_landmarks(const std::vector<LandmarkPoint>& estimate, con
   return errors;
 }
 
+std::vector<TimedPose> sorted_by_time(std::vector<TimedPose> poses) {
+  std::stable_sort(poses.begin(), poses.end(), [](const TimedPose& a, const TimedPose& b) { return a.t_s < b.t_s; });
+  return poses;
+}
+
 }  // namespace pixyslam::eval

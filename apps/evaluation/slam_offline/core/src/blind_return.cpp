@@ -54,7 +54,7 @@ std::optional<BlindReturnCase> make_blind_return(const RunInput& restarted, cons
   }
   if (!found || c.return_s > far_end + o.after_s) return std::nullopt;
   const double end = c.return_s + o.after_s;
-  const std::vector<eval::TimedPose> truth = sorted_by_time(restarted.truth);
+  const std::vector<eval::TimedPose> truth = eval::sorted_by_time(restarted.truth);
   if (truth.empty() || truth.back().t_s < end) return std::nullopt;
 
   c.input = restarted;

@@ -106,7 +106,7 @@ Report evaluate(const RunInput& input, const RunResult& result) {
     r.has_truth = true;
     r.filter = eval::compare_trajectory(result.trajectory, input.truth);
     r.dead_reckoning = eval::compare_trajectory(result.dead_reckoning, input.truth);
-    r.nees = trajectory_nees(result.trajectory, result.covariance, sorted_by_time(input.truth));
+    r.nees = trajectory_nees(result.trajectory, result.covariance, eval::sorted_by_time(input.truth));
   }
   if (!input.landmarks.empty() && !result.landmarks.empty()) {
     r.has_landmarks = true;
@@ -227,7 +227,7 @@ void print_report(const std::string& title, const Report& r, const RunResult& re
 
 RunInput restart_at_truth(const RunInput& input, double start_s) {
   const std::optional<eval::TimedPose> g =
-      interpolate_pose(sorted_by_time(input.truth), start_s, std::numeric_limits<double>::infinity());
+      interpolate_pose(eval::sorted_by_time(input.truth), start_s, std::numeric_limits<double>::infinity());
   if (!g) throw std::invalid_argument("restart_at_truth: no ground truth at the start time");
   RunInput restarted = input;
   restarted.initial_pose = slam::Pose2(g->x_m, g->y_m, g->theta_rad);

@@ -31,11 +31,6 @@ Summary summarize(std::vector<double> values) {
   return s;
 }
 
-std::vector<eval::TimedPose> sorted_by_time(std::vector<eval::TimedPose> poses) {
-  std::stable_sort(poses.begin(), poses.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
-  return poses;
-}
-
 std::optional<eval::TimedPose> interpolate_pose(const std::vector<eval::TimedPose>& truth, double t,
                                                 double max_gap_s) {
   if (truth.empty() || !(t >= truth.front().t_s && t <= truth.back().t_s)) return std::nullopt;

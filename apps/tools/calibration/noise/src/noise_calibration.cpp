@@ -516,7 +516,7 @@ References truth_references(const offline::RunInput& raw) {
   if (raw.truth.empty() || raw.landmarks.empty()) {
     throw std::invalid_argument("noise calibration with ground truth: needs robot and landmark ground truth");
   }
-  const std::vector<eval::TimedPose> truth = offline::sorted_by_time(raw.truth);
+  const std::vector<eval::TimedPose> truth = eval::sorted_by_time(raw.truth);
   References refs;
   refs.frame_pose.resize(raw.frames.size(), slam::Pose2::Zero());
   refs.has_pose.resize(raw.frames.size(), false);

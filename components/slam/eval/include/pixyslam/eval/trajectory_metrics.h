@@ -24,6 +24,9 @@ struct LandmarkPoint {
   double y_m;
 };
 
+// The poses in time order (equal times keep their order).
+std::vector<TimedPose> sorted_by_time(std::vector<TimedPose> poses);
+
 // Trajectory error statistics over `samples` truth poses: RMSE and maximum of
 // the position error (m) and the truth time of that maximum (s), RMSE of the
 // wrapped heading error (rad), and the

@@ -25,8 +25,6 @@ struct Summary {
 };
 Summary summarize(std::vector<double> values);
 
-// The poses in time order (equal times keep their order).
-std::vector<eval::TimedPose> sorted_by_time(std::vector<eval::TimedPose> poses);
 
 // The pose at time t interpolated between the two truth poses around it (x, y
 // linearly, heading along the shorter arc), or nullopt when t lies outside the
