@@ -1,7 +1,7 @@
 // robot_sim: the simulated robot's hardware. Writes Arduino encoder lines and
 // Pixy UART bytes into two pseudo-terminals and publishes GroundTruth.
 //   robot_sim --config config/robot_sim.yaml [--pixy-config config/pixy_bridge.yaml]
-//             [--encoder-config config/encoder_bridge.yaml] [--duration S]
+//             [--encoder-config config/encoder_bridge.yaml] [--duration S] [--rate R]
 //             [--arduino-link PATH] [--pixy-link PATH] [--camera-video FIFO] [--domain N]
 //             [--set world.KEY=V,hardware.KEY=V,run.KEY=V,dds.KEY=V ...]
 // The bridge configs default to the files beside --config. Exits 0 when the
@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
   using namespace pixyslam;
   app::StopSignal::install();
   std::string config, pixy_config, encoder_config, arduino_link, pixy_link, camera_video;
-  double duration_s = 0.0;
+  double duration_s = 0.0, rate = 1.0;
   bool verbose = false;
   std::vector<std::string> dds_overrides, overrides;
   app::Cli cli{"robot_sim",
@@ -33,6 +33,9 @@ int main(int argc, char** argv) {
       .existing_file()
       .type("FILE");
   cli.option("--duration", duration_s, "simulated seconds (default: run.duration_s)").non_negative().type("S");
+  cli.option("--rate", rate, "hardware seconds per wall second (overrides run.rate)")
+      .range(0.1, 10.0)
+      .type("R");
   cli.option("--arduino-link", arduino_link, "a symlink to the Arduino's pseudo-terminal at PATH").type("PATH");
   cli.option("--pixy-link", pixy_link, "a symlink to the Pixy's pseudo-terminal at PATH").type("PATH");
   cli.option("--camera-video", camera_video, "also write the synthetic camera's frames to FIFO").type("FIFO");
@@ -51,6 +54,7 @@ int main(int argc, char** argv) {
         robot_sim::apply_overrides(c, overrides);
         // The dedicated flags after --set, as everywhere: the narrower statement wins.
         if (cli.given("--duration")) c.run.duration_s = duration_s;
+        if (cli.given("--rate")) c.run.rate = rate;
         if (cli.given("--arduino-link")) c.run.arduino_link = arduino_link;
         if (cli.given("--pixy-link")) c.run.pixy_link = pixy_link;
         if (cli.given("--camera-video")) c.run.camera_video = camera_video;

@@ -393,7 +393,9 @@ const parameters::Table<Options>& table() {
                    if (v.find('.') == std::string::npos) throw std::invalid_argument("not dotted");
                  }),
       P::required(P::real<O>("rate_hz", 0.1, 100.0, "Hz", "the rate", [](O& o) -> double& { return o.rate_hz; })),
-      P::real<O>("max_rate_hz", 0.1, 1000.0, "Hz", "the most", [](O& o) -> double& { return o.max_rate_hz; }),
+      P::renamed(
+          P::real<O>("max_rate_hz", 0.1, 1000.0, "Hz", "the most", [](O& o) -> double& { return o.max_rate_hz; }),
+          "top_hz"),
   };
   return t;
 }
@@ -453,6 +455,32 @@ TEST(ParameterTable, OverridesFromTextCheckLikeTheFile) {
     EXPECT_THROW(parameters::apply_override(o, table_test::table(), "s", bad), std::invalid_argument) << bad;
     EXPECT_EQ(o.peers, before.peers) << bad;  // unchanged after a refused value
   }
+}
+
+// A renamed key: a file with the old name is read (the warning names the file
+// and both keys), one with both is refused, and --set with the old name is
+// refused naming the new one.
+TEST(ParameterTable, ARenamedKeyIsStillReadFromFilesButNotFromOverrides) {
+  testing::internal::CaptureStderr();
+  const table_test::Options o = table_test::read("s:\n  rate_hz: 5\n  top_hz: 50\n");
+  const std::string warning = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(o.max_rate_hz, 50.0);
+  EXPECT_NE(warning.find("t.yaml: key 's.top_hz' is deprecated: it was renamed 's.max_rate_hz'"), std::string::npos)
+      << warning;
+  EXPECT_NE(config_error_of([] { table_test::read("s:\n  rate_hz: 5\n  top_hz: 50\n  max_rate_hz: 40\n"); })
+                .find("t.yaml: key 's.top_hz': renamed 's.max_rate_hz', which is given too"),
+            std::string::npos);
+  EXPECT_NE(config_error_of([] { table_test::read("s:\n  rate_hz: 5\n  top_hz: 500000\n"); })
+                .find("t.yaml: key 's.top_hz': value 500000 is out of range"),
+            std::string::npos);
+  table_test::Options over;
+  try {
+    parameters::apply_override(over, table_test::table(), "s", "s.top_hz=20");
+    ADD_FAILURE() << "the old name was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "'s.top_hz' was renamed 's.max_rate_hz'");
+  }
+  EXPECT_EQ(over.max_rate_hz, 12.0);
 }
 
 }  // namespace

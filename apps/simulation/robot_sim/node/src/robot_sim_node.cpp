@@ -33,8 +33,9 @@ const parameters::Table<RunOptions>& run_parameters() {
       P::real<O>("ground_truth_rate_hz", 0.1, 1000.0, "Hz", "GroundTruth messages per second",
                  [](O& o) -> double& { return o.ground_truth_rate_hz; }),
       P::real<O>("tick_s", 0.0005, 0.1, "s", "wall-clock step of the emulation loop", [](O& o) -> double& { return o.tick_s; }),
-      P::real<O>("speed_factor", 0.1, 10.0, "", "hardware seconds per wall second",
-                 [](O& o) -> double& { return o.speed_factor; }),
+      P::renamed(P::real<O>("rate", 0.1, 10.0, "", "hardware seconds per wall second (a speed factor, as --rate)",
+                            [](O& o) -> double& { return o.rate; }),
+                 "speed_factor"),
       P::real<O>("unplug_at_s", 0.0, 1e6, "s", "fault test: both serial devices vanish at this time (0: never)",
                  [](O& o) -> double& { return o.unplug_at_s; }),
       P::real<O>("unplug_for_s", 0.01, 3600.0, "s", "... and come back this much later",
@@ -226,7 +227,7 @@ double RobotSimNode::run() {
   const auto tick = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(run.tick_s));
   auto wake = start;
   while (!app::StopSignal::requested()) {
-    t = std::chrono::duration<double>(Clock::now() - start).count() * run.speed_factor;
+    t = std::chrono::duration<double>(Clock::now() - start).count() * run.rate;
     if (run.duration_s > 0.0 && t > run.duration_s) t = run.duration_s;
     const HardwareOutput out = s.emulator.advance_to(t);
     if (run.unplug_at_s > 0.0 && s.arduino && t >= run.unplug_at_s && t < run.unplug_at_s + run.unplug_for_s) {

@@ -4,6 +4,7 @@
 // (pixyslam/parameters/parameters.h): every key read with the table's range,
 // nested mappings by the paths' prefixes, unknown keys refused (finish()),
 // required keys demanded.
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,20 @@
 #include "pixyslam/parameters/parameters.h"
 
 namespace pixyslam::config {
+
+// The key to read `p` from in this mapping: its former name when the file
+// still uses that (with a warning on stderr naming the file and both keys), else `key`.
+template <class Options>
+std::string renamed_key(const YamlReader& section, const parameters::Parameter<Options>& p, const std::string& prefix,
+                        const std::string& key) {
+  if (p.old_path.empty() || p.old_path.compare(0, prefix.size(), prefix) != 0) return key;
+  const std::string old_key = p.old_path.substr(prefix.size());
+  if (!section.has(old_key)) return key;
+  if (section.has(key)) section.fail(old_key, "renamed '" + section.key_path(key) + "', which is given too: keep one");
+  std::fprintf(stderr, "%s: key '%s' is deprecated: it was renamed '%s' (read as that; rename it in the file)\n",
+               section.origin().c_str(), section.key_path(old_key).c_str(), section.key_path(key).c_str());
+  return old_key;
+}
 
 // Reads the keys of `table` under `section` (paths below `prefix`) into `o`;
 // absent keys keep o's value. Finishes the nested mappings it opens; the
@@ -21,15 +36,16 @@ void read_parameters(YamlReader& section, const parameters::Table<Options>& tabl
   std::vector<std::string> groups;
   for (const parameters::Parameter<Options>& p : table) {
     if (p.path.compare(0, prefix.size(), prefix) != 0) continue;
-    const std::string key = p.path.substr(prefix.size());
-    const auto dot = key.find('.');
+    const std::string path = p.path.substr(prefix.size());
+    const auto dot = path.find('.');
     if (dot != std::string::npos) {
-      const std::string group = key.substr(0, dot);
+      const std::string group = path.substr(0, dot);
       bool seen = false;
       for (const std::string& g : groups) seen = seen || g == group;
       if (!seen) groups.push_back(group);
       continue;
     }
+    const std::string key = renamed_key(section, p, prefix, path);
     if (p.required && !section.has(key)) section.fail(key, "missing (required: " + p.help + ")");
     switch (p.kind) {
       case parameters::Kind::kReal: p.set(o, section.number(key, p.min, p.max, p.get(o))); break;

@@ -57,6 +57,9 @@ struct Parameter {
   // of a list) is not allowed; empty: any text.
   std::function<void(const std::string&)> check;
   bool required = false;  // the YAML must give it (required())
+  // Its former path (renamed()): a YAML file that still uses it is read, with
+  // a warning; --set with it is refused, naming the new path.
+  std::string old_path;
 };
 
 template <class Options>
@@ -195,6 +198,13 @@ Parameter<Options> required(Parameter<Options> p) {
   return p;
 }
 
+// The parameter was called `old_path` (in the same mapping) before.
+template <class Options>
+Parameter<Options> renamed(Parameter<Options> p, std::string old_path) {
+  p.old_path = std::move(old_path);
+  return p;
+}
+
 // ---- Using the table.
 
 // The whole of `text` as a finite number, or nothing.
@@ -297,7 +307,14 @@ void set_from_text(Options& o, const Table<Options>& table, const std::string& s
                    const std::string& text) {
   const Parameter<Options>* p = find(table, path);
   const std::string name = section + "." + path;
-  if (p == nullptr) throw std::invalid_argument("unknown parameter '" + name + "'");
+  if (p == nullptr) {
+    for (const Parameter<Options>& q : table) {
+      if (!q.old_path.empty() && q.old_path == path) {
+        throw std::invalid_argument("'" + name + "' was renamed '" + section + "." + q.path + "'");
+      }
+    }
+    throw std::invalid_argument("unknown parameter '" + name + "'");
+  }
   const auto fail = [&](const std::string& why) {
     throw std::invalid_argument(name + " = '" + text + "': " + why + " (" + range_text(*p) +
                                 (p->unit.empty() ? "" : " " + p->unit) + ")");

@@ -19,7 +19,7 @@ struct RunOptions {
   std::string pixy_link = "/tmp/pixyslam/pixy";
   double ground_truth_rate_hz = 10.0;
   double tick_s = 0.002;             // wall-clock step of the emulation loop
-  double speed_factor = 1.0;         // hardware seconds per wall second
+  double rate = 1.0;                 // hardware seconds per wall second (was speed_factor)
   // A fault for tests: both serial devices vanish at unplug_at_s (the ptys and
   // their links go, as a USB cable pulled out) and come back unplug_for_s later
   // at the same links while the robot drives on; bytes meanwhile are lost.
