@@ -105,7 +105,7 @@ grep -q "check passed" "$work/station.log" || fail "the log check"
 # late or reordered, ATE equal); Dataset6 live vs offline shows up to 9.1 mm.
 "$support/live_vs_offline.sh" "$bin" "$config" "$work/Dataset" "$work/run" "$work/station.log" 1,2 1 0 0.02 ||
   fail "the containers' results differ from slam_offline's"
-"$bin/pixyslam_log" print "$work/run/run.mcap" --topic pixyslam/fleet_map --json > "$work/fleet.json" ||
+"$bin/pixyslam_log" print "$work/run/run.mcap" --topics pixyslam/fleet_map --json > "$work/fleet.json" ||
   fail "print the fleet map"
 tail -n 1 "$work/fleet.json" | grep -q '"robot_id":"robot1".*"robot_id":"robot2"' || fail "the fleet map lacks a robot"
 [[ -s $work/run/fleet_map.png ]] || fail "no fleet picture"

@@ -101,12 +101,12 @@ grep -q "robot1: seq 1..100, robot2: seq 1..80" "$work/check.log" || fail "odome
   --expect pixyslam/ground_truth=180 > "$work/check_others.log" 2>&1 || fail "log check (two topics)"
 if grep -q "pixyslam/odometry" "$work/check_others.log"; then fail "the two-topic recording holds odometry"; fi
 # Robot 1's sightings of robot 2, as written.
-"$bin/pixyslam_log" print "$work/run.mcap" --topic pixyslam/robot_sighting --json > "$work/sightings.json" ||
+"$bin/pixyslam_log" print "$work/run.mcap" --topics pixyslam/robot_sighting --json > "$work/sightings.json" ||
   fail "print sightings"
 head -n 1 "$work/sightings.json"
 [[ $(grep -c '"seen_robot_id":"robot2"' "$work/sightings.json") == 3 ]] || fail "sightings of robot2"
 # The fleet map: the one landmark both robots mapped, fused from both.
-"$bin/pixyslam_log" print "$work/run.mcap" --topic pixyslam/fleet_map --json > "$work/fleet.json" || fail "print fleet"
+"$bin/pixyslam_log" print "$work/run.mcap" --topics pixyslam/fleet_map --json > "$work/fleet.json" || fail "print fleet"
 tail -n 1 "$work/fleet.json" | cut -c1-300
 tail -n 1 "$work/fleet.json" | grep -q '"landmark_id":6,.*"robots":2}' || fail "fleet map did not fuse both robots"
 tail -n 1 "$work/fleet.json" | grep -q '"robot_id":"robot1".*"robot_id":"robot2"' || fail "fleet map robots"

@@ -41,7 +41,7 @@ for r in 1 2; do
     fail "estimator robot$r: expected '$expect'"
   echo "estimator robot$r: $expect (as robot $r's and robot $other's bridges published)"
 done
-"$bin/pixyslam_log" print "$work/run/run.mcap" --topic pixyslam/fleet_map --json > "$work/fleet.json" ||
+"$bin/pixyslam_log" print "$work/run/run.mcap" --topics pixyslam/fleet_map --json > "$work/fleet.json" ||
   fail "print the fleet map"
 tail -n 1 "$work/fleet.json" | grep -q '"robot_id":"robot1".*"robot_id":"robot2"' || fail "the fleet map lacks a robot"
 grep -q "robots robot1, robot2 -> " "$log" || fail "the fleet picture lacks a robot"

@@ -66,6 +66,17 @@ expect_match("info no summary" "${info_no_summary_out}" "messages: +50 ")
 run(print_closed 0 print ${dir}/closed.mcap --json)
 expect_count("print closed" "${print_closed_out}" "${odometry}" ${MESSAGES})
 expect_match("print closed stderr" "x${print_closed_err}" "^x$")
+# --topics selects as pixyslam_play's does (names, globs, exclusions; --topic
+# is its old name); a selection of nothing, or a name the file has no channel
+# of, is an error naming the pattern.
+run(print_glob 0 print ${dir}/closed.mcap --topics "pixyslam/*" --json)
+expect_count("print --topics glob" "${print_glob_out}" "${odometry}" ${MESSAGES})
+run(print_old_flag 0 print ${dir}/closed.mcap --topics pixyslam/odometry --json)
+expect_count("print --topic" "${print_old_flag_out}" "${odometry}" ${MESSAGES})
+run(print_none 1 print ${dir}/closed.mcap --topics "!pixyslam/odometry")
+expect_match("print --topics excluding all" "${print_none_err}" "--topics '!pixyslam/odometry': ")
+run(print_absent 1 print ${dir}/closed.mcap --topics pixyslam/map_state)
+expect_match("print --topics absent" "${print_absent_err}" "--topics 'pixyslam/map_state': ")
 run(check_closed 0 check ${dir}/closed.mcap --expect pixyslam/odometry=${MESSAGES})
 
 # Not closed (cut in a chunk): exit 0 for info and print, a note on stderr;

@@ -35,7 +35,7 @@ if grep "fewer than" "$work/launch.log"; then fail "the dataset bridge started b
 "$(dirname "$0")/support/live_vs_offline.sh" "$bin" "$config" "$dataset" "$work/run" "$work/launch.log" 1,2 1 \
   "$duration" "$max_diff" || fail "live and offline differ"
 
-"$bin/pixyslam_log" print "$work/run/run.mcap" --topic pixyslam/fleet_map --json > "$work/fleet.json" ||
+"$bin/pixyslam_log" print "$work/run/run.mcap" --topics pixyslam/fleet_map --json > "$work/fleet.json" ||
   fail "print the fleet map"
 tail -n 1 "$work/fleet.json" | grep -q '"robot_id":"robot1".*"robot_id":"robot2"' || fail "the fleet map lacks a robot"
 echo PASS

@@ -227,7 +227,7 @@ for n in "$odometry" "$observations" "$truth"; do [[ -n $n && $n -gt 0 ]] || fai
   fail "the laptop's log does not hold every message the robot sent"
 
 map_times() {
-  "$bin/pixyslam_log" print "$log" --topic pixyslam/map_state --json | grep -oE '"log_time_ns":[0-9]+' | grep -oE '[0-9]+'
+  "$bin/pixyslam_log" print "$log" --topics pixyslam/map_state --json | grep -oE '"log_time_ns":[0-9]+' | grep -oE '[0-9]+'
 }
 if [[ -n $link_schedule ]]; then
   # MapState all along: the longest gap between two in the laptop's log, and

@@ -126,7 +126,7 @@ grep -q "write failure(s), samples lost while not recording" "$work/logger_full.
   fail "logger_full did not report its write failures"
 full_files=0 full_states=0
 for f in "$work"/full/run*.mcap; do
-  n=$("$bin/pixyslam_log" print "$f" --topic pixyslam/map_state --json 2>/dev/null | wc -l || true)
+  n=$("$bin/pixyslam_log" print "$f" --topics pixyslam/map_state --json 2>/dev/null | wc -l || true)
   [[ $n -gt 0 ]] || fail "$f (written on the full disk) holds no readable MapState"
   full_files=$((full_files + 1)) full_states=$((full_states + n))
 done
@@ -137,7 +137,7 @@ echo "full disk: $full_files files of at most $full_kb KB, $full_states MapState
 for f in "$work/run_1.mcap" "$work/run_2.mcap"; do
   "$bin/pixyslam_log" info "$f" > "$work/info.txt" 2>&1 || { cat "$work/info.txt"; fail "$f is not readable"; }
   echo "$(basename "$f"): $(grep -ciE "recovered|chunk" "$work/info.txt" || true) info lines on recovery; $(head -c 300 "$work/info.txt" | tr '\n' ' ')"
-  "$bin/pixyslam_log" print "$f" --topic pixyslam/map_state --json >> "$work/map_states.jsonl" ||
+  "$bin/pixyslam_log" print "$f" --topics pixyslam/map_state --json >> "$work/map_states.jsonl" ||
     fail "cannot print the MapStates of $f"
 done
 states=$(wc -l < "$work/map_states.jsonl")

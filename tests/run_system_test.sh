@@ -104,7 +104,7 @@ done
 # Every echoed sample is, field for field, a message the publisher sent (the
 # log holds exactly what each publisher sent: checked above).
 for t in "${topics[@]}"; do
-  "$bin/pixyslam_log" print "$work/run/run.mcap" --topic "pixyslam/$t" --json > "$work/log_$t.jsonl"
+  "$bin/pixyslam_log" print "$work/run/run.mcap" --topics "pixyslam/$t" --json > "$work/log_$t.jsonl"
   lines=$(wc -l < "$work/echo_$t.jsonl")
   if [[ $lines -ne 20 ]]; then echo "FAIL: echo pixyslam/$t printed $lines samples, wanted 20"; exit 1; fi
   while IFS= read -r line; do

@@ -7,7 +7,7 @@
 //   pixyslam_spy record [TOPIC ...] [--out FILE.mcap] [--duration S] [--set logger.KEY=V] [DDS options]
 //   pixyslam_spy info FILE.mcap [--json]
 //   pixyslam_spy check FILE.mcap [--expect TOPIC=N ...] [--allow-recovered]
-//   pixyslam_spy print FILE.mcap [--topic T] [--json]
+//   pixyslam_spy print FILE.mcap [--topics T] [--json]
 //   pixyslam_spy compare A.mcap B.mcap --topic T [--ignore F,...] [--tolerance X] [--match F,... [--max-unmatched N]]
 // DDS options: --config FILE (a YAML with a `dds:` mapping, e.g.
 // config/slam_estimator.yaml; default: config/dds/profiles.xml on domain 0),
@@ -170,6 +170,9 @@ int main(int argc, char** argv) {
       cli.subcommand("record", "records topics to an MCAP file until Ctrl-C or --duration, like ros2 bag record");
   record.option("topics", record_topics, "names or patterns, '!' to leave out (default: every topic)")
       .type("TOPIC");
+  std::string record_topic_list;
+  record.option("--topics", record_topic_list, "the same as a comma-separated list, as the logger's --topics")
+      .type("LIST");
   record
       .option("--out", record_out,
               "the recording (default pixyslam_YYYY_MM_DD-HH_MM_SS.mcap; a file holding data is kept and the next "
@@ -201,7 +204,11 @@ int main(int argc, char** argv) {
   log_tool::PrintRequest print_request;
   app::Cli& print = cli.subcommand("print", "a recording's messages, decoded");
   print.option("file", print_request.path, "the MCAP file").required().input_file().type("FILE.mcap");
-  print.option("--topic", print_request.topic, "only this topic").type("TOPIC");
+  std::string print_topics;
+  print.option("--topics,--topic", print_topics,
+               "comma-separated names, globs, !exclusions, as pixyslam_play's (default: every topic; --topic: its "
+               "old name)")
+      .type("LIST");
   print.flag("--json", print_request.json, "one JSON object per line");
 
   log_tool::CompareRequest compare_request;
@@ -242,7 +249,13 @@ int main(int argc, char** argv) {
   }
   return app::run_main(PIXYSLAM_TOOL_NAME, [&]() -> int {
     if (info.chosen()) return log_tool::run_info(info_file, json, std::cout, std::cerr);
-    if (print.chosen()) return log_tool::run_print(print_request, std::cout, std::cerr);
+    if (print.chosen()) {
+      print_request.topics = parameters::split_list(print_topics);
+      if (print.given("--topics") && print_request.topics.empty()) {
+        throw app::UsageError("--topics needs at least one topic");
+      }
+      return log_tool::run_print(print_request, std::cout, std::cerr);
+    }
     if (check.chosen()) return log_tool::run_check(check_request, std::cout, std::cerr);
     if (compare.chosen()) {
       if (compare_files.size() != 2) throw app::UsageError("compare needs exactly two MCAP files");
@@ -269,6 +282,7 @@ int main(int argc, char** argv) {
       logger_node::LoggerOptions o;
       try {
         o.output_file = record_out.empty() ? default_recording_name() : record_out;
+        for (const std::string& t : parameters::split_list(record_topic_list)) record_topics.push_back(t);
         o.topics = logger_node::select_known_topics(record_topics.empty() ? std::vector<std::string>{"*"} : record_topics,
                                                     "record");
         o.dds = dds::read_dds_options_file(dds_args.config, dds::default_profiles_file());

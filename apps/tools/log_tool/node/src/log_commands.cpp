@@ -11,6 +11,7 @@
 #include <sstream>
 #include <vector>
 
+#include "pixyslam/dds/topic_selection.h"
 #include "pixyslam/dds/topics.h"
 #include "pixyslam/log_tool/message_format.h"
 #include "pixyslam/log_tool/sequence_check.h"
@@ -443,13 +444,21 @@ std::vector<Value> decoded_messages(const std::string& path, const std::string& 
 
 int run_print(const PrintRequest& request, std::ostream& out, std::ostream& err) {
   const mcap::McapReader reader(request.path);
-  if (!request.topic.empty() && reader.find_channel(request.topic) == nullptr) {
-    throw std::runtime_error(request.path + ": no channel '" + request.topic + "'");
+  std::set<std::string> printed;
+  for (const mcap::McapChannel& channel : reader.channels()) printed.insert(channel.topic);
+  if (!request.topics.empty()) {
+    const dds::TopicSelection selection =
+        dds::select_topics(request.topics, std::vector<std::string>(printed.begin(), printed.end()));
+    if (!selection.error.empty()) {
+      throw std::runtime_error(request.path + ": --topics '" + request.topics[selection.bad_pattern] +
+                               "': " + selection.error);
+    }
+    printed = std::set<std::string>(selection.topics.begin(), selection.topics.end());
   }
   int status = 0;
   for (const mcap::McapMessage& m : reader.messages()) {
     const mcap::McapChannel* channel = reader.find_channel(m.channel_id);
-    if (channel == nullptr || (!request.topic.empty() && channel->topic != request.topic)) continue;
+    if (channel == nullptr || printed.count(channel->topic) == 0) continue;
     Value value = Value::structure();
     std::string error;
     if (!decode_value(channel->topic, m.data, value, error)) {

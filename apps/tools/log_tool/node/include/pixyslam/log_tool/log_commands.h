@@ -32,11 +32,13 @@ int run_check(const CheckRequest& request, std::ostream& out, std::ostream& err)
 
 struct PrintRequest {
   std::string path;
-  std::string topic;  // "" = every topic
+  // Names, globs and !exclusions (dds::select_topics over the file's
+  // channels, as pixyslam_play --topics); empty = every topic.
+  std::vector<std::string> topics;
   bool json = false;  // JSON lines instead of YAML documents
 };
 
-// `pixyslam_log print FILE.mcap [--topic T] [--json]`: every message decoded
+// `pixyslam_log print FILE.mcap [--topics LIST] [--json]`: every message decoded
 // with the project's types, in file order, with its topic and log time (the
 // same printers as `echo`). Prints the messages it could read; on `err`, a
 // file that is not closed is noted, and the damage of a damaged one listed
