@@ -1,10 +1,10 @@
 // Map optimiser cost over a whole run, as the live process solves it: one
 // UTIAS MRCLAM robot (or the simulated world without --dataset) through the
 // filter, then the optimiser fed the same input in order with the live
-// schedule (the newest window every --window-period s of data, the whole
-// problem every --whole-period s, and once at the end).
-//   bench_map_optimizer --dataset DIR --robot N --config FILE
-//                       [--window-period S] [--window-keyframes K] [--whole-period S]
+// schedule (config/map_optimizer.yaml's defaults: the newest window every
+// optimizer.window_period_s of data, the whole problem every
+// optimizer.whole_period_s, and once at the end).
+//   bench_map_optimizer --dataset DIR --robot N --config FILE [--set optimizer.KEY=V ...]
 //   bench_map_optimizer --config config/slam_sim.yaml        (the simulated world)
 // Prints the data time, the optimiser thread's CPU time in all and per minute
 // of data, the window and whole-problem solves (count, mean and max Ceres time),
@@ -21,6 +21,7 @@
 
 #include "pixyslam/app/cli.h"
 #include "pixyslam/app/process_main.h"
+#include "pixyslam/parameters/parameters.h"
 #include "pixyslam/mrclam/mrclam_dataset.h"
 #include "pixyslam/offline/optimised_run.h"
 #include "pixyslam/config/yaml_reader.h"
@@ -44,7 +45,7 @@ void print_solves(const char* label, const std::vector<map_optimizer::SolveSumma
 int run(int argc, char** argv) {
   std::string dataset, config_file;
   int robot = 0;
-  int window_keyframes = 0;
+  std::vector<std::string> overrides;
   map_optimizer::SolveScheduleOptions schedule;  // the live process's defaults
   app::Cli cli{"bench_map_optimizer", "Map optimiser cost over a whole run with the live process's solve schedule."};
   app::Cli::Option& dataset_option =
@@ -54,17 +55,34 @@ int run(int argc, char** argv) {
   dataset_option.needs(robot_option);
   robot_option.needs(dataset_option);
   app::add_config(cli, config_file, "filter: (and mrclam: or world:) options").required();
-  cli.option("--window-period", schedule.window_period_s, "data time between window solves, default 1 "
-                                                          "(as config/map_optimizer.yaml)").positive().type("S");
-  cli.option("--window-keyframes", window_keyframes, "keyframes a window solve frees, default 100").range(1, 1000000)
-      .type("K");
-  cli.option("--whole-period", schedule.whole_period_s, "data time between whole-problem solves, default 10")
-      .positive().type("S");
-  cli.option("--whole-max-duty", schedule.whole_max_duty,
-             "whole solves take at most this fraction of data time, default 0.1 (0: no bound)")
-      .range(0.0, 1.0).type("F");
+  app::add_set(cli, overrides, "optimizer.window_period_s=2");
+  const map_optimizer::MapOptimizerOptions core_defaults;
+  const map_optimizer::SolveScheduleOptions schedule_defaults;
+  cli.footer("optimizer parameters for --set (the map_optimizer process's keys; the noise models are the filter's):\n" +
+             parameters::help_text(map_optimizer::map_optimizer_parameters(), "optimizer", core_defaults) +
+             parameters::help_text(map_optimizer::solve_schedule_parameters(), "optimizer", schedule_defaults) +
+             "Exit status: 0 done, 1 a failure, 2 a command-line or configuration error, 77 the data set folder "
+             "is absent.");
   if (const auto done = cli.parse(argc, argv)) return *done;
-  if (cli.given("--window-keyframes")) schedule.window_keyframes = static_cast<std::size_t>(window_keyframes);
+  std::vector<std::string> optimizer_sets;
+  if (const auto failed = app::configure("bench_map_optimizer", [&] {
+        optimizer_sets = parameters::take_section(overrides, "optimizer");
+        if (!overrides.empty()) throw std::invalid_argument("'" + overrides.front() + "': not an optimizer. parameter");
+        std::vector<std::string> core_sets;
+        for (const std::string& a : optimizer_sets) {
+          const std::string key = a.substr(0, a.find('=')).substr(std::string("optimizer.").size());
+          if (parameters::find(map_optimizer::solve_schedule_parameters(), key) != nullptr) {
+            parameters::apply_override(schedule, map_optimizer::solve_schedule_parameters(), "optimizer", a);
+          } else {
+            core_sets.push_back(a);
+          }
+        }
+        optimizer_sets = core_sets;
+        slam::FilterOptions defaults;
+        offline::optimizer_options(defaults, optimizer_sets);  // refuses a bad key or value now
+      })) {
+    return *failed;
+  }
 
   config::YamlReader root = config::YamlReader::from_file(config_file);
   config::YamlReader filter_yaml = root.child("filter");
@@ -90,7 +108,7 @@ int run(int argc, char** argv) {
     for (const sim::Pole& p : run.poles) input.landmarks.push_back({p.id, p.x_m, p.y_m});
   }
   const offline::RunResult filter = offline::run_filter(options, input);
-  const offline::OptimisedRun opt = offline::optimise_run(options, input, filter, schedule);
+  const offline::OptimisedRun opt = offline::optimise_run(options, input, filter, schedule, optimizer_sets);
   const double data_s = filter.trajectory.empty() ? 0.0 : filter.trajectory.back().t_s - input.start_time_s;
   std::printf("data %.1f s, %zu keyframes, %zu observation factors; schedule: window of %zu keyframes every %.1f s, "
               "whole problem every %.1f s (at most %.0f %% of data time)\n",

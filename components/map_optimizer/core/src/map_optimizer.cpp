@@ -668,6 +668,22 @@ slam::Pose2 MapOptimizer::pose_of(const PoseAnchor& anchor) const {
   return slam::Pose2(p[0], p[1], p[2]);
 }
 
+const parameters::Table<SolveScheduleOptions>& solve_schedule_parameters() {
+  using O = SolveScheduleOptions;
+  namespace P = parameters;
+  static const P::Table<O> table = {
+      P::integer<O, std::size_t>("window_keyframes", 1, 1000000, "", "the newest keyframes a window solve frees",
+                                 [](O& o) -> std::size_t& { return o.window_keyframes; }),
+      P::real<O>("window_period_s", 0.01, 3600.0, "s", "data time between window solves",
+                 [](O& o) -> double& { return o.window_period_s; }),
+      P::real<O>("whole_period_s", 0.01, 86400.0, "s", "data time between whole-problem solves",
+                 [](O& o) -> double& { return o.whole_period_s; }),
+      P::real<O>("whole_max_duty", 0.0, 1.0, "", "whole solves take at most this fraction of data time (0: no bound)",
+                 [](O& o) -> double& { return o.whole_max_duty; }),
+  };
+  return table;
+}
+
 SolveSchedule::SolveSchedule(const SolveScheduleOptions& options, double start_s)
     : options_(options),
       next_window_s_(start_s + options.window_period_s),

@@ -11,15 +11,6 @@ const parameters::Table<OptimizerNodeOptions>& optimizer_node_parameters() {
   using O = OptimizerNodeOptions;
   namespace P = parameters;
   static const P::Table<O> table = {
-      P::integer<O, std::size_t>("window_keyframes", 1, 1000000, "", "the newest keyframes a window solve frees",
-                                 [](O& o) -> std::size_t& { return o.schedule.window_keyframes; }),
-      P::real<O>("window_period_s", 0.01, 3600.0, "s", "data time between window solves",
-                 [](O& o) -> double& { return o.schedule.window_period_s; }),
-      P::real<O>("whole_period_s", 0.01, 86400.0, "s", "data time between whole-problem solves",
-                 [](O& o) -> double& { return o.schedule.whole_period_s; }),
-      P::real<O>("whole_max_duty", 0.0, 1.0, "",
-                 "whole solves take at most this fraction of data time (0: no bound)",
-                 [](O& o) -> double& { return o.schedule.whole_max_duty; }),
       P::integer<O, int>("published_keyframes", 2, 8192, "", "OptimisedMap keyframes at most",
                          [](O& o) -> int& { return o.published_keyframes; }),
       P::integer<O, std::size_t>("max_keyframes", 0, 100000000, "",
@@ -41,6 +32,8 @@ void apply_overrides(OptimizerNodeOptions& o, const std::vector<std::string>& as
     const std::string key = a.substr(0, a.find('=')).substr(10);  // below "optimizer."
     if (parameters::find(map_optimizer::map_optimizer_parameters(), key) != nullptr) {
       parameters::apply_override(o.optimizer, map_optimizer::map_optimizer_parameters(), "optimizer", a);
+    } else if (parameters::find(map_optimizer::solve_schedule_parameters(), key) != nullptr) {
+      parameters::apply_override(o.schedule, map_optimizer::solve_schedule_parameters(), "optimizer", a);
     } else {
       parameters::apply_override(o, optimizer_node_parameters(), "optimizer", a);
     }
@@ -50,18 +43,21 @@ void apply_overrides(OptimizerNodeOptions& o, const std::vector<std::string>& as
 }
 
 std::string to_yaml(const OptimizerNodeOptions& o) {
-  std::string node = parameters::to_yaml(o, optimizer_node_parameters(), "optimizer");
-  node.erase(0, node.find('\n') + 1);  // the same section as the core's keys
-  return parameters::to_yaml(o.optimizer, map_optimizer::map_optimizer_parameters(), "optimizer") + node +
-         dds::to_yaml(o.dds);
+  // One section, three tables: the core's keys, the schedule's, the node's.
+  const auto below_section = [](std::string yaml) { return yaml.erase(0, yaml.find('\n') + 1); };
+  return parameters::to_yaml(o.optimizer, map_optimizer::map_optimizer_parameters(), "optimizer") +
+         below_section(parameters::to_yaml(o.schedule, map_optimizer::solve_schedule_parameters(), "optimizer")) +
+         below_section(parameters::to_yaml(o, optimizer_node_parameters(), "optimizer")) + dds::to_yaml(o.dds);
 }
 
 std::string help_text() {
   // Named defaults: GCC 12 warns (maybe-uninitialized, falsely) on the temporary default argument.
   const map_optimizer::MapOptimizerOptions core_defaults;
+  const map_optimizer::SolveScheduleOptions schedule_defaults;
   const OptimizerNodeOptions node_defaults;
   return "optimizer parameters (optimizer:; the noise models come from filter_config):\n" +
          parameters::help_text(map_optimizer::map_optimizer_parameters(), "optimizer", core_defaults) +
+         parameters::help_text(map_optimizer::solve_schedule_parameters(), "optimizer", schedule_defaults) +
          parameters::help_text(optimizer_node_parameters(), "optimizer", node_defaults) +
          "DDS settings (dds:; the PIXYSLAM_DDS_* environment overrides the file, --set both):\n" +
          parameters::help_text(dds::dds_parameters(), "dds");
@@ -81,6 +77,7 @@ OptimizerNodeOptions read_optimizer_node_options_file(const std::string& path) {
 
   config::YamlReader y = root.child("optimizer");
   config::read_parameters(y, map_optimizer::map_optimizer_parameters(), o.optimizer);
+  config::read_parameters(y, map_optimizer::solve_schedule_parameters(), o.schedule);
   config::read_parameters(y, optimizer_node_parameters(), o);
   y.finish();
   map_optimizer::validate(o.optimizer);

@@ -304,6 +304,8 @@ struct SolveScheduleOptions {
   // No solve on the way: only the caller's solve at the end.
   static SolveScheduleOptions at_end_only() { return {100, 0.0, 0.0, 0.0}; }
 };
+// Its keys in the `optimizer:` section (config/map_optimizer.yaml).
+const parameters::Table<SolveScheduleOptions>& solve_schedule_parameters();
 
 enum class SolveKind { kNone, kWindow, kWhole };
 
