@@ -35,6 +35,11 @@ msg::MapState map_state(std::uint64_t stamp_ns, double dx) {
   return m;
 }
 
+// Publishes `m` and waits until every reader has it.
+bool deliver(dds::Writer<msg::MapState>& writer, msg::MapState& m) {
+  return writer.publish(m) && writer.wait_for_acknowledgments(std::chrono::seconds(10));
+}
+
 // A FleetMapNode on the loopback domain and a reader of what it publishes.
 struct FleetBench {
   explicit FleetBench(int max_robots = 64, double robot_timeout_s = 60.0)
@@ -157,14 +162,10 @@ TEST(FleetMapNode, AFarFutureStampAndInventedRobotsAreBounded) {
   const std::uint64_t t = 1'000'000'000'000ull;
   msg::MapState hostile = map_state(~0ull, 5.0), real = map_state(t, 0.0), two = map_state(t, 0.0),
                 three = map_state(t, 0.0);
-  ASSERT_TRUE(robot1.publish(hostile));
-  ASSERT_TRUE(robot1.wait_for_acknowledgments(std::chrono::seconds(10)));
-  ASSERT_TRUE(robot1.publish(real));
-  ASSERT_TRUE(robot2.publish(two));
-  ASSERT_TRUE(robot1.wait_for_acknowledgments(std::chrono::seconds(10)));
-  ASSERT_TRUE(robot2.wait_for_acknowledgments(std::chrono::seconds(10)));
-  ASSERT_TRUE(robot3.publish(three));
-  ASSERT_TRUE(robot3.wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(deliver(robot1, hostile));
+  ASSERT_TRUE(deliver(robot1, real));
+  ASSERT_TRUE(deliver(robot2, two));
+  ASSERT_TRUE(deliver(robot3, three));
   bench.wait_for(2, t);
   node.stop();
   const FleetMapCounters c = node.counters();
@@ -190,16 +191,12 @@ TEST(FleetMapNode, SilentRobotsTimeOutAndFreeTheirPlaces) {
   }
   const std::uint64_t t = 1'000'000'000'000ull;
   msg::MapState ghost = map_state(t, 0.0), first = map_state(t + 1, 0.0), second = map_state(t + 2, 0.0);
-  ASSERT_TRUE(ghost1.publish(ghost));
-  ASSERT_TRUE(ghost2.publish(ghost));
-  ASSERT_TRUE(ghost1.wait_for_acknowledgments(std::chrono::seconds(10)));
-  ASSERT_TRUE(ghost2.wait_for_acknowledgments(std::chrono::seconds(10)));
-  ASSERT_TRUE(robot.publish(first));  // no place: dropped
-  ASSERT_TRUE(robot.wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(deliver(ghost1, ghost));
+  ASSERT_TRUE(deliver(ghost2, ghost));
+  ASSERT_TRUE(deliver(robot, first));  // no place: dropped
   EXPECT_EQ(node.counters().robots_over_limit, 1u);
   std::this_thread::sleep_for(std::chrono::milliseconds(2500));
-  ASSERT_TRUE(robot.publish(second));
-  ASSERT_TRUE(robot.wait_for_acknowledgments(std::chrono::seconds(10)));
+  ASSERT_TRUE(deliver(robot, second));
   bench.wait_for(1, t + 2);
   node.stop();
   const FleetMapCounters c = node.counters();
