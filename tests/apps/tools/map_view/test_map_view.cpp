@@ -620,21 +620,32 @@ TEST(MsgConversion, OneStampFarAheadDoesNotFreezeTheView) {
   EXPECT_EQ(builder.state().optimised_trajectory.size(), 3u);
 }
 
-// Any participant can invent robot ids: past kMaxRobots their samples are
-// dropped and counted, and the robots already drawn go on.
-TEST(FleetView, InventedRobotsPastTheLimitAreDroppedAndCounted) {
+// Any participant can invent robot ids: past kMaxRobots a new id takes the
+// place of the robot heard from least recently (counted), so a robot that keeps
+// sending is still drawn after a flood of ids sent once, and ids sent once
+// cannot keep a later robot out.
+TEST(FleetView, InventedRobotsPastTheLimitTakeTheLeastRecentlyHeardPlaces) {
   FleetViewBuilder fleet;
+  const auto from = [](const std::string& id, std::uint64_t stamp) {
+    msg::MapState m = map_state(stamp, 0.0, 1);
+    m.header().robot_id(id);
+    return m;
+  };
+  ASSERT_TRUE(fleet.add(from("real", 1000)));
   const std::size_t extra = 10;
   for (std::size_t r = 0; r < FleetViewBuilder::kMaxRobots + extra; ++r) {
-    msg::MapState m = map_state(1000, 0.0, 1);
-    m.header().robot_id("robot" + std::to_string(r));
-    EXPECT_EQ(fleet.add(m), r < FleetViewBuilder::kMaxRobots) << r;
+    EXPECT_TRUE(fleet.add(from("ghost" + std::to_string(r), 1000))) << r;
+    if (r % 8 == 0) EXPECT_TRUE(fleet.add(from("real", 2000 + r)));  // it keeps sending
   }
   EXPECT_EQ(fleet.robots(), FleetViewBuilder::kMaxRobots);
-  EXPECT_EQ(fleet.over_robot_limit(), extra);
-  msg::MapState again = map_state(2000, 0.5, 1);
-  again.header().robot_id("robot0");
-  EXPECT_TRUE(fleet.add(again));
+  EXPECT_EQ(fleet.robots_evicted(), extra + 1);
+  EXPECT_EQ(fleet.map_states(), 11u + 63u);  // "real"'s 11, one of each of the 63 ghosts kept
+  const MapViewState state = fleet.state();
+  bool real_drawn = state.robot_id == "real";
+  for (const MapViewState& other : state.other_robots) real_drawn = real_drawn || other.robot_id == "real";
+  EXPECT_TRUE(real_drawn);
+  EXPECT_TRUE(fleet.add(from("late", 5000)));  // a robot that comes after the flood is drawn
+  EXPECT_EQ(fleet.robots(), FleetViewBuilder::kMaxRobots);
 }
 
 TEST(FleetView, EveryRobotIsDrawnInOnePictureInItsOwnColour) {

@@ -189,11 +189,11 @@ int run_live(const MapViewOptions& options, const LiveRequest& request) {
   std::size_t dropped = 0;
   {
     std::lock_guard<std::mutex> lock(shared.mutex);  // the readers still run
-    dropped = shared.builder.over_robot_limit();
+    dropped = shared.builder.robots_evicted();
   }
   std::fprintf(stderr,
                "map_view: stopped; %llu map states, %llu ground-truth messages, %llu optimised maps received "
-               "(%zu of robots past the first %zu dropped)%s%s\n",
+               "(%zu robots dropped for newer ones past %zu)%s%s\n",
                static_cast<unsigned long long>(maps.received()), static_cast<unsigned long long>(truth.received()),
                static_cast<unsigned long long>(optimised.received()), dropped,
                FleetViewBuilder::kMaxRobots, snapshots ? "; last snapshot " : "",

@@ -1,5 +1,7 @@
 #include "pixyslam/map_view/msg_conversion.h"
 
+#include <algorithm>
+
 namespace pixyslam::map_view {
 
 Pose2 to_pose(const msg::Pose2D& pose) { return {pose.x_m(), pose.y_m(), pose.theta_rad()}; }
@@ -115,19 +117,26 @@ bool FleetViewBuilder::add(const msg::FleetMap& map) {
 }
 
 MapViewBuilder* FleetViewBuilder::robot(const std::string& robot_id) {
-  if (const auto it = robots_.find(robot_id); it != robots_.end()) return &it->second;
-  if (robots_.size() >= kMaxRobots) {
-    ++over_robot_limit_;
-    return nullptr;
+  ++samples_;
+  if (const auto it = robots_.find(robot_id); it != robots_.end()) {
+    it->second.last_heard = samples_;
+    return &it->second.builder;
   }
-  return &robots_.try_emplace(robot_id, min_step_m_).first->second;
+  if (robots_.size() >= kMaxRobots) {
+    const auto oldest = std::min_element(robots_.begin(), robots_.end(), [](const auto& a, const auto& b) {
+      return a.second.last_heard < b.second.last_heard;
+    });
+    robots_.erase(oldest);
+    ++robots_evicted_;
+  }
+  return &robots_.try_emplace(robot_id, Robot{MapViewBuilder(min_step_m_), samples_}).first->second.builder;
 }
 
 MapViewState FleetViewBuilder::state() const {
   MapViewState out;
   bool first = true;
-  for (const auto& [id, builder] : robots_) {
-    MapViewState one = builder.state();
+  for (const auto& [id, robot] : robots_) {
+    MapViewState one = robot.builder.state();
     one.robot_id = id;
     if (first) {
       out = std::move(one);
@@ -142,7 +151,7 @@ MapViewState FleetViewBuilder::state() const {
 
 std::size_t FleetViewBuilder::total(std::size_t (MapViewBuilder::*count)() const) const {
   std::size_t n = 0;
-  for (const auto& entry : robots_) n += (entry.second.*count)();
+  for (const auto& entry : robots_) n += (entry.second.builder.*count)();
   return n;
 }
 

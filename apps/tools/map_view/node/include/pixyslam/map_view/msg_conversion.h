@@ -66,8 +66,10 @@ class MapViewBuilder {
 // One MapViewBuilder per robot (header.robot_id): several robots on one
 // domain or in one log are drawn in one picture. state() is the first robot's
 // (by id) with the others in other_robots; each robot's times count from its
-// own first stamp. At most kMaxRobots robots: samples of further robot ids
-// (any participant can invent them) are dropped and counted. Thread-compatible.
+// own first stamp. At most kMaxRobots robots: a sample of a further robot id
+// (any participant can invent them) takes the place of the robot heard from
+// least recently, which is counted, so that ids invented once cannot keep a
+// real robot out for good. Thread-compatible.
 class FleetViewBuilder {
  public:
   static constexpr std::size_t kMaxRobots = 64;  // as fleet_map.max_robots
@@ -90,24 +92,30 @@ class FleetViewBuilder {
 
   MapViewState state() const;
   std::size_t robots() const { return robots_.size(); }
+  // Robots dropped to make room for a new robot id past kMaxRobots.
+  std::size_t robots_evicted() const { return robots_evicted_; }
   // Totals over the robots.
   std::size_t map_states() const { return total(&MapViewBuilder::map_states); }
   std::size_t ground_truths() const { return total(&MapViewBuilder::ground_truths); }
   std::size_t optimised_maps() const { return total(&MapViewBuilder::optimised_maps); }
   std::size_t fleet_maps() const { return fleet_order_.taken(); }
-  // Samples dropped because their robot id would be robot kMaxRobots + 1.
-  std::size_t over_robot_limit() const { return over_robot_limit_; }
 
  private:
-  // The robot's builder, nullptr past kMaxRobots.
+  // The robot's builder; past kMaxRobots a new one in the place of the robot
+  // heard from least recently.
   MapViewBuilder* robot(const std::string& robot_id);
   std::size_t total(std::size_t (MapViewBuilder::*count)() const) const;
 
+  struct Robot {
+    MapViewBuilder builder;
+    std::uint64_t last_heard = 0;  // the sample count when its last sample came
+  };
   double min_step_m_;
-  std::map<std::string, MapViewBuilder> robots_;
+  std::uint64_t samples_ = 0;
+  std::map<std::string, Robot> robots_;
   std::vector<LandmarkView> fleet_landmarks_;
   dds::NewestStamp fleet_order_;
-  std::size_t over_robot_limit_ = 0;
+  std::size_t robots_evicted_ = 0;
 };
 
 }  // namespace pixyslam::map_view
