@@ -70,7 +70,8 @@ using Table = std::vector<Parameter<Options>>;
 template <class Options>
 Parameter<Options> real(std::string path, double min, double max, std::string unit, std::string help,
                         std::function<double&(Options&)> member) {
-  Parameter<Options> p{std::move(path), Kind::kReal, min, max, {}, std::move(unit), std::move(help), {}, {}, {}, {}, {}, false};
+  Parameter<Options> p{std::move(path), Kind::kReal, min, max, {}, std::move(unit), std::move(help),
+                       {}, {}, {}, {}, {}, false, {}};
   p.get = [member](const Options& o) { return member(const_cast<Options&>(o)); };
   p.set = [member](Options& o, double v) { member(o) = v; };
   return p;
@@ -81,7 +82,7 @@ template <class Options, class Int>
 Parameter<Options> integer(std::string path, Int min, Int max, std::string unit, std::string help,
                            std::function<Int&(Options&)> member) {
   Parameter<Options> p{std::move(path), Kind::kInteger, static_cast<double>(min), static_cast<double>(max), {},
-                       std::move(unit), std::move(help), {}, {}, {}, {}, {}, false};
+                       std::move(unit), std::move(help), {}, {}, {}, {}, {}, false, {}};
   p.get = [member](const Options& o) { return static_cast<double>(member(const_cast<Options&>(o))); };
   p.set = [member](Options& o, double v) { member(o) = static_cast<Int>(v); };
   return p;
@@ -89,7 +90,8 @@ Parameter<Options> integer(std::string path, Int min, Int max, std::string unit,
 
 template <class Options>
 Parameter<Options> boolean(std::string path, std::string help, std::function<bool&(Options&)> member) {
-  Parameter<Options> p{std::move(path), Kind::kBoolean, 0.0, 1.0, {}, "", std::move(help), {}, {}, {}, {}, {}, false};
+  Parameter<Options> p{std::move(path), Kind::kBoolean, 0.0, 1.0, {}, "", std::move(help),
+                       {}, {}, {}, {}, {}, false, {}};
   p.get = [member](const Options& o) { return member(const_cast<Options&>(o)) ? 1.0 : 0.0; };
   p.set = [member](Options& o, double v) { member(o) = v != 0.0; };
   return p;
@@ -103,7 +105,8 @@ constexpr std::uint64_t kMaxSeed = std::uint64_t{1} << 53;
 template <class Options, class Enum>
 Parameter<Options> choice(std::string path, std::vector<std::pair<std::string, Enum>> names, std::string help,
                           std::function<Enum&(Options&)> member) {
-  Parameter<Options> p{std::move(path), Kind::kChoice, 0.0, 0.0, {}, "", std::move(help), {}, {}, {}, {}, {}, false};
+  Parameter<Options> p{std::move(path), Kind::kChoice, 0.0, 0.0, {}, "", std::move(help),
+                       {}, {}, {}, {}, {}, false, {}};
   for (const auto& n : names) p.choices.push_back(n.first);
   p.get_choice = [member, names](const Options& o) {
     for (const auto& n : names) {
@@ -127,7 +130,8 @@ Parameter<Options> choice(std::string path, std::vector<std::pair<std::string, E
 template <class Options>
 Parameter<Options> text(std::string path, std::string help, std::function<std::string&(Options&)> member,
                         std::function<void(const std::string&)> check = {}) {
-  Parameter<Options> p{std::move(path), Kind::kText, 0.0, 0.0, {}, "", std::move(help), {}, {}, {}, {}, std::move(check), false};
+  Parameter<Options> p{std::move(path), Kind::kText, 0.0, 0.0, {}, "", std::move(help),
+                       {}, {}, {}, {}, std::move(check), false, {}};
   p.get_choice = [member](const Options& o) { return member(const_cast<Options&>(o)); };
   p.set_choice = [member](Options& o, const std::string& v) { member(o) = v; };
   return p;
@@ -181,7 +185,8 @@ inline std::vector<int> parse_int_list(const std::string& text, const std::strin
 template <class Options>
 Parameter<Options> list(std::string path, std::string help, std::function<std::vector<std::string>&(Options&)> member,
                         std::function<void(const std::string&)> check = {}) {
-  Parameter<Options> p{std::move(path), Kind::kList, 0.0, 0.0, {}, "", std::move(help), {}, {}, {}, {}, std::move(check), false};
+  Parameter<Options> p{std::move(path), Kind::kList, 0.0, 0.0, {}, "", std::move(help),
+                       {}, {}, {}, {}, std::move(check), false, {}};
   p.get_choice = [member](const Options& o) {
     std::string joined;
     for (const std::string& item : member(const_cast<Options&>(o))) joined += (joined.empty() ? "" : ",") + item;
