@@ -635,7 +635,9 @@ TEST(FleetView, InventedRobotsPastTheLimitTakeTheLeastRecentlyHeardPlaces) {
   const std::size_t extra = 10;
   for (std::size_t r = 0; r < FleetViewBuilder::kMaxRobots + extra; ++r) {
     EXPECT_TRUE(fleet.add(from("ghost" + std::to_string(r), 1000))) << r;
-    if (r % 8 == 0) EXPECT_TRUE(fleet.add(from("real", 2000 + r)));  // it keeps sending
+    if (r % 8 == 0) {
+      EXPECT_TRUE(fleet.add(from("real", 2000 + r)));  // it keeps sending
+    }
   }
   EXPECT_EQ(fleet.robots(), FleetViewBuilder::kMaxRobots);
   EXPECT_EQ(fleet.robots_evicted(), extra + 1);
