@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <cstdint>
-#include <limits>
 #include <sstream>
 #include <utility>
 
@@ -22,8 +20,6 @@ mcap::McapCompression default_compression() {
 namespace {
 
 constexpr std::uint64_t kMinRotateSizeBytes = 65536;
-constexpr std::size_t kMaxQueueBytes =
-    static_cast<std::size_t>(std::min<std::uint64_t>(std::uint64_t{1} << 32, std::numeric_limits<std::size_t>::max()));
 
 std::string compression_name(mcap::McapCompression c) {
   return c == mcap::McapCompression::kNone ? "none" : mcap::mcap_compression_name(c);
@@ -62,8 +58,7 @@ const parameters::Table<LoggerOptions>& logger_parameters() {
       P::real<O>("flush_period_s", 0.0, 3600.0, "s", "the open chunk written at least this often (0: when full)",
                  [](O& o) -> double& { return o.flush_period_s; }),
       P::boolean<O>("fsync", "fsync(2) after every chunk (survives a power cut)", [](O& o) -> bool& { return o.fsync; }),
-      // 4 GiB, or the most a 32-bit size_t holds (armhf).
-      P::integer<O, std::size_t>("queue_max_bytes", std::size_t{1} << 20, kMaxQueueBytes, "B",
+      P::integer<O, std::size_t>("queue_max_bytes", std::size_t{1} << 20, P::kMaxBytes4GiB, "B",
                                  "payload bytes waiting for the writer; beyond: dropped and counted",
                                  [](O& o) -> std::size_t& { return o.queue_max_bytes; }),
       P::real<O>("retry_period_s", 0.1, 3600.0, "s", "after a write failure, a new file tried this often",

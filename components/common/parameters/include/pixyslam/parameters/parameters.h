@@ -65,6 +65,11 @@ struct Parameter {
 template <class Options>
 using Table = std::vector<Parameter<Options>>;
 
+// A byte-count bound for a std::size_t parameter: 4 GiB, or the most a 32-bit
+// size_t holds (armhf, where std::size_t{1} << 32 is 0).
+inline constexpr std::size_t kMaxBytes4GiB =
+    static_cast<std::size_t>(std::min<std::uint64_t>(std::uint64_t{1} << 32, std::numeric_limits<std::size_t>::max()));
+
 // ---- Declaring: one call per member.
 
 template <class Options>
