@@ -24,6 +24,7 @@
 #include "pixyslam/parameters/parameters.h"
 #include "pixyslam/mrclam/mrclam_dataset.h"
 #include "pixyslam/offline/optimised_run.h"
+#include "pixyslam/offline/optimizer_sets.h"
 #include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/sim/sim_world.h"
 #include "pixyslam/slam/slam_options_yaml.h"
@@ -46,7 +47,6 @@ int run(int argc, char** argv) {
   std::string dataset, config_file;
   int robot = 0;
   std::vector<std::string> overrides;
-  map_optimizer::SolveScheduleOptions schedule;  // the live process's defaults
   app::Cli cli{"bench_map_optimizer", "Map optimiser cost over a whole run with the live process's solve schedule."};
   app::Cli::Option& dataset_option =
       cli.option("--dataset", dataset, "a MRCLAM data set (exit 77 when the folder is absent); without: the simulated "
@@ -68,18 +68,7 @@ int run(int argc, char** argv) {
   if (const auto failed = app::configure("bench_map_optimizer", [&] {
         optimizer_sets = parameters::take_section(overrides, "optimizer");
         if (!overrides.empty()) throw std::invalid_argument("'" + overrides.front() + "': not an optimizer. parameter");
-        std::vector<std::string> core_sets;
-        for (const std::string& a : optimizer_sets) {
-          const std::string key = a.substr(0, a.find('=')).substr(std::string("optimizer.").size());
-          if (parameters::find(map_optimizer::solve_schedule_parameters(), key) != nullptr) {
-            parameters::apply_override(schedule, map_optimizer::solve_schedule_parameters(), "optimizer", a);
-          } else {
-            core_sets.push_back(a);
-          }
-        }
-        optimizer_sets = core_sets;
-        slam::FilterOptions defaults;
-        offline::optimizer_options(defaults, optimizer_sets);  // refuses a bad key or value now
+        offline::check_optimizer_sets(slam::FilterOptions{}, optimizer_sets, true);  // a bad key or value now
       })) {
     return *failed;
   }
@@ -108,7 +97,8 @@ int run(int argc, char** argv) {
     for (const sim::Pole& p : run.poles) input.landmarks.push_back({p.id, p.x_m, p.y_m});
   }
   const offline::RunResult filter = offline::run_filter(options, input);
-  const offline::OptimisedRun opt = offline::optimise_run(options, input, filter, schedule, optimizer_sets);
+  const offline::OptimisedRun opt = offline::optimise_run(options, input, filter, map_optimizer::SolveScheduleOptions{}, optimizer_sets);
+  const map_optimizer::SolveScheduleOptions& schedule = opt.schedule;  // the live process's, after --set
   const double data_s = filter.trajectory.empty() ? 0.0 : filter.trajectory.back().t_s - input.start_time_s;
   std::printf("data %.1f s, %zu keyframes, %zu observation factors; schedule: window of %zu keyframes every %.1f s, "
               "whole problem every %.1f s (at most %.0f %% of data time)\n",

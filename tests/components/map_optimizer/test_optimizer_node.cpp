@@ -320,6 +320,27 @@ TEST(OptimizerNodeOptions, ShippedConfigTakesTheEstimatorsModels) {
   EXPECT_EQ(o.schedule.window_keyframes, 100u);
 }
 
+TEST(OptimizerNodeOptions, SetReachesEachOfTheThreeTablesOfTheSection) {
+  OptimizerNodeOptions o = test_options();
+  apply_overrides(o, {"optimizer.huber_threshold=2.5", "optimizer.window_period_s=3", "optimizer.published_keyframes=64",
+                      "dds.domain_id=7"});
+  EXPECT_EQ(o.optimizer.huber_threshold, 2.5);  // the core's
+  EXPECT_EQ(o.schedule.window_period_s, 3.0);  // the schedule's
+  EXPECT_EQ(o.published_keyframes, 64);  // the process's
+  EXPECT_EQ(o.dds.domain_id, 7);
+  const auto error_of = [&](const std::string& assignment) {
+    try {
+      apply_overrides(o, {assignment});
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(error_of("optimizer.windwo_period_s=3").find("optimizer.windwo_period_s"), std::string::npos);
+  EXPECT_NE(error_of("optimizer.window_period_s=-1").find("window_period_s"), std::string::npos);
+  EXPECT_NE(error_of("filter.particles=10").find("filter.particles"), std::string::npos);
+}
+
 TEST(OptimizerNodeOptions, ErrorsNameTheFileAndKey) {
   const test::TempDir dir;
   const auto expect_error = [&](const std::string& text, const std::string& needle) {

@@ -684,6 +684,12 @@ const parameters::Table<SolveScheduleOptions>& solve_schedule_parameters() {
   return table;
 }
 
+void apply_optimizer_override(MapOptimizerOptions& options, SolveScheduleOptions& schedule,
+                              const std::string& assignment) {
+  parameters::apply_override_to_either(options, map_optimizer_parameters(), schedule, solve_schedule_parameters(),
+                                       "optimizer", assignment);
+}
+
 SolveSchedule::SolveSchedule(const SolveScheduleOptions& options, double start_s)
     : options_(options),
       next_window_s_(start_s + options.window_period_s),

@@ -29,13 +29,11 @@ void apply_overrides(OptimizerNodeOptions& o, const std::vector<std::string>& as
   const std::vector<std::string> optimizer = parameters::take_section(rest, "optimizer");
   if (!rest.empty()) throw std::invalid_argument("'" + rest.front() + "': not an optimizer. or dds. parameter");
   for (const std::string& a : optimizer) {
-    const std::string key = a.substr(0, a.find('=')).substr(10);  // below "optimizer."
-    if (parameters::find(map_optimizer::map_optimizer_parameters(), key) != nullptr) {
-      parameters::apply_override(o.optimizer, map_optimizer::map_optimizer_parameters(), "optimizer", a);
-    } else if (parameters::find(map_optimizer::solve_schedule_parameters(), key) != nullptr) {
-      parameters::apply_override(o.schedule, map_optimizer::solve_schedule_parameters(), "optimizer", a);
-    } else {
+    const std::string path = a.substr(0, a.find('='));
+    if (parameters::find(optimizer_node_parameters(), path.substr(path.find('.') + 1)) != nullptr) {
       parameters::apply_override(o, optimizer_node_parameters(), "optimizer", a);
+    } else {
+      map_optimizer::apply_optimizer_override(o.optimizer, o.schedule, a);
     }
   }
   map_optimizer::validate(o.optimizer);

@@ -6,11 +6,10 @@
 namespace pixyslam::offline {
 
 map_optimizer::MapOptimizerOptions optimizer_options(const slam::FilterOptions& options,
-                                                     const std::vector<std::string>& optimizer_sets) {
+                                                     const std::vector<std::string>& optimizer_sets,
+                                                     map_optimizer::SolveScheduleOptions& schedule) {
   map_optimizer::MapOptimizerOptions o = map_optimizer::MapOptimizerOptions::from_filter(options);
-  for (const std::string& a : optimizer_sets) {
-    parameters::apply_override(o, map_optimizer::map_optimizer_parameters(), "optimizer", a);
-  }
+  for (const std::string& a : optimizer_sets) map_optimizer::apply_optimizer_override(o, schedule, a);
   return o;
 }
 
@@ -20,7 +19,8 @@ OptimisedRun optimise_run(const slam::FilterOptions& options, const RunInput& in
   OptimisedRun out;
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_seconds();
-  map_optimizer::MapOptimizer optimizer(optimizer_options(options, optimizer_sets), input.initial_pose,
+  out.schedule = schedule;
+  map_optimizer::MapOptimizer optimizer(optimizer_options(options, optimizer_sets, out.schedule), input.initial_pose,
                                         input.start_time_s);
   for (const eval::LandmarkRow& row : filter.landmarks) optimizer.set_landmark_guess(row.id, {row.x_m, row.y_m});
   optimizer.add_odometry({input.start_time_s, 0.0, 0.0});
@@ -28,7 +28,7 @@ OptimisedRun optimise_run(const slam::FilterOptions& options, const RunInput& in
   std::vector<double> times;
   anchors.reserve(filter.trajectory.size());
   times.reserve(filter.trajectory.size());
-  map_optimizer::SolveSchedule due(schedule, input.start_time_s);
+  map_optimizer::SolveSchedule due(out.schedule, input.start_time_s);
   auto record = [&](double t) {
     anchors.push_back(optimizer.anchor_now());
     times.push_back(t);
@@ -36,7 +36,7 @@ OptimisedRun optimise_run(const slam::FilterOptions& options, const RunInput& in
     switch (kind) {
       case map_optimizer::SolveKind::kWhole: out.whole_solves.push_back(optimizer.solve()); break;
       case map_optimizer::SolveKind::kWindow:
-        out.window_solves.push_back(optimizer.solve(schedule.window_keyframes));
+        out.window_solves.push_back(optimizer.solve(out.schedule.window_keyframes));
         break;
       case map_optimizer::SolveKind::kNone: return;
     }

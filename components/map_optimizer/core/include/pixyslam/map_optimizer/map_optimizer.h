@@ -307,6 +307,12 @@ struct SolveScheduleOptions {
 // Its keys in the `optimizer:` section (config/map_optimizer.yaml).
 const parameters::Table<SolveScheduleOptions>& solve_schedule_parameters();
 
+// One --set "optimizer.KEY=V" applied to the table that declares KEY: the
+// optimiser's or the schedule's. std::invalid_argument naming an unknown key or
+// a bad value.
+void apply_optimizer_override(MapOptimizerOptions& options, SolveScheduleOptions& schedule,
+                              const std::string& assignment);
+
 enum class SolveKind { kNone, kWindow, kWhole };
 
 class SolveSchedule {

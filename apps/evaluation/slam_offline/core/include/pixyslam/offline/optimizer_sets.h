@@ -18,7 +18,8 @@ inline void check_optimizer_sets(const slam::FilterOptions& options, const std::
                                  bool optimise) {
   if (!sets.empty() && !optimise) throw std::invalid_argument(sets.front() + ": optimizer. needs --optimise");
 #ifdef PIXYSLAM_HAVE_MAP_OPTIMIZER
-  optimizer_options(options, sets);
+  map_optimizer::SolveScheduleOptions schedule;
+  optimizer_options(options, sets, schedule);
 #else
   (void)options;
 #endif
