@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
-# Cross-builds every robot-side program (and the rest but map_view) for the
-# Raspberry Pi 2 (armhf, Cortex-A7) and runs the armhf unit tests under
-# qemu-arm-static. Nothing armhf is installed on this machine: the armhf
+# Cross-builds every robot-side program (and the rest but map_view and the
+# programs only the native tests run) for the Raspberry Pi 2 (armhf, Cortex-A7)
+# and runs the armhf unit tests under qemu-arm-static. Nothing armhf is installed on this machine: the armhf
 # libraries (Fast DDS, yaml-cpp, ...) are Debian packages unpacked into a
 # sysroot (debootstrap --foreign fetches them with their dependencies), and
 # Debian's cross compiler builds against it (cmake/toolchain-armhf.cmake).
-#   scripts/cross_build_armhf.sh [--sysroot DIR] [--build-dir DIR] [--no-tests] [--map-optimizer] [ctest args...]
+#   scripts/cross_build_armhf.sh [--sysroot DIR] [--build-dir DIR] [--no-tests] [--prepare-only] [--map-optimizer] [ctest args...]
+# --prepare-only: the cross tools, the sysroot and the configured build folder,
+# nothing compiled (mostly downloads: scripts/run_tests.sh runs it beside the
+# native build).
 # Output: BUILD_DIR/bin (default build-armhf/bin); the sysroot is kept for the
 # next run (default build-armhf-sysroot/).
 # --map-optimizer: also Ceres (libceres-dev and its dependencies, in a sysroot
@@ -17,6 +20,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 sysroot=$root/build-armhf-sysroot
 build_dir=$root/build-armhf
 run_tests=1
+prepare_only=0
 map_optimizer=0
 sysroot_given=0
 while [[ $# -gt 0 ]]; do
@@ -24,6 +28,7 @@ while [[ $# -gt 0 ]]; do
     --sysroot) sysroot=$(realpath -m "${2:?}"); sysroot_given=1; shift 2 ;;
     --build-dir) build_dir=$(realpath -m "${2:?}"); shift 2 ;;
     --no-tests) run_tests=0; shift ;;
+    --prepare-only) prepare_only=1; shift ;;
     --map-optimizer) map_optimizer=1; shift ;;
     *) break ;;
   esac
@@ -82,6 +87,7 @@ if command -v ninja > /dev/null && [[ ! -f $build_dir/Makefile ]]; then generato
 cmake -S "$root" -B "$build_dir" "${generator[@]}" -DCMAKE_TOOLCHAIN_FILE="$root/cmake/toolchain-armhf.cmake" \
   -DPIXYSLAM_ARMHF_SYSROOT="$sysroot" -DCMAKE_BUILD_TYPE=Release \
   -DPIXYSLAM_BUILD_MAP_VIEW=OFF "${extra_cmake[@]}" > /dev/null
+if ((prepare_only)); then exit 0; fi
 cmake --build "$build_dir" -j "$(nproc)"
 file "$build_dir/bin/slam_estimator"
 if ((run_tests)); then

@@ -16,8 +16,27 @@ phase() {
   return "$rc"
 }
 phase install "$root/scripts/install_deps.sh"
+armhf=0
+[[ ${PIXYSLAM_ARMHF:-1} == 0 ]] || armhf=1
+if ((armhf)); then
+  # The cross tools and the armhf sysroot are mostly downloads: beside the
+  # native build, which keeps the cores busy (its output in a file until then).
+  # Its own process group (setsid), stopped with it if the build fails.
+  armhf_prepare_log=$(mktemp /tmp/pixyslam_armhf_prepare.XXXXXX)
+  setsid "$root/scripts/cross_build_armhf.sh" --prepare-only --build-dir "$root/build-armhf" \
+    > "$armhf_prepare_log" 2>&1 &
+  armhf_prepare=$!
+  trap 'kill -- -"$armhf_prepare" 2> /dev/null || true; rm -f "$armhf_prepare_log"' EXIT
+fi
 phase build "$root/scripts/build.sh"
-if [[ ${PIXYSLAM_ARMHF:-1} != 0 ]]; then
+if ((armhf)); then
+  armhf_prepared() {
+    local rc=0
+    wait "$armhf_prepare" || rc=$?
+    cat "$armhf_prepare_log"
+    return "$rc"
+  }
+  phase armhf_prepare armhf_prepared
   phase armhf_build "$root/scripts/cross_build_armhf.sh" --no-tests --build-dir "$root/build-armhf"
 fi
 build_dir=${BUILD_DIR:-$root/build}
