@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Configures and builds the project (Release) into ${BUILD_DIR:-build}.
+# Arguments go to cmake when it configures, e.g. scripts/build.sh
+# -DPIXYSLAM_BUILD_MAP_VIEW=OFF (the options: CMakeLists.txt, README.md).
 set -euo pipefail
+case ${1:-} in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 root=$(cd "$(dirname "$0")/.." && pwd)
 build_dir=${BUILD_DIR:-$root/build}
 generator=()

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Cross-builds every robot-side program (and the rest but map_view and the
 # programs only the native tests run) for the Raspberry Pi 2 (armhf, Cortex-A7)
-# and runs the armhf unit tests under qemu-arm-static. Nothing armhf is installed on this machine: the armhf
-# libraries (Fast DDS, yaml-cpp, ...) are Debian packages unpacked into a
-# sysroot (debootstrap --foreign fetches them with their dependencies), and
-# Debian's cross compiler builds against it (cmake/toolchain-armhf.cmake).
+# and runs the armhf unit tests under qemu-arm-static. Nothing armhf is
+# installed on this machine: the armhf libraries (Fast DDS, yaml-cpp, ...) are
+# Debian packages unpacked into a sysroot (debootstrap --foreign fetches them
+# with their dependencies), and Debian's cross compiler builds against it
+# (cmake/toolchain-armhf.cmake).
 #   scripts/cross_build_armhf.sh [--sysroot DIR] [--build-dir DIR] [--no-tests] [--prepare-only] [--map-optimizer] [ctest args...]
 # --prepare-only: the cross tools, the sysroot and the configured build folder,
 # nothing compiled (mostly downloads: scripts/run_tests.sh runs it beside the
@@ -16,6 +17,7 @@
 # benchmarks, to measure the optimiser's cost on the Pi's instruction set
 # (docs/benchmarks.md); the robot itself does not need it.
 set -euo pipefail
+case ${1:-} in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 root=$(cd "$(dirname "$0")/.." && pwd)
 sysroot=$root/build-armhf-sysroot
 build_dir=$root/build-armhf

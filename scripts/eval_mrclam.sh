@@ -3,7 +3,9 @@
 # 1-3, one parameter set. Usage: scripts/eval_mrclam.sh [DATASET_DIR] [extra mrclam_eval args]
 # Default dataset: ../shared/data/mrclam/Dataset6 beside the checkout. Skips (exit 0)
 # when that default folder is absent; a DATASET_DIR given that does not exist exits 1.
+# The extra arguments: build/bin/mrclam_eval --help lists them.
 set -euo pipefail
+case ${1:-} in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 root=$(cd "$(dirname "$0")/.." && pwd)
 dataset=$root/../shared/data/mrclam/Dataset6
 if [[ $# -gt 0 && $1 != -* ]]; then

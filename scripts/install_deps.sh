@@ -2,6 +2,8 @@
 # Installs the Debian 12 packages this project needs, and only those missing.
 # Idempotent: a machine that has everything installs nothing. Uses sudo when not root.
 set -euo pipefail
+case ${1:-} in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
+if (($#)); then echo "usage: scripts/install_deps.sh (no arguments; --help: more)" >&2; exit 2; fi
 
 PACKAGES=(
   cmake g++ ninja-build pkg-config

@@ -10,8 +10,9 @@
 # Default names: every pixyslam process and tool. Keep ca.key.pem off the robot.
 set -euo pipefail
 
-usage() { echo "usage: $0 OUT_DIR [--domains MIN-MAX] [--days N] [NAME ...]" >&2; exit 2; }
-[[ $# -ge 1 ]] || usage
+case ${1:-} in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
+usage() { echo "usage: $0 OUT_DIR [--domains MIN-MAX] [--days N] [NAME ...] (--help: more)" >&2; exit 2; }
+[[ $# -ge 1 && $1 != -* ]] || usage
 out=$1; shift
 domains=0-232 days=365 names=()
 while [[ $# -gt 0 ]]; do

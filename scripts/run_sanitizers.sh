@@ -7,6 +7,7 @@
 # Debian's Fast DDS is not instrumented; tests/sanitizers/ holds the settings
 # and suppressions for what ASan/LSan/TSan report inside it (not in our code).
 set -euo pipefail
+case ${1:-} in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 root=$(cd "$(dirname "$0")/.." && pwd)
 kind=${1:?usage: run_sanitizers.sh asan|tsan [ctest args]}
 shift

@@ -4,6 +4,7 @@
 # skips it), and runs every test (ctest). Extra arguments go to ctest, e.g.
 # scripts/run_tests.sh -L unit.
 set -euo pipefail
+case ${1:-} in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 root=$(cd "$(dirname "$0")/.." && pwd)
 # Each phase's wall time, on one line at the end (and when a phase fails).
 phases=""

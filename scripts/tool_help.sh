@@ -2,6 +2,8 @@
 # Prints docs/tools.md: every shipped executable's --help text, from the build.
 #   scripts/tool_help.sh > docs/tools.md      (after scripts/build.sh)
 set -euo pipefail
+case ${1:-} in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
+if (($#)); then echo "usage: scripts/tool_help.sh > docs/tools.md (no arguments; --help: more)" >&2; exit 2; fi
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${BUILD_DIR:-$root/build}/bin
 tools=(encoder_bridge pixy_bridge slam_estimator map_optimizer logger foxglove_bridge pixyslam_launch pixyslam_spy pixyslam_play

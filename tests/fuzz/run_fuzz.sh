@@ -7,6 +7,7 @@
 # Longer campaign, e.g. one hour each:  tests/fuzz/run_fuzz.sh 3600
 # FUZZ_JOBS: build jobs and targets run at once (default: the number of cores).
 set -euo pipefail
+case ${1:-} in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 root=$(cd "$(dirname "$0")/../.." && pwd)
 seconds=${1:-60}
 shift || true
