@@ -97,7 +97,8 @@ int run(int argc, char** argv) {
     for (const sim::Pole& p : run.poles) input.landmarks.push_back({p.id, p.x_m, p.y_m});
   }
   const offline::RunResult filter = offline::run_filter(options, input);
-  const offline::OptimisedRun opt = offline::optimise_run(options, input, filter, map_optimizer::SolveScheduleOptions{}, optimizer_sets);
+  const offline::OptimisedRun opt =
+      offline::optimise_run(options, input, filter, map_optimizer::SolveScheduleOptions{}, optimizer_sets);
   const map_optimizer::SolveScheduleOptions& schedule = opt.schedule;  // the live process's, after --set
   const double data_s = filter.trajectory.empty() ? 0.0 : filter.trajectory.back().t_s - input.start_time_s;
   std::printf("data %.1f s, %zu keyframes, %zu observation factors; schedule: window of %zu keyframes every %.1f s, "
