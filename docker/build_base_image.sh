@@ -5,7 +5,12 @@
 # With a registry, `--build-arg BASE_IMAGE=debian:bookworm-slim` works the same.
 #   docker/build_base_image.sh [podman|docker]
 set -euo pipefail
+case ${1:-} in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 engine=${1:-podman}
+if (($# > 1)) || [[ $engine != podman && $engine != docker ]]; then
+  echo "usage: docker/build_base_image.sh [podman|docker] (--help: more)" >&2
+  exit 2
+fi
 image=localhost/pixyslam-base:bookworm
 if "$engine" image exists "$image" 2>/dev/null || "$engine" image inspect "$image" >/dev/null 2>&1; then
   echo "build_base_image: $image exists"

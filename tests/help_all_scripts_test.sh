@@ -1,19 +1,21 @@
 #!/usr/bin/env bash
-# Every script a user runs (scripts/*.sh, tests/fuzz/run_fuzz.sh): `--help`
-# exits 0 within 5 s and prints the script's header comment (and so does
-# nothing else: before this test, `run_tests.sh --help` started a build and
-# `paper_experiments.sh --help` an experiment). Scripts whose arguments are
-# their own (not handed on to cmake, ctest or a program) also refuse an
-# unknown flag with exit status 2 and a message on stderr.
+# Every script a user runs (scripts/*.sh, docker/*.sh, tests/fuzz/run_fuzz.sh):
+# `--help` exits 0 within 5 s and prints the script's header comment (and so
+# does nothing else: before this test, `run_tests.sh --help` started a build,
+# `paper_experiments.sh --help` an experiment and `build_base_image.sh --help`
+# a debootstrap). Scripts whose arguments are their own (not handed on to
+# cmake, ctest or a program) also refuse an unknown flag with exit status 2 and
+# a message on stderr.
 #   help_all_scripts_test.sh SOURCE_DIR
 set -uo pipefail
 src=$1
 work=$(mktemp -d "${TMPDIR:-/tmp}/pixyslam_help_scripts.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 trap 'exit 130' INT TERM
-own_arguments=(install_deps tool_help paper_experiments make_dds_security run_sanitizers fleet_scale stall_process)
+own_arguments=(install_deps tool_help paper_experiments make_dds_security run_sanitizers fleet_scale stall_process
+  build_base_image build_images)
 fail=0 checked=0
-for script in "$src"/scripts/*.sh "$src"/tests/fuzz/run_fuzz.sh; do
+for script in "$src"/scripts/*.sh "$src"/docker/*.sh "$src"/tests/fuzz/run_fuzz.sh; do
   name=$(basename "$script" .sh)
   checked=$((checked + 1))
   problems=()
