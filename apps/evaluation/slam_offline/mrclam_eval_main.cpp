@@ -868,8 +868,8 @@ int main(int argc, char** argv) {
       .non_negative()
       .type("GAP_S");
   cli.flag("--optimise", a.optimise.on,
-           "also the map optimiser (Ceres) over every run after the filter (--set optimizer.KEY=V: map_optimizer "
-           "--help lists them)");
+           "also the map optimiser (Ceres) over every run after the filter (--set optimizer.KEY=V: the "
+           "optimiser's and its solve schedule's keys that map_optimizer --help lists)");
   cli.option("--out-dir", a.out_dir,
              "write runs.csv, segments.csv and errors_robotR_seedS.csv (error over time) there, for "
              "scripts/plot_results.py")

@@ -214,7 +214,7 @@ int main(int argc, char** argv) {
     mode.option("--seed", args.seed, "the filter's seed (filter.seed)").type("S");
     app::add_set(mode, args.sets, "filter.particles=300 (slam_estimator --help lists them; sim also world.KEY=V, "
                                   "mrclam also mrclam.KEY=V, both listed below; with --optimise optimizer.KEY=V, "
-                                  "map_optimizer --help lists them)");
+                                  "the optimiser's and its solve schedule's keys that map_optimizer --help lists)");
     mode.flag("--optimise",
               args.optimise,
               "also solve the whole run with the map optimiser (Ceres): its solution goes to trajectory.csv and "
