@@ -51,6 +51,9 @@ data_topics=(pixyslam/odometry pixyslam/landmark_observation pixyslam/map_state 
 viz_topics=(pixyslam/viz/landmarks pixyslam/viz/estimate pixyslam/viz/path pixyslam/viz/tf
             pixyslam/viz/true_path pixyslam/viz/true_landmarks)
 
+# The log exists before the bridge starts: the loop below may read it before the
+# background shell has opened it.
+: > "$work/bridge.log"
 "$bin/foxglove_bridge" --config "$config/foxglove_bridge.yaml" --port 0 --domain "$domain" \
   > "$work/bridge.log" 2>&1 &
 bridge_pid=$!
