@@ -13,7 +13,7 @@ while (($#)); do
     --from-source) from_source=1 ;;
     --build-dir) build_dir=${2:?--build-dir needs a folder}; shift ;;
     podman|docker) engine=$1 ;;
-    -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;;
     *) echo "build_images: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift

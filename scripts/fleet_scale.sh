@@ -20,7 +20,7 @@
 # --sim, an estimator got none of its robot's samples or lost some), 2 usage,
 # 77 not root (skipped).
 set -euo pipefail
-usage() { sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; }
 case ${1:-} in -h | --help) usage; exit 0 ;; esac
 sim=0
 args=()

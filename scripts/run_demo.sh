@@ -17,7 +17,7 @@ launch_args=()
 while (($#)); do
   case $1 in
     -h | --help)
-      sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'
+      sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"
       exit 0
       ;;
     --run-dir)

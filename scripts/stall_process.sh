@@ -11,7 +11,7 @@
 # A stopped process is always continued, also when this script is interrupted.
 # Exit status: 0 done, 2 usage.
 set -euo pipefail
-usage() { sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; }
 case ${1:-} in -h | --help) usage; exit 0 ;; esac
 (($# >= 3 && $# <= 4)) || { usage >&2; exit 2; }
 name=$1 stop_s=$2 every_s=$3 duration_s=${4:-3600}
