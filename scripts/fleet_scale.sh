@@ -49,6 +49,7 @@ cleanup() {
 }
 trap cleanup EXIT
 trap 'exit 130' INT TERM
+ip netns del "$ns" 2>/dev/null || true  # left by a run killed before its cleanup (the name recurs with the pid)
 ip netns add "$ns"
 ip -n "$ns" link set lo up
 ip -n "$ns" link set lo multicast on
@@ -141,7 +142,7 @@ if ((sim)); then
   for pid in "${sims[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
   for pid in "${sims[@]}"; do wait "$pid" 2>/dev/null || true; done
   sleep 1
-  for pid in "${!kind_of[@]}"; do [[ ${kind_of[$pid]} == slam_estimator ]] && kill -INT "$pid" 2>/dev/null; done
+  for pid in "${!kind_of[@]}"; do [[ ${kind_of[$pid]} == slam_estimator ]] && { kill -INT "$pid" 2>/dev/null || true; }; done
   for pid in "${!kind_of[@]}"; do [[ ${kind_of[$pid]} == slam_estimator ]] && { wait "$pid" 2>/dev/null || true; }; done
   for f in "$work"/est*.log; do grep "slam_estimator: odometry" "$f" | tail -n 1; done | sed -n "s/.*slam_estimator: odometry \([0-9]*\) (lost \([0-9]*\)), observations \([0-9]*\) (lost \([0-9]*\)), other robots' \([0-9]*\), steps \([0-9]*\), late \([0-9]*\).*/\1 \2 \3 \4 \5 \6 \7/p" |
     awk -v n="$n" '

@@ -19,6 +19,7 @@ if [[ $(id -u) -ne 0 ]] || ! command -v ip >/dev/null || ! ip netns list >/dev/n
 fi
 [[ -x $relay ]] || { echo "SKIP: no cyclone_relay (apt install cyclonedds-dev cyclonedds-tools, then rebuild)"; exit 77; }
 
+source "$(dirname "$0")/support/netns_lib.sh"
 tag=pxc$$
 net=$((10 + $$ % 240))
 domain=$((100 + $$ % 60))
@@ -28,19 +29,15 @@ cleanup() {
   for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
   sleep 0.5
   for pid in "${pids[@]}"; do kill -KILL "$pid" 2>/dev/null || true; done
-  for h in fast cyc; do  # anything left in the namespaces
-    ip netns pids "${tag}_$h" 2>/dev/null | xargs -r kill -KILL 2>/dev/null || true
-  done
-  ip netns del "${tag}_fast" 2>/dev/null || true
-  ip netns del "${tag}_cyc" 2>/dev/null || true
+  netns_remove "$tag" fast cyc
   rm -rf "$work"
 }
 trap cleanup EXIT
 trap 'exit 130' INT TERM
 fail() { echo "FAIL: $*"; for f in "$work"/*.log; do echo "== $f"; cat "$f"; done; exit 1; }
 
-ip netns add "${tag}_fast"
-ip netns add "${tag}_cyc"
+netns_add "${tag}_fast"
+netns_add "${tag}_cyc"
 ip link add eth0 netns "${tag}_fast" type veth peer name eth0 netns "${tag}_cyc"
 i=1
 for h in fast cyc; do

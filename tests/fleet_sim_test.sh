@@ -37,7 +37,7 @@ done
 for r in 1 2; do
   other=$((3 - r))
   expect="odometry ${odometry[$r]} (lost 0), observations ${observations[$r]} (lost 0), other robots' $((odometry[$other] + observations[$other])),"
-  grep -E "^\[estimator_robot$r\]" "$log" | grep -qF "$expect" ||
+  grep -E "^\[estimator_robot$r\]" "$log" | grep -F "$expect" > /dev/null ||
     fail "estimator robot$r: expected '$expect'"
   echo "estimator robot$r: $expect (as robot $r's and robot $other's bridges published)"
 done

@@ -85,9 +85,9 @@ echo "== live (foxglove_bridge -> @foxglove/ws-protocol client)"
 cat "$work/live.out"
 [[ $live_status -eq 0 ]] || fail "live client: exit $live_status"
 
-kill -INT "$record_pid"
+kill -INT "$record_pid" 2>/dev/null || true
 wait "$record_pid" || fail "pixyslam_log record: exit $?"
-kill -INT "$bridge_pid"
+kill -INT "$bridge_pid" 2>/dev/null || true
 bridge_status=0
 wait "$bridge_pid" || bridge_status=$?
 tail -n 1 "$work/bridge.log"

@@ -51,7 +51,7 @@ for _ in $(seq 200); do
 done
 grep -q '^progress' "$work/publisher.out" || { echo "publisher never started"; cat "$work/logger.err"; exit 1; }
 sleep "$kill_after_s"
-kill -9 "$logger_pid"
+kill -9 "$logger_pid" 2>/dev/null || { echo "FAIL: the logger had exited before the kill"; cat "$work/logger.err"; exit 1; }
 sent=$(grep '^progress' "$work/publisher.out" | tail -n 1 | cut -d' ' -f2)
 wait "$logger_pid" 2>/dev/null || true
 logger_pid=""

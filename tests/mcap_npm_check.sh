@@ -122,7 +122,7 @@ YAML
     echo "FAIL $name: publisher failed"; cat "$dir/publisher.err" "$dir/logger.err"; return 1
   fi
   sleep 0.5
-  kill -INT "$logger_pid"
+  kill -INT "$logger_pid" 2>/dev/null || true
   local rc=0
   wait "$logger_pid" || rc=$?
   logger_pid=""

@@ -45,11 +45,12 @@ for f in usr/lib/pixyslam/bin/slam_estimator usr/lib/pixyslam/bin/encoder_bridge
   [[ -e $work/root/$f ]] || fail "$f is in neither package"
 done
 # pixy_bridge runs pixy_bridge_camera from its own folder for a camera (and --help).
-"$work/root/usr/lib/pixyslam/bin/pixy_bridge" --help | grep -q "camera.input" ||
+# grep > /dev/null, not -q: an early exit of grep would make the writer's SIGPIPE the pipeline's status.
+"$work/root/usr/lib/pixyslam/bin/pixy_bridge" --help | grep "camera.input" > /dev/null ||
   fail "the packaged pixy_bridge --help does not reach pixy_bridge_camera (no camera keys)"
-ldd "$work/root/usr/lib/pixyslam/bin/pixy_bridge" | grep -q opencv && fail "pixy_bridge loads OpenCV (only pixy_bridge_camera should)"
-dpkg-deb -c "$robot_deb" | grep -q "usr/lib/pixyslam/bin/map_view" && fail "map_view (GUI) is in pixyslam-robot"
-dpkg-deb -c "$station_deb" | grep -q "etc/pixyslam" && fail "pixyslam-station ships config files (pixyslam-robot's)"
+ldd "$work/root/usr/lib/pixyslam/bin/pixy_bridge" | grep opencv > /dev/null && fail "pixy_bridge loads OpenCV (only pixy_bridge_camera should)"
+dpkg-deb -c "$robot_deb" | grep "usr/lib/pixyslam/bin/map_view" > /dev/null && fail "map_view (GUI) is in pixyslam-robot"
+dpkg-deb -c "$station_deb" | grep "etc/pixyslam" > /dev/null && fail "pixyslam-station ships config files (pixyslam-robot's)"
 grep -qx "/etc/pixyslam/slam_estimator.yaml" "$work/control/conffiles" || fail "config files are not conffiles"
 # Every /usr/bin entry is a pixyslam-NAME link to a program of the package.
 for link in "$work"/root/usr/bin/*; do

@@ -45,7 +45,7 @@ b0=$(cpu_s "$bridge"); e0=$(cpu_s "$estimator")
 sleep "$seconds"
 b1=$(cpu_s "$bridge"); e1=$(cpu_s "$estimator")
 wait "$flood"  # it keeps the pty open for 1 s after the flood
-kill -INT "$bridge" "$estimator"
+kill -INT "$bridge" "$estimator" 2>/dev/null || true
 wait "$bridge" "$estimator"
 
 cat "$work/flood.out"

@@ -77,7 +77,7 @@ i=0
 for h in "${hosts[@]}"; do
   i=$((i + 1))
   if [[ -n $link_schedule && $h == robot ]]; then
-    ip netns add "${tag}_$h"
+    netns_add "${tag}_$h"
     "$LINK_EMULATOR" --a "${tag}_robot:eth0" --b "${tag}_sw:v_robot" --schedule "$link_schedule" \
       > "$work/link_emulator.log" 2>&1 &
     emulator=$!
@@ -180,7 +180,9 @@ doomed=$!
 pids+=($doomed)
 
 # Cut the robot's link for cut_s seconds (not when it is emulated).
-sleep $((cut_at_s - ($(date +%s) - start)))
+# Late under load: no sleep rather than a negative one (`sleep -1` fails the test).
+until_cut_s=$((cut_at_s - ($(date +%s) - start)))
+((until_cut_s <= 0)) || sleep "$until_cut_s"
 if [[ -z $link_schedule ]]; then
   ip -n "${tag}_sw" link set v_robot down
   cut_begin_ns=$(date +%s%N)

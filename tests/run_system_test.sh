@@ -33,7 +33,7 @@ fi
 status=0
 "$bin/pixyslam_launch" "$work/config/$launch" "${launch_args[@]}" --run-dir "$work/run" > "$work/out.log" 2>&1 &
 launcher=$!
-trap 'kill "$launcher" 2>/dev/null || true; rm -rf "$work"' EXIT
+trap 'kill "$launcher" 2>/dev/null || true; wait 2>/dev/null || true; rm -rf "$work"' EXIT
 trap 'exit 130' INT TERM  # a killed test still cleans up (the EXIT trap)
 # pixyslam_spy echo of every topic while the system runs: 20 samples each.
 topics=(odometry landmark_observation map_state ground_truth)
@@ -44,7 +44,7 @@ for t in "${topics[@]}"; do
     --config "$work/config/slam_estimator.yaml" > "$work/echo_$t.jsonl" 2> "$work/echo_$t.err" &
   echoes+=($!)
 done
-trap 'kill "$launcher" "${echoes[@]}" 2>/dev/null || true; rm -rf "$work"' EXIT
+trap 'kill "$launcher" "${echoes[@]}" 2>/dev/null || true; wait 2>/dev/null || true; rm -rf "$work"' EXIT
 for pid in "${echoes[@]}"; do wait "$pid" || { echo "FAIL: pixyslam_spy echo failed"; cat "$work"/echo_*.err; exit 1; }; done
 wait "$launcher" || status=$?
 grep -v "robot_sim: t \|status: " "$work/out.log"

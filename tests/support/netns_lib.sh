@@ -3,9 +3,21 @@
 # /24) and one for the switch (TAG_sw, a bridge br0 without multicast
 # snooping, one v_HOST port per host). Root needed; nothing leaves them.
 
+# netns_add NAME: a new namespace NAME. One of that name left by a run that was
+# killed before its cleanup (a ctest timeout; the tag comes from a pid, which
+# recurs) is emptied and deleted first.
+netns_add() {
+  if ip netns list | grep -x "$1\( .*\)\{0,1\}" > /dev/null; then
+    echo "removing namespace $1, left by an earlier run"
+    ip netns pids "$1" 2>/dev/null | xargs -r kill -KILL 2>/dev/null || true
+    ip netns del "$1"
+  fi
+  ip netns add "$1"
+}
+
 # netns_switch TAG: the switch's namespace and bridge.
 netns_switch() {
-  ip netns add "$1_sw"
+  netns_add "$1_sw"
   ip -n "$1_sw" link add br0 type bridge mcast_snooping 0
   ip -n "$1_sw" link set br0 up
 }
@@ -25,7 +37,7 @@ netns_attach() {
 # netns_host TAG HOST ADDRESS/PREFIX: a host joined to the switch by a veth pair.
 netns_host() {
   local tag=$1 host=$2
-  ip netns add "${tag}_$host"
+  netns_add "${tag}_$host"
   ip link add "v_$host" netns "${tag}_sw" type veth peer name eth0 netns "${tag}_$host"
   netns_attach "$@"
 }
