@@ -4,7 +4,8 @@
 # fails stops the run; an optional one exiting 2 (configuration error) is not
 # restarted; with several processes marked ends_run (a for_each over robots),
 # the run ends with the last of them. A file that uses ${input}: --show-args
-# works without --input, a run without it exits 2 saying so.
+# works without --input, a run without it exits 2 saying so. A program that is
+# not there stops the run before anything starts (exit 2).
 #   launcher_roles_test.sh LAUNCHER
 set -euo pipefail
 launcher=$1
@@ -99,4 +100,24 @@ grep -qF "this launch file needs --input FILE" "$work/input.log" && [[ $status -
 "$launcher" "$work/input.yaml" --input "$work/data.txt" --run-dir "$work/run_input" > "$work/input.log" 2>&1 ||
   fail "with --input: $(cat "$work/input.log")"
 grep -qF "reading $work/data.txt" "$work/input.log" || fail "\${input} not the file given: $(cat "$work/input.log")"
+
+# A misspelt program: refused before anything starts (exit 2, naming the file
+# and the process), so no process runs and no run folder is made.
+cat > "$work/typo.yaml" <<YAML
+launch:
+  processes:
+    - name: first
+      command: [/bin/sh, -c, "touch $work/first_ran"]
+    - name: second
+      delay_s: 1
+      command: [pixyslam_no_such_program, --help]
+  after_run:
+    - name: report
+      command: [/bin/true]
+YAML
+run_launch typo
+[[ $status -eq 2 ]] || fail "a misspelt program: exit $status, expected 2"
+grep -qF "typo.yaml: launch.processes 'second': program 'pixyslam_no_such_program' not found" "$work/typo.log" ||
+  fail "the error does not name the file, the process and the program"
+[[ ! -e $work/first_ran && ! -d $work/run_typo ]] || fail "the run started before the misspelt program was found"
 echo PASS

@@ -287,6 +287,20 @@ int run(const LaunchCommandLine& args, const std::map<std::string, std::string>&
                 args.deployment.c_str(), plan.processes.size(), plan.after_run.size());
   }
   if (args.duration_s >= 0.0) plan.duration_s = args.duration_s;
+  // Every program is found before anything starts: a misspelt one must not stop
+  // a run half-way, its log unclosed.
+  const launcher::ProcessGroup finder(bin_dir, stdout);
+  auto check_programs = [&](const std::vector<launcher::ProcessSpec>& specs, const char* list) {
+    for (const launcher::ProcessSpec& spec : specs) {
+      try {
+        finder.resolve(spec.command.front());
+      } catch (const std::runtime_error& e) {
+        throw std::invalid_argument(launch_file + ": launch." + list + " '" + spec.name + "': " + e.what());
+      }
+    }
+  };
+  check_programs(plan.processes, "processes");
+  check_programs(plan.after_run, "after_run");
   std::filesystem::create_directories(run_dir);  // only once the files and arguments are good
   char duration[48] = "";
   if (plan.duration_s > 0) std::snprintf(duration, sizeof(duration), ", for %.1f s", plan.duration_s);

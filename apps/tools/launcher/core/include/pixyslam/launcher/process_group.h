@@ -41,6 +41,10 @@ class ProcessGroup {
   ProcessGroup(const ProcessGroup&) = delete;
   ProcessGroup& operator=(const ProcessGroup&) = delete;
 
+  // The path a command's program runs from: a path as given, else the first of
+  // the launcher's folder and PATH that holds it. Throws std::runtime_error if
+  // it is not there or not executable.
+  std::string resolve(const std::string& program) const;
   // Starts a child and returns its index; throws std::runtime_error if the
   // program is not found. A child started again under the name of one that
   // ended (a restart) takes its index: a crash loop does not grow the group.
@@ -60,7 +64,6 @@ class ProcessGroup {
 
  private:
   struct Child;
-  std::string resolve(const std::string& program) const;
   void drain(Child& child, bool final);
   void reap();
   void stop_adopted(std::chrono::milliseconds timeout);
