@@ -9,6 +9,10 @@
 #include <stdexcept>
 #include <utility>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include "mcap_format.h"
 #include "pixyslam/mcap/crc32.h"
 
@@ -1419,16 +1423,31 @@ class McapReader::Parser {
 
 namespace {
 
+// The whole file. Only a regular file: a FIFO (which would wait for a writer,
+// deaf to Ctrl-C), a directory or a device is refused, naming what it is.
 std::vector<std::uint8_t> read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw std::runtime_error(path + ": cannot open for reading: " + std::strerror(errno));
-  const std::streamoff size = in.tellg();
-  if (size < 0) throw std::runtime_error(path + ": cannot determine the file size");
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
-  in.seekg(0);
-  if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) {
-    throw std::runtime_error(path + ": read failed");
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK);
+  if (fd < 0) throw std::runtime_error(path + ": cannot open for reading: " + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) throw std::runtime_error(path + ": cannot read: " + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) {
+    const char* kind = S_ISDIR(st.st_mode) ? "a directory" : S_ISFIFO(st.st_mode) ? "a pipe" : "a device or socket";
+    throw std::runtime_error(path + ": not a regular file (" + kind + "); an MCAP file is read whole");
   }
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(st.st_size));
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw std::runtime_error(path + ": read failed: " + std::strerror(errno));
+    if (n == 0) break;  // shrank since fstat(): the bytes there are
+    done += static_cast<std::size_t>(n);
+  }
+  bytes.resize(done);
   return bytes;
 }
 

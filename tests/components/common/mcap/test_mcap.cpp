@@ -14,10 +14,12 @@
 #include <ostream>
 #include <random>
 #include <stdexcept>
+#include <utility>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "pixyslam/mcap/crc32.h"
 #include "pixyslam/mcap/mcap_reader.h"
@@ -617,6 +619,23 @@ TEST(McapReaderErrors, NotMcapFilesThrowNamingTheFile) {
     McapReader reader(text);
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("bad magic"), std::string::npos) << e.what();
+  }
+}
+
+// A FIFO would block the open until a writer came (and Ctrl-C with it): it is
+// refused at once, as a directory is, naming what it is.
+TEST(McapReaderErrors, APipeOrADirectoryIsRefusedWithoutWaiting) {
+  test::TempDir dir;
+  const std::string fifo = dir.file("fifo.mcap");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const auto& [path, kind] : {std::pair<std::string, std::string>{fifo, "a pipe"}, {dir.path(), "a directory"}}) {
+    try {
+      McapReader reader(path);
+      ADD_FAILURE() << "no exception for " << path;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(path + ": not a regular file (" + kind + ")"), std::string::npos)
+          << e.what();
+    }
   }
 }
 
