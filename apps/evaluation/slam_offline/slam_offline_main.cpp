@@ -126,7 +126,12 @@ int run(const Args& args) {
     robot_sim::RobotSimConfig hw = robot_sim::load_robot_sim_config(
         sim_config, (std::filesystem::path(folder) / "pixy_bridge.yaml").string(),
         (std::filesystem::path(folder) / "encoder_bridge.yaml").string());
-    if (!args.seed.empty()) hw.hardware.seed = options.seed;
+    // The estimator's own sections are its business; any other is an error, as in sim and mrclam.
+    for (const char* section : {"estimator", "dds"}) {
+      if (root.has(section)) root.child(section);
+    }
+    root.finish();
+    // --seed is the filter's: the bytes stay robot_sim's (hardware.seed in --sim-config).
     input = offline::hardware_input(hw, args.duration_s);
     title = "emulated hardware, " + std::to_string(input.landmarks.size()) + " visible poles, " +
             std::to_string(input.frames.size()) + " frames with detections";
