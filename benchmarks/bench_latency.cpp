@@ -1,11 +1,12 @@
 // End-to-end latency on loopback: Odometry published by this process -> the
 // MapState that includes it, from a separate slam_estimator process.
-//   bench_latency [--config config/slam_estimator.yaml] [--duration S] [--out FILE.csv]
+//   bench_latency [--config config/slam_estimator.yaml] [--duration S] [--out FILE.csv] [--domain N]
 // Streams the simulated world in real time at the paper's rates (odometry 10 Hz,
 // stamped at the start of its period and sent at its end, as the encoder bridge
 // does; camera frames 10 Hz) and prints p50/p90/p99/max of the latency.
 // --out writes every sample's latency (one column latency_ms) for
-// scripts/plot_results.py.
+// scripts/plot_results.py. This process joins DDS as the estimator does: the
+// dds: section of --config, PIXYSLAM_DDS_*, then --domain (passed on to it).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -22,6 +23,7 @@
 #include "pixyslam/app/cli.h"
 #include "pixyslam/app/process_main.h"
 #include "pixyslam/app/stop_signal.h"
+#include "pixyslam/dds/dds_options.h"
 #include "pixyslam/dds/endpoints.h"
 #include "pixyslam/launcher/process_group.h"
 #include "../tests/support/sim_sensor_messages.h"
@@ -42,15 +44,18 @@ std::string own_folder() {
 
 }  // namespace
 
-int run(const std::string& config, double duration_s, const std::string& out) {
+int run(const std::string& config, double duration_s, const std::string& out,
+        const std::vector<std::string>& dds_overrides, const std::string& domain) {
+  // The estimator's DDS settings, as it resolves them (a bad dds: key exits 2 here, before it starts).
+  dds::DdsOptions dds_options = dds::read_dds_options_file(config, dds::default_profiles_file());
+  dds::resolve_settings(dds_options, dds_overrides);
+
   // The estimator as its own process, its output forwarded with a prefix.
   launcher::ProcessGroup estimator(own_folder(), stdout);
   std::vector<std::string> command{"slam_estimator", "--config", config};
+  if (!domain.empty()) command.insert(command.end(), {"--domain", domain});
   estimator.start({"slam_estimator", command, 0.0, false, {}});
 
-  dds::DdsOptions dds_options;
-  dds_options.profiles_file = std::string(PIXYSLAM_CONFIG_DIR) + "/dds/profiles.xml";
-  dds::resolve_settings(dds_options);  // as the estimator does
   dds::Participant participant(dds_options, "bench_latency");
   dds::Writer<msg::Odometry> odometry_writer(participant);
   dds::Writer<msg::LandmarkObservation> observation_writer(participant);
@@ -70,10 +75,21 @@ int run(const std::string& config, double duration_s, const std::string& out) {
     auto it = published_ns.find(seq);
     if (it != published_ns.end()) latencies_ms.push_back(static_cast<double>(now - it->second) * 1e-6);
   });
-  if (!odometry_writer.wait_for_readers(1, std::chrono::seconds(20)) ||
-      !observation_writer.wait_for_readers(1, std::chrono::seconds(20))) {
-    std::fprintf(stderr, "bench_latency: the estimator did not appear on DDS\n");
-    return 1;
+  // Its output is forwarded while waiting; one that exits (a config error) ends the wait with its status.
+  const auto appear_by = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (odometry_writer.matched_readers() < 1 || observation_writer.matched_readers() < 1) {
+    estimator.poll(std::chrono::milliseconds(100));
+    if (!estimator.running(0)) {
+      const launcher::ExitStatus& status = estimator.status(0);
+      std::fprintf(stderr, "bench_latency: slam_estimator %s before it appeared on DDS\n", status.describe().c_str());
+      return status.exited && status.code == 2 ? 2 : 1;
+    }
+    if (app::StopSignal::requested()) return 1;
+    if (std::chrono::steady_clock::now() > appear_by) {
+      std::fprintf(stderr, "bench_latency: the estimator did not appear on DDS within 20 s (domain %d)\n",
+                   dds_options.domain_id);
+      return 1;
+    }
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
 
@@ -144,12 +160,19 @@ int main(int argc, char** argv) {
   std::string config = std::string(PIXYSLAM_CONFIG_DIR) + "/slam_estimator.yaml";
   double duration_s = 60.0;
   std::string out;
+  std::vector<std::string> dds_overrides;
   app::Cli cli{"bench_latency",
                "End-to-end latency Odometry -> MapState through a separate slam_estimator on loopback."};
   cli.option("--config", config, "the estimator's YAML (default config/slam_estimator.yaml)").existing_file().type("FILE");
   cli.option("--duration", duration_s, "seconds of odometry (default 60)").positive().type("S");
   cli.option("--out", out, "every sample's latency as CSV (for scripts/plot_results.py)").type("FILE.csv");
+  app::add_domain(cli, dds_overrides);
   if (const auto done = cli.parse(argc, argv)) return *done;
+  // --domain N, for the estimator too.
+  std::string domain;
+  for (const std::string& o : dds_overrides) {
+    if (o.rfind("dds.domain_id=", 0) == 0) domain = o.substr(std::string("dds.domain_id=").size());
+  }
   // A bad config exits 2, any other error 1 (as every program here).
-  return app::run_main("bench_latency", [&] { return bench::run(config, duration_s, out); });
+  return app::run_main("bench_latency", [&] { return bench::run(config, duration_s, out, dds_overrides, domain); });
 }
