@@ -11,7 +11,9 @@
 
 #include <gtest/gtest.h>
 
+#include "pixyslam/foxglove_node/bridge_options.h"
 #include "pixyslam/foxglove_node/ws_server.h"
+#include "pixyslam/parameters/parameters.h"
 
 namespace pixyslam::foxglove_node {
 namespace {
@@ -80,6 +82,26 @@ template <class Predicate>
 bool eventually(Predicate p) {
   for (int i = 0; i < 200 && !p(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   return p();
+}
+
+// foxglove_bridge.address is checked with the options (a config error, exit 2),
+// not when the server binds it (exit 1, no key named).
+TEST(BridgeOptions, TheAddressMustBeANumericIpAddress) {
+  using foxglove_node::BridgeOptions;
+  for (const char* good : {"127.0.0.1", "0.0.0.0", "::1", "::"}) {
+    BridgeOptions o;
+    EXPECT_NO_THROW(parameters::apply_override(o, foxglove_node::bridge_parameters(), "foxglove_bridge",
+                                               std::string("foxglove_bridge.address=") + good))
+        << good;
+    EXPECT_EQ(o.server.address, good);
+  }
+  for (const char* bad : {"nope", "999.1.1.1", "localhost", "127.0.0.1:8765"}) {
+    BridgeOptions o;
+    EXPECT_THROW(parameters::apply_override(o, foxglove_node::bridge_parameters(), "foxglove_bridge",
+                                            std::string("foxglove_bridge.address=") + bad),
+                 std::invalid_argument)
+        << bad;
+  }
 }
 
 TEST(WsServer, AdvertisesToAFoxgloveClientAndRefusesOthers) {

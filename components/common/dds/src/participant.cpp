@@ -1,5 +1,6 @@
 #include "pixyslam/dds/participant.h"
 
+#include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/dds/topics.h"
 
 #include <arpa/inet.h>
@@ -141,10 +142,12 @@ fdds::DomainParticipant* create_participant(const DdsOptions& options, const std
   fdds::DomainParticipantQos qos;
   if (factory->get_participant_qos_from_profile(options.participant_profile, qos) !=
       ReturnCode_t::RETCODE_OK) {
-    throw std::runtime_error("no participant profile '" + options.participant_profile + "' in '" +
-                             (options.profiles_file.empty() ? std::string("(no profiles file)")
-                                                            : options.profiles_file) +
-                             "'");
+    // A setting, not a failure of the network: a config error (exit 2) naming where it comes from.
+    throw config::ConfigError("dds.participant_profile (or --set / PIXYSLAM_DDS_PROFILE): no participant profile '" +
+                              options.participant_profile + "' in '" +
+                              (options.profiles_file.empty() ? std::string("(no profiles file)")
+                                                             : options.profiles_file) +
+                              "'");
   }
   qos.name(name);
   apply_deployment(options, name, listener != nullptr, qos);

@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include <arpa/inet.h>
+
 #include "pixyslam/config/parameters_yaml.h"
 #include "pixyslam/dds/topic_config.h"
 
@@ -13,6 +15,14 @@ void check_frame(const std::string& v) {
   if (v.empty()) throw std::invalid_argument("empty");
 }
 
+// A numeric IPv4 or IPv6 address (the server binds it; no name lookup).
+void check_address(const std::string& v) {
+  unsigned char bytes[16];
+  if (::inet_pton(AF_INET, v.c_str(), bytes) != 1 && ::inet_pton(AF_INET6, v.c_str(), bytes) != 1) {
+    throw std::invalid_argument("'" + v + "' is not a numeric IPv4 or IPv6 address");
+  }
+}
+
 }  // namespace
 
 const parameters::Table<BridgeOptions>& bridge_parameters() {
@@ -20,7 +30,7 @@ const parameters::Table<BridgeOptions>& bridge_parameters() {
   namespace P = parameters;
   static const P::Table<O> table = {
       P::text<O>("address", "IPv4/IPv6 address to listen on (127.0.0.1: this host only; 0.0.0.0: every interface)",
-                 [](O& o) -> std::string& { return o.server.address; }, check_frame),
+                 [](O& o) -> std::string& { return o.server.address; }, check_address),
       P::integer<O, std::uint16_t>("port", 0, 65535, "", "TCP port (Foxglove's default 8765; 0: any free port)",
                                    [](O& o) -> std::uint16_t& { return o.server.port; }),
       P::integer<O, std::size_t>("max_clients", 1, 1000, "", "connections beyond this are refused",

@@ -24,6 +24,7 @@
 
 #include <gtest/gtest.h>
 
+#include "pixyslam/config/yaml_reader.h"
 #include "pixyslam/dds/endpoints.h"
 #include "raw_sample_writer.h"
 
@@ -56,6 +57,21 @@ struct Collector {
   std::vector<Message> got;
   Reader<Message> reader;  // last: its callback uses the members above
 };
+
+// A participant profile the profiles file lacks is a setting's error (exit 2
+// in every program), named with where it can be set; nothing joins the network.
+TEST(DdsLoopback, AnUnknownParticipantProfileIsAConfigErrorNamingTheKey) {
+  DdsOptions o = loopback_options();
+  o.participant_profile = "no_such_profile";
+  try {
+    Participant participant(o, "test");
+    ADD_FAILURE() << "a participant was made with an unknown profile";
+  } catch (const config::ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("dds.participant_profile"), std::string::npos) << what;
+    EXPECT_NE(what.find("'no_such_profile'"), std::string::npos) << what;
+  }
+}
 
 TEST(DdsLoopback, EveryOdometryMessageArrivesInOrder) {
   Participant sender(loopback_options(), "test_sender");
