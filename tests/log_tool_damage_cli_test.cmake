@@ -77,6 +77,9 @@ run(print_none 1 print ${dir}/closed.mcap --topics "!pixyslam/odometry")
 expect_match("print --topics excluding all" "${print_none_err}" "--topics '!pixyslam/odometry': ")
 run(print_absent 1 print ${dir}/closed.mcap --topics pixyslam/map_state)
 expect_match("print --topics absent" "${print_absent_err}" "--topics 'pixyslam/map_state': ")
+# A name that is no topic of this project is a command-line error (2), as in echo, hz and record.
+run(print_unknown 2 print ${dir}/closed.mcap --topics pixyslam/nope)
+expect_match("print --topics unknown" "${print_unknown_err}" "--topics 'pixyslam/nope': ")
 run(check_closed 0 check ${dir}/closed.mcap --expect pixyslam/odometry=${MESSAGES})
 
 # Not closed (cut in a chunk): exit 0 for info and print, a note on stderr;

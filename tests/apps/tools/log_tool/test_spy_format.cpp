@@ -187,6 +187,20 @@ TEST(SpyFormat, GroundTruthFieldsCanBeFoundByPath) {
   EXPECT_EQ(v.find("pose.nothing"), nullptr);
 }
 
+// compare --ignore / --match: a misspelt field is refused, not silently unused.
+TEST(CompareFields, FieldPathsAreCheckedAgainstAMessage) {
+  msg::MapState m;
+  m.landmarks().resize(2);
+  const Value v = to_value(m);
+  for (const char* good : {"header.stamp_ns", "mean_pose.x_m", "odometry_sequence", "landmarks", "landmarks.x_m",
+                           "landmarks[1].cov_xy_m2", "pose_covariance", "particle_poses.theta_rad"}) {
+    EXPECT_TRUE(field_path_exists(v, good)) << good;  // particle_poses is empty: not checkable below it
+  }
+  for (const char* bad : {"nosuchfield", "mean_pose.z_m", "landmarks.z", "mean_pose.x_m.below", "header.", ""}) {
+    EXPECT_FALSE(field_path_exists(v, bad)) << bad;
+  }
+}
+
 TEST(SpyFormat, OptimisedMapAsYamlDocumentHasEveryFieldInIdlOrder) {
   EXPECT_EQ(to_yaml_document(to_value(optimised_map())),
             "---\n"

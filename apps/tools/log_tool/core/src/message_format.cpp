@@ -642,4 +642,27 @@ GapStats gap_stats(const std::vector<double>& arrivals_s) {
   return a.stats();
 }
 
+bool field_path_exists(const Value& message, const std::string& path) {
+  const std::string plain = without_indices(path);
+  const Value* at = &message;
+  std::size_t start = 0;
+  while (start <= plain.size()) {
+    while (at->kind() == Value::Kind::kList) {
+      if (at->items().empty()) return true;  // nothing to look into
+      at = &at->items().front();
+    }
+    const std::size_t dot = std::min(plain.find('.', start), plain.size());
+    const std::string name = plain.substr(start, dot - start);
+    if (name.empty() || at->kind() != Value::Kind::kStruct) return false;
+    const Value* next = nullptr;
+    for (const auto& [field, value] : at->fields()) {
+      if (field == name) next = &value;
+    }
+    if (next == nullptr) return false;
+    at = next;
+    start = dot + 1;
+  }
+  return true;
+}
+
 }  // namespace pixyslam::log_tool

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <vector>
 
+#include "pixyslam/app/cli.h"
 #include "pixyslam/dds/topic_selection.h"
 #include "pixyslam/dds/topics.h"
 #include "pixyslam/log_tool/message_format.h"
@@ -457,8 +458,13 @@ int run_print(const PrintRequest& request, std::ostream& out, std::ostream& err)
     const dds::TopicSelection selection =
         dds::select_topics(request.topics, std::vector<std::string>(printed.begin(), printed.end()));
     if (!selection.error.empty()) {
-      throw std::runtime_error(request.path + ": --topics '" + request.topics[selection.bad_pattern] +
-                               "': " + selection.error);
+      const std::string& pattern = request.topics[selection.bad_pattern];
+      const std::string message = request.path + ": --topics '" + pattern + "': " + selection.error;
+      // No topic of this project by that name: a command-line error (2), as echo, hz and record;
+      // a topic the file lacks, or patterns that leave none: the input's (1).
+      const bool plain_name = pattern.find_first_of("*?[!") == std::string::npos;
+      if (plain_name && !dds::visit_topic_type(pattern, [](auto) {})) throw app::UsageError(message);
+      throw std::runtime_error(message);
     }
     printed = std::set<std::string>(selection.topics.begin(), selection.topics.end());
   }
@@ -486,8 +492,23 @@ int run_print(const PrintRequest& request, std::ostream& out, std::ostream& err)
 }
 
 int run_compare(const CompareRequest& request, std::ostream& out) {
+  if (!dds::visit_topic_type(request.topic, [](auto) {})) {
+    std::string known;
+    for (const dds::TopicInfo& t : dds::known_topics()) known += (known.empty() ? "" : ", ") + t.topic;
+    throw app::UsageError("--topic: unknown topic '" + request.topic + "' (known: " + known + ")");
+  }
   const std::vector<Value> first = decoded_messages(request.first_path, request.topic);
   const std::vector<Value> second = decoded_messages(request.second_path, request.topic);
+  // A misspelt field would silently compare everything, or pair by position.
+  const Value* sample = !first.empty() ? &first.front() : !second.empty() ? &second.front() : nullptr;
+  for (const auto* fields : {&request.ignored, &request.match}) {
+    for (const std::string& f : *fields) {
+      if (sample != nullptr && !field_path_exists(*sample, f)) {
+        throw app::UsageError(std::string(fields == &request.ignored ? "--ignore" : "--match") + ": '" + f +
+                              "' is not a field of " + request.topic + "'s messages");
+      }
+    }
+  }
   out << request.topic << ": " << first.size() << " messages in " << request.first_path << ", " << second.size()
       << " in " << request.second_path << "\n";
   const MessagePairs paired = pair_messages(first, second, request.match);

@@ -89,6 +89,11 @@ std::string format_double(double v);
 std::vector<std::string> compare_values(const Value& a, const Value& b, const std::vector<std::string>& ignored,
                                         double tolerance, std::size_t max_lines);
 
+// False when `path` ("pose.x_m", "landmarks[2].x_m" or "landmarks.x_m") names
+// no field of `message`: a struct lacks a name on it, or a number or text has
+// a field below it. Below an empty list nothing can be checked: true. Pure.
+bool field_path_exists(const Value& message, const std::string& path);
+
 // Messages of two recordings paired by the values of `key_fields` (e.g. the
 // input sequence numbers a MapState includes), in order among equal keys;
 // without key fields, by position. Pure.
