@@ -248,7 +248,7 @@ int main(int argc, char** argv) {
       "hardware", "the robot_sim hardware decoded by the bridges' parsers (their configs beside --sim-config)");
   common(hardware);
   hardware.option("--sim-config", args.sim_config, "robot_sim's YAML").required().existing_file().type("FILE");
-  hardware.option("--duration", args.duration_s, "seconds of hardware time (default 85)").non_negative().type("S");
+  hardware.option("--duration", args.duration_s, "seconds of hardware time (default 85; > 0)").positive().type("S");
   if (const auto done = cli.parse(argc, argv)) return *done;
   args.mode = sim.chosen() ? "sim" : mrclam.chosen() ? "mrclam" : "hardware";
   return app::run_main("slam_offline", [&] { return run(args); });
