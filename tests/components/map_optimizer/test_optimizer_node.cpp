@@ -359,7 +359,9 @@ TEST(OptimizerNodeOptions, ErrorsNameTheFileAndKey) {
   const std::string estimator = "filter_config: " + kConfigDir + "/slam_estimator.yaml\n";
   expect_error(estimator + "optimizer:\n  window_period_s: -1\n", "window_period_s");
   expect_error(estimator + "optimizer:\n  windwo_keyframes: 5\n", "windwo_keyframes");
-  expect_error("filter_config: no_such_file.yaml\noptimizer: {}\n", "no_such_file.yaml");
+  // The missing file, and the file and key that named it.
+  expect_error("filter_config: no_such_file.yaml\noptimizer: {}\n",
+               dir.file("map_optimizer_test.yaml") + ": filter_config: " + dir.path() + "/no_such_file.yaml");
   expect_error(estimator, "optimizer");  // the section is required
 }
 

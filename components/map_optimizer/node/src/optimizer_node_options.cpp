@@ -67,7 +67,8 @@ OptimizerNodeOptions read_optimizer_node_options_file(const std::string& path) {
   std::string filter_config = root.text("filter_config");
   if (!filter_config.empty() && filter_config.front() != '/') filter_config = config::folder_of(path) + "/" + filter_config;
   // The estimator's own reader: the same keys, checks and defaults as the filter's.
-  const slam_node::EstimatorOptions estimator = slam_node::read_estimator_options_file(filter_config);
+  const slam_node::EstimatorOptions estimator = config::read_referenced(
+      path, "filter_config", [&] { return slam_node::read_estimator_options_file(filter_config); });
   o.optimizer = map_optimizer::MapOptimizerOptions::from_filter(estimator.filter);
   o.initial_pose = estimator.initial_pose;
   o.queue = estimator.queue;

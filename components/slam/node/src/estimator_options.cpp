@@ -93,9 +93,11 @@ EstimatorOptions read_estimator_options_file(const std::string& path) {
     if (root.has("filter")) root.fail("filter_config", "give filter: or filter_config:, not both");
     std::string filter_config = root.text("filter_config");
     if (!filter_config.empty() && filter_config.front() != '/') filter_config = config::folder_of(path) + "/" + filter_config;
-    config::YamlReader filter_root = config::YamlReader::from_file(filter_config);
-    config::YamlReader filter = filter_root.child("filter");
-    o.filter = slam::read_filter_options(filter);
+    o.filter = config::read_referenced(path, "filter_config", [&] {
+      config::YamlReader filter_root = config::YamlReader::from_file(filter_config);
+      config::YamlReader filter = filter_root.child("filter");
+      return slam::read_filter_options(filter);
+    });
   } else {
     config::YamlReader filter = root.child("filter");
     o.filter = slam::read_filter_options(filter);

@@ -51,12 +51,12 @@ DatasetBridgeOptions read_dataset_bridge_options_file(const std::string& path) {
   DatasetBridgeOptions o;
   std::string filter_config = root.text("filter_config");
   if (!filter_config.empty() && filter_config.front() != '/') filter_config = config::folder_of(path) + "/" + filter_config;
-  {
+  config::read_referenced(path, "filter_config", [&] {
     config::YamlReader filter_root = config::YamlReader::from_file(filter_config);
     config::YamlReader filter = filter_root.child("filter");
     o.filter = slam::read_filter_options(filter);
     o.sensor_model = offline::read_mrclam_sensor_model(filter_root);
-  }
+  });
   config::YamlReader y = root.child("dataset_bridge");
   if (y.has("robots")) {
     std::string text;

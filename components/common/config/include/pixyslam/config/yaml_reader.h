@@ -115,4 +115,15 @@ class YamlReader {
   std::set<std::string> used_;
 };
 
+// read() of the file that `key` of config file `path` names (e.g. filter_config):
+// a ConfigError from it also names `path` and `key`, which sent the user there.
+template <class Read>
+auto read_referenced(const std::string& path, const std::string& key, Read read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const ConfigError& e) {
+    throw ConfigError(path + ": " + key + ": " + e.what());
+  }
+}
+
 }  // namespace pixyslam::config
