@@ -47,6 +47,9 @@ expect(2 "--config: At Most 1" camera --config ${pixy} --config ${pixy} --sample
 expect(2 "unknown option --confg" camera --confg ${pixy} --samples ${WORK_DIR}/poles.csv)
 # A measurement file is input, not configuration: 1, with the OS reason.
 expect(1 "nope.csv: cannot open: No such file or directory" camera --config ${pixy} --samples ${WORK_DIR}/nope.csv)
+# --out in a folder that is not there: refused before the calibration runs.
+expect(2 "--out ${WORK_DIR}/no_folder/pixy.yaml: no folder '${WORK_DIR}/no_folder'" camera --config ${pixy}
+       --samples ${WORK_DIR}/poles.csv --out ${WORK_DIR}/no_folder/pixy.yaml)
 # noise: --dataset, and --mrclam, its old name, still accepted.
 foreach(flag --dataset --mrclam)
   expect(1 "data set folder not found: ${WORK_DIR}/no_data" noise ${flag} ${WORK_DIR}/no_data --robot 1

@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -405,6 +406,13 @@ int main(int argc, char** argv) {
   noise_command.flag("--fit-range-scale", fit_range_scale, "also fit (and write) the range scale");
   if (const auto done = cli.parse(argc, argv)) return *done;
   return app::run_main("pixyslam_calibrate", [&] {
+    // A folder that is not there fails now, not after a calibration of minutes.
+    if (flags.has("out")) {
+      const std::string folder = config::folder_of(flags.get("out"));
+      if (!std::filesystem::is_directory(folder)) {
+        throw app::UsageError("--out " + flags.get("out") + ": no folder '" + folder + "' to write it in");
+      }
+    }
     if (camera.chosen()) return calibrate_camera(flags);
     if (odometry_command.chosen()) return odometry(flags);
     return noise(flags, robot, with_ground_truth, fit_range_scale);
