@@ -45,7 +45,7 @@ std::string own_folder() {
 }  // namespace
 
 int run(const std::string& config, double duration_s, const std::string& out,
-        const std::vector<std::string>& dds_overrides, const std::string& domain) {
+        const std::vector<std::string>& dds_overrides) {
   // The estimator's DDS settings, as it resolves them (a bad dds: key exits 2 here, before it starts).
   dds::DdsOptions dds_options = dds::read_dds_options_file(config, dds::default_profiles_file());
   dds::resolve_settings(dds_options, dds_overrides);
@@ -53,7 +53,7 @@ int run(const std::string& config, double duration_s, const std::string& out,
   // The estimator as its own process, its output forwarded with a prefix.
   launcher::ProcessGroup estimator(own_folder(), stdout);
   std::vector<std::string> command{"slam_estimator", "--config", config};
-  if (!domain.empty()) command.insert(command.end(), {"--domain", domain});
+  command.insert(command.end(), {"--domain", std::to_string(dds_options.domain_id)});  // the domain resolved here
   estimator.start({"slam_estimator", command, 0.0, false, {}});
 
   dds::Participant participant(dds_options, "bench_latency");
@@ -168,11 +168,6 @@ int main(int argc, char** argv) {
   cli.option("--out", out, "every sample's latency as CSV (for scripts/plot_results.py)").type("FILE.csv");
   app::add_domain(cli, dds_overrides);
   if (const auto done = cli.parse(argc, argv)) return *done;
-  // --domain N, for the estimator too.
-  std::string domain;
-  for (const std::string& o : dds_overrides) {
-    if (o.rfind("dds.domain_id=", 0) == 0) domain = o.substr(std::string("dds.domain_id=").size());
-  }
   // A bad config exits 2, any other error 1 (as every program here).
-  return app::run_main("bench_latency", [&] { return bench::run(config, duration_s, out, dds_overrides, domain); });
+  return app::run_main("bench_latency", [&] { return bench::run(config, duration_s, out, dds_overrides); });
 }

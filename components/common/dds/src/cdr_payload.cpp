@@ -127,6 +127,15 @@ const std::vector<TopicInfo>& known_topics() {
   return topics;
 }
 
+const std::vector<std::string>& known_topic_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const TopicInfo& t : known_topics()) out.push_back(t.topic);
+    return out;
+  }();
+  return names;
+}
+
 const TopicInfo* find_topic(std::string_view topic) {
   for (const TopicInfo& t : known_topics()) {
     if (t.topic == topic) return &t;

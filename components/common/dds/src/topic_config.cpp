@@ -6,8 +6,7 @@
 namespace pixyslam::dds {
 
 std::vector<std::string> read_topic_patterns(config::YamlReader& section) {
-  std::vector<std::string> all;
-  for (const TopicInfo& t : known_topics()) all.push_back(t.topic);
+  const std::vector<std::string>& all = known_topic_names();
   if (!section.has("topics")) return all;
   const std::vector<std::string> patterns = section.text_list("topics");
   if (patterns.empty()) section.fail("topics", "empty list (leave the key out for every topic)");

@@ -69,7 +69,7 @@ class TypedBridgeSubscription final : public BridgeSubscription {
 
 BridgeNode::BridgeNode(const BridgeOptions& options) : options_(options), visualiser_(options.visual) {
   if (options_.topics.empty()) {
-    for (const dds::TopicInfo& t : dds::known_topics()) options_.topics.push_back(t.topic);
+    options_.topics = dds::known_topic_names();
   }
   WsServerOptions server = options_.server;
   server.metadata["robot_id"] = options_.dds.robot_id;

@@ -63,8 +63,7 @@ class TypedSubscription final : public Subscription {
 }  // namespace detail
 
 LoggerNode::LoggerNode(const LoggerOptions& options) : options_(options) {
-  std::vector<std::string> all;
-  for (const dds::TopicInfo& t : dds::known_topics()) all.push_back(t.topic);
+  const std::vector<std::string>& all = dds::known_topic_names();
   if (options_.topics.empty()) {
     options_.topics = all;
   } else {

@@ -14,9 +14,7 @@ namespace pixyslam::logger_node {
 
 std::vector<std::string> select_known_topics(const std::vector<std::string>& patterns, const std::string& what) {
   if (patterns.empty()) throw std::invalid_argument(what + ": empty list");
-  std::vector<std::string> known;
-  for (const dds::TopicInfo& t : dds::known_topics()) known.push_back(t.topic);
-  const dds::TopicSelection selection = dds::select_topics(patterns, known);
+  const dds::TopicSelection selection = dds::select_topics(patterns, dds::known_topic_names());
   if (!selection.error.empty()) {
     throw std::invalid_argument(what + ": '" + patterns[selection.bad_pattern] + "': " + selection.error);
   }

@@ -458,12 +458,14 @@ int run_print(const PrintRequest& request, std::ostream& out, std::ostream& err)
     const dds::TopicSelection selection =
         dds::select_topics(request.topics, std::vector<std::string>(printed.begin(), printed.end()));
     if (!selection.error.empty()) {
-      const std::string& pattern = request.topics[selection.bad_pattern];
-      const std::string message = request.path + ": --topics '" + pattern + "': " + selection.error;
-      // No topic of this project by that name: a command-line error (2), as echo, hz and record;
-      // a topic the file lacks, or patterns that leave none: the input's (1).
-      const bool plain_name = pattern.find_first_of("*?[!") == std::string::npos;
-      if (plain_name && !dds::visit_topic_type(pattern, [](auto) {})) throw app::UsageError(message);
+      // Patterns no recording of this project could satisfy (an unknown name): a
+      // command-line error (2), as echo, hz and record; a topic this file lacks: the input's (1).
+      const dds::TopicSelection in_project = dds::select_topics(request.topics, dds::known_topic_names());
+      const bool usage = !in_project.error.empty();
+      const dds::TopicSelection& bad = usage ? in_project : selection;
+      const std::string message =
+          request.path + ": --topics '" + request.topics[bad.bad_pattern] + "': " + bad.error;
+      if (usage) throw app::UsageError(message);
       throw std::runtime_error(message);
     }
     printed = std::set<std::string>(selection.topics.begin(), selection.topics.end());
@@ -492,10 +494,9 @@ int run_print(const PrintRequest& request, std::ostream& out, std::ostream& err)
 }
 
 int run_compare(const CompareRequest& request, std::ostream& out) {
-  if (!dds::visit_topic_type(request.topic, [](auto) {})) {
-    std::string known;
-    for (const dds::TopicInfo& t : dds::known_topics()) known += (known.empty() ? "" : ", ") + t.topic;
-    throw app::UsageError("--topic: unknown topic '" + request.topic + "' (known: " + known + ")");
+  if (dds::find_topic(request.topic) == nullptr) {
+    const std::string why = dds::select_topics({request.topic}, dds::known_topic_names()).error;
+    throw app::UsageError("--topic: " + (why.empty() ? "'" + request.topic + "' is not one topic" : why));
   }
   const std::vector<Value> first = decoded_messages(request.first_path, request.topic);
   const std::vector<Value> second = decoded_messages(request.second_path, request.topic);

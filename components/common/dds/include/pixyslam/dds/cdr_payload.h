@@ -55,6 +55,8 @@ struct TopicInfo {
 
 // Every topic of the system (dds/topics.h), in a fixed order.
 const std::vector<TopicInfo>& known_topics();
+// Their names, in the same order.
+const std::vector<std::string>& known_topic_names();
 // nullptr if `topic` is not one of them.
 const TopicInfo* find_topic(std::string_view topic);
 
